@@ -1,0 +1,59 @@
+// Spatial rigid-body inertia, stored compactly as (m, h = m·c, Ī) where c is
+// the centre of mass and Ī the rotational inertia about the frame ORIGIN.
+// Its 6×6 matrix (linear first) is  [m·1  −h×; h×  Ī],  Ī = I_c − m·c×c×.
+#pragma once
+
+#include "zwang/spatial/transform.hpp"
+
+namespace zwang::spatial {
+
+struct RigidInertia {
+  double mass = 0.0;
+  Vec3 h = Vec3::Zero();     // first mass moment m·c
+  Mat3 Ibar = Mat3::Zero();  // rotational inertia about the origin
+
+  // From mass, centre of mass and rotational inertia about the centre of mass,
+  // all in the body frame.
+  static RigidInertia fromMassComInertia(double m, const Vec3& com, const Mat3& I_com) {
+    const Mat3 C = skew(com);
+    return {m, m * com, I_com - m * C * C};
+  }
+
+  Vec3 com() const { return mass > 0.0 ? Vec3(h / mass) : Vec3::Zero(); }
+  Mat3 inertiaAboutCom() const {
+    if (mass <= 0.0) return Ibar;
+    const Mat3 C = skew(com());
+    return Ibar + mass * C * C;
+  }
+
+  Vec6 operator*(const Vec6& m) const {
+    const Vec3 v = lin(m), w = ang(m);
+    return stack(mass * v - h.cross(w), h.cross(v) + Ibar * w);
+  }
+
+  RigidInertia operator+(const RigidInertia& o) const { return {mass + o.mass, h + o.h, Ibar + o.Ibar}; }
+  RigidInertia& operator+=(const RigidInertia& o) { return *this = *this + o; }
+
+  Mat6 matrix() const {
+    Mat6 I;
+    I.topLeftCorner<3, 3>() = mass * Mat3::Identity();
+    I.topRightCorner<3, 3>() = -skew(h);
+    I.bottomLeftCorner<3, 3>() = skew(h);
+    I.bottomRightCorner<3, 3>() = Ibar;
+    return I;
+  }
+};
+
+// The same body's inertia, expressed in frame B, given it in frame A and X = ᴮX_A.
+inline RigidInertia transformInertia(const Transform& X, const RigidInertia& I) {
+  const Vec3 h_shift = I.h - I.mass * X.r;  // first moment about B's origin, A's axes
+  const Mat3 Ibar_shift = I.Ibar + skew(X.r) * skew(I.h) + skew(h_shift) * skew(X.r);
+  return {I.mass, X.E * h_shift, X.E * Ibar_shift * X.E.transpose()};
+}
+
+// The inverse: given the inertia in B, express it in A.
+inline RigidInertia inverseTransformInertia(const Transform& X, const RigidInertia& I) {
+  return transformInertia(X.inverse(), I);
+}
+
+}  // namespace zwang::spatial

@@ -1,0 +1,34 @@
+// Status of a hot-path call: no exception, no allocation; the message is held
+// in a fixed buffer inside the Status itself.
+#pragma once
+
+#include <cstdio>
+
+namespace zwang {
+
+enum class StatusCode {
+  Ok = 0,
+  SizeMismatch,      // an input vector has the wrong length
+  NonFinite,         // an input holds NaN or Inf
+  WorkspaceTooSmall, // the workspace was sized for fewer constraint rows
+  ModelMismatch,     // task or workspace built for another model
+  Degenerate,        // a joint has no inertia to move (D_j ≤ 0) in this configuration
+};
+
+struct Status {
+  StatusCode code = StatusCode::Ok;
+  char message[240] = {};
+
+  bool ok() const { return code == StatusCode::Ok; }
+  explicit operator bool() const { return ok(); }
+
+  template <class... Args>
+  static Status error(StatusCode code, const char* format, Args... args) {
+    Status s;
+    s.code = code;
+    std::snprintf(s.message, sizeof s.message, format, args...);
+    return s;
+  }
+};
+
+}  // namespace zwang

@@ -1,0 +1,97 @@
+// What a solve is asked to do, apart from the joint state: gravity, external
+// wrenches and acceleration constraints Aᵀ Ẍ = b on any frames of the chain.
+// Build a Task once (this allocates); then change set points and wrench values
+// every control cycle (this does not).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "zwang/model.hpp"
+
+namespace zwang {
+
+// How the components of a user-facing spatial quantity are expressed.
+// Every such quantity refers to the ORIGIN of its frame (a wrench acts there; an
+// acceleration is the classical acceleration of that point), so the choice is
+// only of axes:
+//   Local : the frame's own axes;
+//   World : the world (base) axes, at the frame origin. KDL calls this
+//           "base-aligned"; `Aligned` is the same choice under that name.
+enum class Expressed { Local, World, Aligned = World };
+
+using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+// Options for the constraint balance ν = L⁻¹(…) (docs/solver.md, "Singular tasks").
+struct BalanceOptions {
+  // L counts as singular when its smallest eigenvalue is below this fraction of
+  // its largest; its rank counts the eigenvalues above it.
+  double singular_threshold = 1e-9;
+};
+
+class Task {
+ public:
+  explicit Task(const Model& model);
+
+  Vec3 gravity{0.0, 0.0, -9.81};
+  BalanceOptions balance;
+
+  // Constrain the classical acceleration of `frame`'s origin along the columns
+  // of A (6×m, unit constraint forces, linear part first): Aᵀ Ẍ = b. b starts
+  // at zero. Returns the index of the constraint's first row in b and ν.
+  int addConstraint(int frame, const ConstraintMatrix& A, Expressed expressed = Expressed::Local);
+  int addConstraint(const std::string& frame, const ConstraintMatrix& A, Expressed expressed = Expressed::Local);
+
+  // Apply a wrench [f; n] at `frame`'s origin. Starts at zero. Returns its index.
+  int addWrench(int frame, Expressed expressed = Expressed::Local);
+  int addWrench(const std::string& frame, Expressed expressed = Expressed::Local);
+
+  // Set points b (true accelerations, gravity is handled inside). Set them freely.
+  Eigen::VectorXd& targets() { return b_; }
+  const Eigen::VectorXd& targets() const { return b_; }
+  // Wrench values, one 6-vector per addWrench.
+  Vec6& wrench(int index) { return wrenches_.at(static_cast<std::size_t>(index)).value; }
+  const Vec6& wrench(int index) const { return wrenches_.at(static_cast<std::size_t>(index)).value; }
+
+  int constraintRows() const { return static_cast<int>(b_.size()); }
+  int wrenchCount() const { return static_cast<int>(wrenches_.size()); }
+
+  // --- read by the solver -------------------------------------------------
+  struct ConstraintGroup {
+    int frame;
+    int body;
+    Expressed expressed;
+    int first_row;  // in the user's row order (b, ν)
+    int rows;
+    ConstraintMatrix A;
+  };
+  struct AppliedWrench {
+    int frame;
+    Expressed expressed;
+    Vec6 value = Vec6::Zero();
+  };
+  // Groups sorted by body, farthest from the base first, so that the
+  // constraints acting on bodies i..N are always a leading block of columns
+  // ("solver order"). `solver_row[k]` is the user row of solver column k.
+  const std::vector<ConstraintGroup>& groups() const { return groups_; }
+  const std::vector<int>& solverRowToUserRow() const { return solver_row_; }
+  // Number of solver columns acting on body b or beyond (a leading block).
+  int activeColumns(int body) const { return active_.at(static_cast<std::size_t>(body)); }
+  const std::vector<AppliedWrench>& wrenches() const { return wrenches_; }
+  int modelDof() const { return dof_; }
+  int modelFrames() const { return frames_; }
+
+ private:
+  int dof_;
+  int frames_;
+  std::vector<std::string> frame_names_;  // copied, so the Task does not dangle
+  std::vector<int> frame_bodies_;
+  std::vector<ConstraintGroup> groups_;
+  std::vector<int> solver_row_;
+  std::vector<int> active_;
+  std::vector<AppliedWrench> wrenches_;
+  Eigen::VectorXd b_;
+  void reorder();
+};
+
+}  // namespace zwang

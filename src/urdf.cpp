@@ -1,0 +1,1 @@
+namespace zwang {}  // placeholder, filled in by the core work

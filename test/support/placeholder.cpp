@@ -1,0 +1,1 @@
+namespace zwang::testing {}  // placeholder until the references land

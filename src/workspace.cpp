@@ -1,1 +1,48 @@
-namespace zwang {}  // placeholder, filled in by the core work
+#include "zwang/workspace.hpp"
+
+namespace zwang {
+
+Workspace::Workspace(const Model& model, int max_constraint_rows)
+    : dof_(model.dof()), capacity_(max_constraint_rows < 0 ? 0 : max_constraint_rows) {
+  const auto bodies = static_cast<std::size_t>(model.bodyCount());
+  const int n = dof_, m = capacity_;
+  solution.qdd.setZero(n);
+  solution.nu.setZero(0);
+  solution.tau_constraint.setZero(n);
+  solution.tau_control.setZero(n);
+  solution.body_acc_local.assign(bodies, Vec6::Zero());
+  solution.body_acc_world.assign(bodies, Vec6::Zero());
+
+  Xup.assign(bodies, Transform{});
+  Xworld.assign(bodies, Transform{});
+  S.assign(bodies, Vec6::Zero());
+  v.assign(bodies, Vec6::Zero());
+  c.assign(bodies, Vec6::Zero());
+  Fbias.assign(bodies, Vec6::Zero());
+  IA.assign(bodies, Mat6::Zero());
+  FA.assign(bodies, Vec6::Zero());
+  IAS.assign(bodies, Vec6::Zero());
+  D.assign(bodies, 0.0);
+  u.assign(bodies, 0.0);
+  Ahat.assign(bodies, ConstraintMatrix::Zero(6, m));
+  U.setZero(m);
+  L.setZero(m, m);
+  A_body.setZero(6, m);
+  b_body.setZero(m);
+  eigvec.setZero(m, m);
+  eigval.setZero(m);
+  rhs.setZero(m);
+  nu.setZero(m);
+  scratch.setZero(m);
+  a.assign(bodies, Vec6::Zero());
+  f.assign(bodies, Vec6::Zero());
+  Ic.assign(bodies, Mat6::Zero());
+  H.setZero(n, n);
+  tau.setZero(n);
+}
+
+Workspace::Workspace(const Model& model, const Task& task) : Workspace(model, task.constraintRows()) {
+  solution.nu.setZero(task.constraintRows());
+}
+
+}  // namespace zwang

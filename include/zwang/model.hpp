@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "zwang/spatial/cross.hpp"
 #include "zwang/spatial/inertia.hpp"
 
 namespace zwang {

@@ -23,10 +23,15 @@ enum class Expressed { Local, World, Aligned = World };
 using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 // Options for the constraint balance ν = L⁻¹(…) (docs/solver.md, "Singular tasks").
+// With λ_max, λ_min the extreme eigenvalues of L:
+//   singular  ⇔ λ_min < singular_threshold · λ_max  (rank counts the eigenvalues above it);
+//   damping   λ = max_damping · λ_max · sqrt(1 − (λ_min / (singular_threshold·λ_max))²) when singular, else 0;
+//   ν = Σ_k σ_k/(σ_k² + λ²) (e_kᵀ r) e_k  over the eigenpairs (σ_k, e_k) of L:
+// exact when L is regular; when singular, the damped least-squares solution
+// (constraints met in the least-squares sense, no force along L's null space).
 struct BalanceOptions {
-  // L counts as singular when its smallest eigenvalue is below this fraction of
-  // its largest; its rank counts the eigenvalues above it.
   double singular_threshold = 1e-9;
+  double max_damping = 1e-5;
 };
 
 class Task {

@@ -1,0 +1,95 @@
+// All scratch memory of the algorithms, made once per model (and constraint
+// capacity); a solve writes here and allocates nothing. One workspace per
+// thread: the Model is shared, the Workspace is not.
+//
+// The members are named after the report's Algorithm 1 (chapter 4.2); index i
+// is a body (0 = the fixed base), joint i−1 moves body i.
+#pragma once
+
+#include <vector>
+
+#include "zwang/task.hpp"
+
+namespace zwang {
+
+// State of the constraint coupling matrix L at the balance (docs/solver.md).
+struct CouplingDiagnostics {
+  int rows = 0;             // m, the number of constraint rows
+  int rank = 0;             // eigenvalues of L above singular_threshold·λ_max
+  double condition = 1.0;   // λ_max / λ_min (infinite when λ_min ≤ 0)
+  double damping = 0.0;     // λ used in ν = (L² + λ²)⁻¹ L r; 0 when not singular
+  bool singular = false;    // the task asked for more than the robot can do here
+};
+
+struct Solution {
+  Eigen::VectorXd qdd;             // q̈
+  // ν, constraint magnitudes, in the task's row order. Sized to the task's
+  // rows; a solve resizes it only when the task's row count changed since the
+  // last solve (the one allocation a solve can make; none for a fixed task).
+  Eigen::VectorXd nu;
+  Eigen::VectorXd tau_constraint;  // τ_c = Σ J_iᵀ A_i ν_i, the joint torques of the constraint forces
+  Eigen::VectorXd tau_control;     // τ + τ_c, what is sent to the motors
+  double gauss = 0.0;              // Z(q̈), the Gauss function (acceleration energy) at the solution
+  CouplingDiagnostics coupling;
+  // True classical acceleration [linear of the origin; angular] of every body
+  // frame (index = body; 0 is the base), in the body's axes and in world axes.
+  std::vector<Vec6> body_acc_local;
+  std::vector<Vec6> body_acc_world;
+};
+
+class Workspace {
+ public:
+  // Room for tasks with up to `max_constraint_rows` rows in all.
+  explicit Workspace(const Model& model, int max_constraint_rows = 6);
+  // Sized exactly for this task (solution.nu has its row count from the start).
+  Workspace(const Model& model, const Task& task);
+
+  int dof() const { return dof_; }
+  int constraintCapacity() const { return capacity_; }
+
+  Solution solution;
+
+  // --- outward sweep: poses, velocities, bias terms (Algorithm 1, lines 2–10)
+  std::vector<Transform> Xup;     // ⁱX_{i−1}(q_i)
+  std::vector<Transform> Xworld;  // ⁱX_0, world → body i
+  std::vector<Vec6> S;            // S_i, motion subspace in body i
+  std::vector<Vec6> v;            // Ẋ_i
+  std::vector<Vec6> c;            // Ẍ_bias,i = Ẋ_i × S_i q̇_i
+  std::vector<Vec6> Fbias;        // F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
+
+  // --- inward sweep: articulated quantities (lines 11–22)
+  std::vector<Mat6> IA;                // I^A_i
+  std::vector<Vec6> FA;                // F^A_bias,i
+  std::vector<Vec6> IAS;               // I^A_i S_i
+  std::vector<double> D;               // D_i = d_i + S_iᵀ I^A_i S_i
+  std::vector<double> u;               // τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
+  std::vector<ConstraintMatrix> Ahat;  // A_i: unit constraint forces felt at body i (6 × capacity)
+  Eigen::VectorXd U;                   // U_0, acceleration energy of bias forces and torques
+  Eigen::MatrixXd L;                   // 𝓛_0, constraint coupling matrix (capacity²)
+
+  // --- the task in body form, solver column order (see Task::groups)
+  ConstraintMatrix A_body;  // columns of each constraint, as forces on its body, in body axes
+  Eigen::VectorXd b_body;   // set points as spatial accelerations of the gravity-shifted sweep
+
+  // --- balance (line 25)
+  Eigen::MatrixXd eigvec;   // eigenvectors of 𝓛
+  Eigen::VectorXd eigval;
+  Eigen::VectorXd rhs;      // b − A_0ᵀẌ_0 − U_0
+  Eigen::VectorXd nu;       // ν in solver order
+  Eigen::VectorXd scratch;
+
+  // --- final outward sweep (lines 26–30) and the constraint-torque pass
+  std::vector<Vec6> a;      // Ẍ_i of the sweep (true acceleration + gravity shift)
+  std::vector<Vec6> f;      // accumulated forces for τ_c, RNEA
+
+  // --- other algorithms
+  std::vector<Mat6> Ic;     // composite inertias (CRBA)
+  Eigen::MatrixXd H;        // joint-space inertia (CRBA)
+  Eigen::VectorXd tau;      // inverse dynamics result (RNEA)
+
+ private:
+  int dof_;
+  int capacity_;
+};
+
+}  // namespace zwang

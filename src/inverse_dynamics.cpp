@@ -1,0 +1,56 @@
+#include "internal/checks.hpp"
+#include "internal/sweeps.hpp"
+#include "zwang/inverse_dynamics.hpp"
+
+namespace zwang {
+
+Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& qdd,
+                       Workspace& ws) noexcept {
+  if (ws.dof() != model.dof() || task.modelDof() != model.dof())
+    return Status::error(StatusCode::ModelMismatch, "workspace or task was made for another model");
+  if (Status s = internal::checkVector("q", q, model.dof()); !s) return s;
+  if (Status s = internal::checkVector("qd", qd, model.dof()); !s) return s;
+  if (Status s = internal::checkVector("qdd", qdd, model.dof()); !s) return s;
+  if (Status s = internal::checkFinite("gravity", task.gravity); !s) return s;
+  const int N = model.dof();
+  auto at = [](int i) { return static_cast<std::size_t>(i); };
+
+  internal::outwardKinematics(model, q, qd, ws);
+  ws.a[0] = internal::gravityShift(ws, 0, task.gravity);  // gravity as base acceleration
+  for (int i = 1; i <= N; ++i) {
+    const RigidInertia& I = model.inertia(i);
+    ws.a[at(i)] = ws.Xup[at(i)].applyMotion(ws.a[at(i - 1)]) + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
+    ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], I * ws.v[at(i)]);
+  }
+  internal::applyExternalWrenches(model, task, ws);
+  for (int i = 1; i <= N; ++i) ws.f[at(i)] = model.inertia(i) * ws.a[at(i)] + ws.Fbias[at(i)];
+  for (int i = N; i >= 1; --i) {
+    ws.tau[i - 1] = ws.S[at(i)].dot(ws.f[at(i)]) + model.joint(i - 1).rotor_inertia * qdd[i - 1];
+    if (i > 1) ws.f[at(i - 1)] += ws.Xup[at(i)].inverseApplyForce(ws.f[at(i)]);
+  }
+  return {};
+}
+
+Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q, Workspace& ws) noexcept {
+  if (ws.dof() != model.dof())
+    return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
+                         model.dof());
+  if (Status s = internal::checkVector("q", q, model.dof()); !s) return s;
+  const int N = model.dof();
+  auto at = [](int i) { return static_cast<std::size_t>(i); };
+  internal::outwardKinematics(model, q, Eigen::VectorXd(), ws);
+  for (int i = 1; i <= N; ++i) ws.Ic[at(i)] = model.inertia(i).matrix();
+  for (int i = N; i >= 1; --i) {
+    if (i > 1) ws.Ic[at(i - 1)] += ws.Xup[at(i)].inverseApplyInertia(ws.Ic[at(i)]);
+    Vec6 F = ws.Ic[at(i)] * ws.S[at(i)];
+    ws.H(i - 1, i - 1) = ws.S[at(i)].dot(F) + model.joint(i - 1).rotor_inertia;
+    for (int j = i; j > 1; --j) {
+      F = ws.Xup[at(j)].inverseApplyForce(F);
+      ws.H(i - 1, j - 2) = ws.H(j - 2, i - 1) = ws.S[at(j - 1)].dot(F);
+    }
+  }
+  return {};
+}
+
+}  // namespace zwang

@@ -1,1 +1,594 @@
-namespace zwang {}  // placeholder, filled in by the core work
+// URDF → Model (see urdf.hpp).
+//
+// Three readers look at the same text:
+//  1. TinyXML (the parser urdfdom itself uses) checks that the XML is well
+//     formed, so a syntax error is reported with its line and column, and
+//     checks every number zwang reads (origins, axes, masses, inertias,
+//     limits, dynamics) so that a NaN, an infinity or a word where a number
+//     belongs is reported with the link or joint and the attribute at fault
+//     rather than as urdfdom's generic "could not parse" lines.
+//  2. urdfdom builds the link/joint tree. Its console_bridge error messages
+//     are captured and turned into the exception text. urdfdom sometimes logs
+//     an error and still returns a model (e.g. an unreadable <mass> leaves a
+//     zero inertial behind), so any logged error is a failure.
+//  3. TinyXML again for what urdfdom drops: <transmission> elements with
+//     Drake's rotor-inertia tags.
+//
+// The chain runs from the root link to the tip link through revolute,
+// continuous, prismatic and fixed joints. Fixed joints become frames and
+// their links' inertias are merged into the body they are welded to. Besides
+// the chain's own links, every link connected to a chain link through fixed
+// joints only (side branches, links below the tip, fixed parents of the root)
+// is a frame. Links connected through a moving joint that is not on the chain
+// are NOT part of the model: their mass is ignored, as KDL's tree→chain
+// conversion does. A <mimic> tag is ignored (the joint stays independent).
+#include "zwang/urdf.hpp"
+
+#include <console_bridge/console.h>
+#include <tinyxml.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <vector>
+
+namespace zwang {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---------------------------------------------------------------------------
+// Messages
+
+std::string fmt(double value) {
+  std::ostringstream out;
+  out << std::setprecision(12) << value;
+  return out.str();
+}
+
+std::string nameList(const std::vector<std::string>& names, std::size_t max_shown = 12) {
+  std::ostringstream out;
+  for (std::size_t k = 0; k < names.size() && k < max_shown; ++k) out << (k ? ", " : "") << "'" << names[k] << "'";
+  if (names.size() > max_shown) out << ", … (" << names.size() - max_shown << " more)";
+  return out.str();
+}
+
+// Everything the loader throws goes through here: "<source>: <what>".
+class Reporter {
+ public:
+  explicit Reporter(std::string source) : source_(std::move(source)) {}
+  [[noreturn]] void fail(const std::string& what) const { throw ModelError(source_ + ": " + what); }
+  const std::string& source() const { return source_; }
+
+  // Runs a ModelBuilder call and prefixes its errors with the source.
+  template <class F>
+  void builder(F&& call) const {
+    try {
+      call();
+    } catch (const ModelError& e) {
+      fail(e.what());
+    }
+  }
+
+ private:
+  std::string source_;
+};
+
+// ---------------------------------------------------------------------------
+// Numbers as text (pass 1)
+
+enum class Parsed { Ok, NotANumber, NotFinite };
+
+// Locale-independent, like urdfdom's strToDouble, but telling a non-number
+// apart from NaN / infinity / out of range.
+Parsed parseNumber(std::string token, double& value) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') token.erase(0, 1);
+  const char* begin = token.data();
+  const char* end = begin + token.size();
+  const auto result = std::from_chars(begin, end, value, std::chars_format::general);
+  if (result.ec == std::errc::result_out_of_range) return Parsed::NotFinite;
+  if (result.ec != std::errc() || result.ptr != end) return Parsed::NotANumber;
+  return std::isfinite(value) ? Parsed::Ok : Parsed::NotFinite;
+}
+
+std::vector<std::string> splitWhitespace(const std::string& text) {
+  std::vector<std::string> tokens;
+  std::istringstream in(text);
+  std::string token;
+  while (in >> token) tokens.push_back(token);
+  return tokens;
+}
+
+// Checks attribute `attr` of `element` (if present): `count` finite numbers.
+// `what` names the owner and the element path, e.g. "joint 'j': <origin>".
+void checkNumbers(const Reporter& report, const std::string& what, const TiXmlElement* element, const char* attr,
+                  std::size_t count) {
+  if (element == nullptr) return;
+  const char* text = element->Attribute(attr);
+  if (text == nullptr) return;
+  const std::string field = what + " " + attr + " \"" + text + "\"";
+  const std::vector<std::string> tokens = splitWhitespace(text);
+  if (tokens.size() != count) {
+    report.fail(field + " must hold " + std::to_string(count) + (count == 1 ? " number" : " numbers") + ", not " +
+                std::to_string(tokens.size()));
+  }
+  for (const std::string& token : tokens) {
+    double value = 0.0;
+    switch (parseNumber(token, value)) {
+      case Parsed::Ok: break;
+      case Parsed::NotANumber: report.fail(field + ": '" + token + "' is not a number");
+      case Parsed::NotFinite: report.fail(field + ": '" + token + "' is not finite");
+    }
+  }
+}
+
+std::string nameOf(const TiXmlElement* element) {
+  const char* name = element->Attribute("name");
+  return name ? name : "";
+}
+
+// Every number of every link and joint zwang reads, anywhere in the file.
+void checkAllNumbers(const Reporter& report, const TiXmlElement* robot) {
+  for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
+    const TiXmlElement* inertial = link->FirstChildElement("inertial");
+    if (inertial == nullptr) continue;
+    const std::string who = "link '" + nameOf(link) + "': ";
+    const TiXmlElement* origin = inertial->FirstChildElement("origin");
+    checkNumbers(report, who + "<inertial> <origin>", origin, "xyz", 3);
+    checkNumbers(report, who + "<inertial> <origin>", origin, "rpy", 3);
+    checkNumbers(report, who + "<inertial> <mass>", inertial->FirstChildElement("mass"), "value", 1);
+    for (const char* attr : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"})
+      checkNumbers(report, who + "<inertial> <inertia>", inertial->FirstChildElement("inertia"), attr, 1);
+  }
+  for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint;
+       joint = joint->NextSiblingElement("joint")) {
+    const std::string who = "joint '" + nameOf(joint) + "': ";
+    checkNumbers(report, who + "<origin>", joint->FirstChildElement("origin"), "xyz", 3);
+    checkNumbers(report, who + "<origin>", joint->FirstChildElement("origin"), "rpy", 3);
+    checkNumbers(report, who + "<axis>", joint->FirstChildElement("axis"), "xyz", 3);
+    for (const char* attr : {"lower", "upper", "effort", "velocity"})
+      checkNumbers(report, who + "<limit>", joint->FirstChildElement("limit"), attr, 1);
+    for (const char* attr : {"friction", "damping"})
+      checkNumbers(report, who + "<dynamics>", joint->FirstChildElement("dynamics"), attr, 1);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// urdfdom with its console_bridge messages captured (pass 2)
+
+// console_bridge keeps one global handler (and remembers the one before it),
+// so the capturing handler is a process-lifetime object: if anybody later
+// restores "the previous handler" and gets this one, it forwards to the
+// handler that was active when the last load started. Loads are serialised
+// by a mutex while the handler is installed.
+class CaptureHandler final : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char* filename, int line) override {
+    if (sink != nullptr && level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      sink->push_back(text);
+    } else if (forward != nullptr && forward != this && level >= forward_level) {
+      forward->log(text, level, filename, line);
+    }
+  }
+  std::vector<std::string>* sink = nullptr;
+  console_bridge::OutputHandler* forward = nullptr;
+  console_bridge::LogLevel forward_level = console_bridge::CONSOLE_BRIDGE_LOG_WARN;
+};
+
+std::mutex& captureMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+CaptureHandler& captureHandler() {
+  static CaptureHandler* handler = new CaptureHandler;  // never destroyed (see above)
+  return *handler;
+}
+
+urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const std::string& xml) {
+  std::vector<std::string> errors;
+  urdf::ModelInterfaceSharedPtr model;
+  {
+    const std::lock_guard<std::mutex> lock(captureMutex());
+    CaptureHandler& handler = captureHandler();
+    console_bridge::OutputHandler* const previous = console_bridge::getOutputHandler();
+    const console_bridge::LogLevel previous_level = console_bridge::getLogLevel();
+    handler.forward = previous;
+    handler.forward_level = previous_level;
+    handler.sink = &errors;
+    if (previous_level > console_bridge::CONSOLE_BRIDGE_LOG_ERROR)
+      console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
+    console_bridge::useOutputHandler(&handler);
+    struct Restore {
+      CaptureHandler& handler;
+      console_bridge::OutputHandler* previous;
+      console_bridge::LogLevel level;
+      ~Restore() {
+        console_bridge::useOutputHandler(previous);
+        console_bridge::setLogLevel(level);
+        handler.sink = nullptr;
+      }
+    } restore{handler, previous, previous_level};
+    try {
+      model = urdf::parseURDF(xml);
+    } catch (const std::exception& e) {
+      errors.push_back(e.what());
+      model.reset();
+    }
+  }
+  if (!errors.empty()) {
+    std::string joined;
+    for (const std::string& e : errors) joined += (joined.empty() ? "" : "; ") + e;
+    report.fail("urdfdom rejected the URDF: " + joined);
+  }
+  if (!model) report.fail("urdfdom could not parse the URDF (it gave no reason)");
+  return model;
+}
+
+// ---------------------------------------------------------------------------
+// Drake rotor inertia from <transmission> (pass 3)
+
+// Reads <tag value="…"/> under `actuator`; returns false when absent.
+bool drakeValue(const Reporter& report, const std::string& who, const TiXmlElement* actuator, const char* tag,
+                double& value) {
+  const TiXmlElement* element = actuator->FirstChildElement(tag);
+  if (element == nullptr) return false;
+  const std::string field = who + ": <" + std::string(tag) + ">";
+  const char* text = element->Attribute("value");
+  if (text == nullptr) report.fail(field + " has no value attribute");
+  const std::vector<std::string> tokens = splitWhitespace(text);
+  if (tokens.size() != 1) report.fail(field + " value \"" + text + "\" is not a number");
+  switch (parseNumber(tokens[0], value)) {
+    case Parsed::Ok: break;
+    case Parsed::NotANumber: report.fail(field + " value \"" + text + "\" is not a number");
+    case Parsed::NotFinite: report.fail(field + " value \"" + text + "\" is not finite");
+  }
+  if (value < 0.0) report.fail(field + " value " + fmt(value) + " is negative");
+  return true;
+}
+
+// joint name → reflected rotor inertia rotor_inertia · gear_ratio².
+std::map<std::string, double> readTransmissions(const Reporter& report, const TiXmlElement* robot,
+                                                const urdf::ModelInterface& urdf_model) {
+  std::map<std::string, double> reflected;
+  for (const TiXmlElement* tr = robot->FirstChildElement("transmission"); tr;
+       tr = tr->NextSiblingElement("transmission")) {
+    const std::string who = "transmission '" + nameOf(tr) + "'";
+    double rotor_inertia = 0.0;
+    bool has_rotor = false;
+    for (const TiXmlElement* act = tr->FirstChildElement("actuator"); act; act = act->NextSiblingElement("actuator")) {
+      const std::string act_who = who + ": <actuator> '" + nameOf(act) + "'";
+      double rotor = 0.0, gear = 1.0;
+      const bool rotor_here = drakeValue(report, act_who, act, "drake:rotor_inertia", rotor);
+      drakeValue(report, act_who, act, "drake:gear_ratio", gear);
+      if (!rotor_here) continue;
+      if (has_rotor) report.fail(who + ": more than one <actuator> has a <drake:rotor_inertia>");
+      has_rotor = true;
+      rotor_inertia = rotor * gear * gear;
+    }
+    if (!has_rotor) continue;
+    std::vector<std::string> joints;
+    for (const TiXmlElement* j = tr->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint"))
+      joints.push_back(nameOf(j));
+    if (joints.size() != 1)
+      report.fail(who + ": a <drake:rotor_inertia> needs exactly one <joint name=…> in its transmission, found " +
+                  std::to_string(joints.size()));
+    if (!urdf_model.getJoint(joints[0]))
+      report.fail(who + ": <joint> '" + joints[0] + "' is not a joint of the URDF");
+    if (!reflected.emplace(joints[0], rotor_inertia).second)
+      report.fail(who + ": joint '" + joints[0] + "' already has a rotor inertia from another transmission");
+  }
+  return reflected;
+}
+
+// ---------------------------------------------------------------------------
+// Geometry and inertia
+
+Mat3 rotationOf(const urdf::Rotation& q) { return Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix(); }
+Vec3 vectorOf(const urdf::Vector3& v) { return Vec3(v.x, v.y, v.z); }
+
+// ᶜX_p of a joint: the child link's frame (at q = 0) seen from its parent's.
+Transform placementOf(const urdf::Joint& joint) {
+  const urdf::Pose& pose = joint.parent_to_joint_origin_transform;
+  return Transform::fromPose(rotationOf(pose.rotation), vectorOf(pose.position));
+}
+
+// The link's inertia in its own frame; a link without <inertial> is massless.
+RigidInertia linkInertia(const Reporter& report, const urdf::Link& link) {
+  if (!link.inertial) return RigidInertia{};
+  const urdf::Inertial& in = *link.inertial;
+  const std::string who = "link '" + link.name + "': <inertial>";
+  if (!std::isfinite(in.mass)) report.fail(who + " <mass> value is not finite");
+  if (in.mass < 0.0) report.fail(who + " <mass> value " + fmt(in.mass) + " is negative");
+  Mat3 I_frame;  // in the COM frame given by <inertial><origin>
+  I_frame << in.ixx, in.ixy, in.ixz,  //
+      in.ixy, in.iyy, in.iyz,         //
+      in.ixz, in.iyz, in.izz;
+  const Mat3 R = rotationOf(in.origin.rotation);  // COM frame axes in the link frame
+  const Mat3 I_com = R * I_frame * R.transpose();
+  const Vec3 com = vectorOf(in.origin.position);
+  validate::rigidInertia(report.source() + ": " + who, in.mass, com, I_com);
+  return RigidInertia::fromMassComInertia(in.mass, com, I_com);
+}
+
+bool isMoving(const urdf::Joint& joint) { return joint.type != urdf::Joint::FIXED; }
+
+const char* typeName(int type) {
+  switch (type) {
+    case urdf::Joint::REVOLUTE: return "revolute";
+    case urdf::Joint::CONTINUOUS: return "continuous";
+    case urdf::Joint::PRISMATIC: return "prismatic";
+    case urdf::Joint::FLOATING: return "floating";
+    case urdf::Joint::PLANAR: return "planar";
+    case urdf::Joint::FIXED: return "fixed";
+    default: return "unknown";
+  }
+}
+
+// The zwang joint for a moving URDF joint, every field checked.
+Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<std::string, double>& rotor) {
+  const std::string who = "joint '" + uj.name + "'";
+  Joint joint;
+  joint.name = uj.name;
+  switch (uj.type) {
+    case urdf::Joint::REVOLUTE: joint.type = JointType::Revolute; break;
+    case urdf::Joint::CONTINUOUS: joint.type = JointType::Continuous; break;
+    case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
+    default:
+      report.fail(who + " (parent '" + uj.parent_link_name + "', child '" + uj.child_link_name + "'): type " +
+                  typeName(uj.type) +
+                  " is not supported on the chain (only revolute, continuous, prismatic and fixed joints are)");
+  }
+
+  joint.placement = placementOf(uj);
+  if (!joint.placement.E.allFinite() || !joint.placement.r.allFinite()) report.fail(who + ": <origin> is not finite");
+
+  joint.axis = vectorOf(uj.axis);
+  if (!joint.axis.allFinite()) report.fail(who + ": <axis> xyz is not finite");
+  if (joint.axis.norm() < 1e-9)
+    report.fail(who + ": <axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " + fmt(uj.axis.z) +
+                "\" is zero (it must give the joint's direction)");
+  joint.axis.normalize();
+
+  if (uj.limits) {
+    const urdf::JointLimits& lim = *uj.limits;
+    const struct {
+      const char* name;
+      double value;
+    } fields[] = {{"lower", lim.lower}, {"upper", lim.upper}, {"effort", lim.effort}, {"velocity", lim.velocity}};
+    for (const auto& f : fields)
+      if (!std::isfinite(f.value)) report.fail(who + ": <limit> " + f.name + " is not finite");
+    if (lim.effort < 0.0) report.fail(who + ": <limit> effort " + fmt(lim.effort) + " is negative");
+    if (lim.velocity < 0.0) report.fail(who + ": <limit> velocity " + fmt(lim.velocity) + " is negative");
+    joint.effort_limit = lim.effort;
+    joint.velocity_limit = lim.velocity;
+    if (joint.type != JointType::Continuous) {  // a continuous joint has no position limits
+      if (lim.lower > lim.upper)
+        report.fail(who + ": <limit> lower " + fmt(lim.lower) + " is greater than upper " + fmt(lim.upper));
+      joint.lower = lim.lower;
+      joint.upper = lim.upper;
+    }
+  }
+  if (joint.type == JointType::Continuous) {
+    joint.lower = -kInf;
+    joint.upper = kInf;
+  }
+
+  if (uj.dynamics) {
+    const urdf::JointDynamics& dyn = *uj.dynamics;
+    if (!std::isfinite(dyn.friction)) report.fail(who + ": <dynamics> friction is not finite");
+    if (!std::isfinite(dyn.damping)) report.fail(who + ": <dynamics> damping is not finite");
+    if (dyn.friction < 0.0) report.fail(who + ": <dynamics> friction " + fmt(dyn.friction) + " is negative");
+    if (dyn.damping < 0.0) report.fail(who + ": <dynamics> damping " + fmt(dyn.damping) + " is negative");
+    joint.breakaway_friction = dyn.friction;
+    joint.kinetic_friction = dyn.friction;  // SPEC default: f_c = f
+    joint.damping = dyn.damping;
+  }
+
+  const auto r = rotor.find(uj.name);
+  if (r != rotor.end()) joint.rotor_inertia = r->second;
+  return joint;
+}
+
+// ---------------------------------------------------------------------------
+// Choosing the chain
+
+using LinkPtr = urdf::LinkConstSharedPtr;
+
+bool hasMovingJointBelow(const urdf::Link& link) {
+  for (const auto& j : link.child_joints) {
+    if (isMoving(*j)) return true;
+  }
+  for (const auto& child : link.child_links)
+    if (hasMovingJointBelow(*child)) return true;
+  return false;
+}
+
+void collectLeaves(const urdf::Link& link, std::vector<std::string>& leaves) {
+  if (link.child_links.empty()) leaves.push_back(link.name);
+  for (const auto& child : link.child_links) collectLeaves(*child, leaves);
+}
+
+// The links from root to tip (root first).
+std::vector<LinkPtr> chainLinks(const Reporter& report, const urdf::ModelInterface& model, const LinkPtr& root,
+                                const std::string& tip_name) {
+  std::vector<LinkPtr> path;
+  if (!tip_name.empty()) {
+    const LinkPtr tip = model.getLink(tip_name);
+    for (LinkPtr link = tip; link; link = link->getParent()) {
+      path.push_back(link);
+      if (link == root) {
+        std::reverse(path.begin(), path.end());
+        return path;
+      }
+    }
+    report.fail("tip link '" + tip_name + "' is not below root link '" + root->name + "' (its ancestors: " +
+                [&] {
+                  std::vector<std::string> names;
+                  for (std::size_t k = 1; k < path.size(); ++k) names.push_back(path[k]->name);
+                  return names.empty() ? std::string("none") : nameList(names);
+                }() +
+                ")");
+  }
+  // No tip given: follow the single branch that leads to moving joints.
+  LinkPtr link = root;
+  path.push_back(link);
+  for (;;) {
+    std::vector<LinkPtr> branches;
+    for (std::size_t k = 0; k < link->child_joints.size(); ++k) {
+      const auto& child = link->child_links[k];
+      if (isMoving(*link->child_joints[k]) || hasMovingJointBelow(*child)) branches.push_back(child);
+    }
+    if (branches.empty()) return path;
+    if (branches.size() > 1) {
+      std::vector<std::string> candidates;
+      for (const LinkPtr& b : branches) collectLeaves(*b, candidates);
+      report.fail("no tip link given and the tree branches into moving joints at link '" + link->name +
+                  "'; candidate tips: " + nameList(candidates) + " (set UrdfOptions::tip)");
+    }
+    link = branches.front();
+    path.push_back(link);
+  }
+}
+
+std::vector<std::string> allLinkNames(const urdf::ModelInterface& model) {
+  std::vector<std::string> names;
+  for (const auto& entry : model.links_) names.push_back(entry.first);
+  return names;
+}
+
+// ---------------------------------------------------------------------------
+
+Model load(const Reporter& report, const std::string& xml, const UrdfOptions& options) {
+  // Pass 1: well-formed XML, and every number finite.
+  TiXmlDocument doc;
+  doc.Parse(xml.c_str());
+  if (doc.Error()) {
+    std::string where;
+    if (doc.ErrorRow() > 0)
+      where = " at line " + std::to_string(doc.ErrorRow()) + ", column " + std::to_string(doc.ErrorCol());
+    report.fail("malformed XML" + where + ": " + doc.ErrorDesc());
+  }
+  const TiXmlElement* robot = doc.RootElement();
+  if (robot == nullptr || std::string(robot->Value()) != "robot")
+    report.fail("the XML's top element is not <robot>" +
+                (robot ? std::string(" (found <") + robot->Value() + ">)" : std::string()));
+  checkAllNumbers(report, robot);
+
+  // Pass 2: the tree.
+  const urdf::ModelInterfaceSharedPtr urdf_model = parseWithUrdfdom(report, xml);
+  if (!urdf_model->getRoot()) report.fail("the URDF has no root link");
+
+  // Pass 3: rotor inertias, then the options' overrides.
+  std::map<std::string, double> rotor = readTransmissions(report, robot, *urdf_model);
+  for (const auto& [name, value] : options.rotor_inertia) {
+    if (!std::isfinite(value) || value < 0.0)
+      report.fail("UrdfOptions::rotor_inertia for joint '" + name + "': " + fmt(value) +
+                  " is not a finite non-negative number");
+    rotor[name] = value;
+  }
+
+  // Root and tip.
+  const LinkPtr root = options.root.empty() ? urdf_model->getRoot() : urdf_model->getLink(options.root);
+  if (!root)
+    report.fail("root link '" + options.root + "' not found (links: " + nameList(allLinkNames(*urdf_model), 50) + ")");
+  if (!options.tip.empty() && !urdf_model->getLink(options.tip))
+    report.fail("tip link '" + options.tip + "' not found (links: " + nameList(allLinkNames(*urdf_model), 50) + ")");
+  const std::vector<LinkPtr> chain = chainLinks(report, *urdf_model, root, options.tip);
+  const std::string tip_name = chain.back()->name;
+
+  std::vector<std::string> moving;  // moving joints of the chain
+  for (std::size_t k = 1; k < chain.size(); ++k)
+    if (isMoving(*chain[k]->parent_joint)) moving.push_back(chain[k]->parent_joint->name);
+  if (moving.empty())
+    report.fail("the chain from root link '" + root->name + "' to tip link '" + tip_name + "' has no moving joint");
+  for (const auto& entry : options.rotor_inertia) {
+    if (std::find(moving.begin(), moving.end(), entry.first) != moving.end()) continue;
+    report.fail("UrdfOptions::rotor_inertia names joint '" + entry.first + "', which is not a moving joint of the chain " +
+                "from '" + root->name + "' to '" + tip_name + "' (chain joints: " + nameList(moving) + ")" +
+                (urdf_model->getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
+  }
+
+  // Build: chain links in order; after each, the links welded to it.
+  ModelBuilder builder(urdf_model->getName(), root->name);
+  std::set<std::string> placed;
+  for (const LinkPtr& link : chain) placed.insert(link->name);
+
+  auto addWelded = [&](const LinkPtr& anchor) {
+    std::vector<LinkPtr> queue{anchor};
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const LinkPtr from = queue[head];
+      for (std::size_t k = 0; k < from->child_joints.size(); ++k) {
+        const auto& joint = from->child_joints[k];
+        const LinkPtr child = from->child_links[k];
+        if (isMoving(*joint) || placed.count(child->name)) continue;
+        const RigidInertia inertia = linkInertia(report, *child);
+        report.builder([&] { builder.addFixedFrame(child->name, from->name, placementOf(*joint), inertia); });
+        placed.insert(child->name);
+        queue.push_back(child);
+      }
+      // Upwards: a parent welded to this link (only ever off the root).
+      const LinkPtr parent = from->getParent();
+      if (parent && from->parent_joint && !isMoving(*from->parent_joint) && !placed.count(parent->name)) {
+        const RigidInertia inertia = linkInertia(report, *parent);
+        const Transform placement = placementOf(*from->parent_joint).inverse();  // ᵖX_from
+        report.builder([&] { builder.addFixedFrame(parent->name, from->name, placement, inertia); });
+        placed.insert(parent->name);
+        queue.push_back(parent);
+      }
+    }
+  };
+
+  addWelded(chain.front());
+  for (std::size_t k = 1; k < chain.size(); ++k) {
+    const LinkPtr& link = chain[k];
+    const urdf::Joint& uj = *link->parent_joint;
+    const RigidInertia inertia = linkInertia(report, *link);
+    if (isMoving(uj)) {
+      const Joint joint = makeJoint(report, uj, rotor);
+      report.builder([&] { builder.addJoint(joint, link->name, inertia, uj.parent_link_name); });
+    } else {
+      report.builder([&] { builder.addFixedFrame(link->name, uj.parent_link_name, placementOf(uj), inertia); });
+    }
+    addWelded(link);
+  }
+
+  Model model;
+  report.builder([&] { model = builder.build(); });
+  return model;
+}
+
+}  // namespace
+
+Model loadUrdfString(const std::string& xml, const UrdfOptions& options) {
+  return load(Reporter("<string>"), xml, options);
+}
+
+Model loadUrdfFile(const std::string& path, const UrdfOptions& options) {
+  const Reporter report(path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) report.fail("cannot read the file: it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int err = errno;
+    report.fail(std::string("cannot open the file (") + (err ? std::strerror(err) : "unknown error") + ")");
+  }
+  std::ostringstream content;
+  content << in.rdbuf();
+  if (in.bad()) report.fail("cannot read the file");
+  return load(report, content.str(), options);
+}
+
+}  // namespace zwang

@@ -1,1 +1,0 @@
-namespace zwang {}  // placeholder, filled in by the core work

@@ -1,0 +1,20 @@
+// Uses the installed zwang: load the 1-DOF arm, push it, check q̈ = τ / I.
+#include <cmath>
+#include <cstdio>
+#include <zwang/zwang.hpp>
+
+int main(int argc, char** argv) {
+  if (argc < 2) return 2;
+  const zwang::Model model = zwang::loadUrdfFile(argv[1]);
+  zwang::Task task(model);
+  task.gravity.setZero();
+  zwang::Workspace ws(model, task);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(1), tau = Eigen::VectorXd::Constant(1, 4.5);
+  const zwang::Status status = zwang::solveHybridDynamics(model, task, zero, zero, tau, ws);
+  if (!status) {
+    std::printf("solve failed: %s\n", status.message);
+    return 1;
+  }
+  std::printf("qdd = %.12f (expected 2)\n", ws.solution.qdd[0]);
+  return std::abs(ws.solution.qdd[0] - 2.0) < 1e-12 ? 0 : 1;
+}

@@ -1,0 +1,88 @@
+#include "support/chain_spec.hpp"
+
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+namespace zwang::testing {
+
+int ChainSpec::dof() const { return static_cast<int>(movingJoints().size()); }
+
+std::vector<int> ChainSpec::movingJoints() const {
+  std::vector<int> moving;
+  for (std::size_t k = 0; k < joints.size(); ++k)
+    if (!joints[k].isFixed()) moving.push_back(static_cast<int>(k));
+  return moving;
+}
+
+int ChainSpec::linkIndex(const std::string& link_name) const {
+  for (std::size_t i = 0; i < links.size(); ++i)
+    if (links[i].name == link_name) return static_cast<int>(i);
+  throw std::invalid_argument("ChainSpec '" + name + "': no link named '" + link_name + "'");
+}
+
+void ChainSpec::check() const {
+  const std::string where = "ChainSpec '" + name + "': ";
+  if (links.size() != joints.size() + 1)
+    throw std::invalid_argument(where + "needs links.size() == joints.size() + 1");
+  std::set<std::string> names;
+  for (const LinkSpec& link : links) {
+    if (!names.insert("link:" + link.name).second) throw std::invalid_argument(where + "repeated link " + link.name);
+    if (!(link.mass >= 0.0)) throw std::invalid_argument(where + "negative mass on link " + link.name);
+  }
+  for (const JointSpec& joint : joints) {
+    if (!names.insert("joint:" + joint.name).second)
+      throw std::invalid_argument(where + "repeated joint " + joint.name);
+    if (joint.type != "revolute" && joint.type != "continuous" && joint.type != "prismatic" && joint.type != "fixed")
+      throw std::invalid_argument(where + "joint " + joint.name + " has unknown type '" + joint.type + "'");
+    if (!joint.isFixed() && std::abs(joint.axis.norm() - 1.0) > 1e-12)
+      throw std::invalid_argument(where + "joint " + joint.name + " axis is not a unit vector");
+  }
+}
+
+Eigen::Matrix3d rpyToMatrix(const Eigen::Vector3d& rpy) {
+  // Fixed axes: roll about x first, then pitch about the fixed y, then yaw about
+  // the fixed z, i.e. R = Rz(yaw)·Ry(pitch)·Rx(roll) (URDF <origin rpy>).
+  return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+ChainSpec oneDofArm() {
+  ChainSpec spec;
+  spec.name = "one_dof_arm";
+
+  LinkSpec base;
+  base.name = "base";
+  LinkSpec link;
+  link.name = "link1";
+  link.mass = 1.0;
+  link.com = Eigen::Vector3d(0.5, 0.0, 0.0);
+  // A slender bar along x: I_zz = 2 (SPEC), I_yy = 2, a small I_xx that keeps
+  // the triangle inequality I_xx + I_yy >= I_zz.
+  link.inertia = Eigen::Vector3d(0.01, 2.0, 2.0).asDiagonal();
+  LinkSpec tool;  // massless frame at the tip, where the report applies its force
+  tool.name = "tool";
+
+  JointSpec joint;
+  joint.name = "joint1";
+  joint.type = "revolute";
+  joint.axis = Eigen::Vector3d::UnitZ();
+  joint.lower = -3.0;
+  joint.upper = 3.0;
+  joint.effort = 100.0;
+  joint.velocity = 10.0;
+  joint.friction = 10.0;
+  JointSpec tip;
+  tip.name = "tool_joint";
+  tip.type = "fixed";
+  tip.xyz = Eigen::Vector3d(1.0, 0.0, 0.0);
+
+  spec.links = {base, link, tool};
+  spec.joints = {joint, tip};
+  return spec;
+}
+
+}  // namespace zwang::testing

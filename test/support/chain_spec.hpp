@@ -1,0 +1,77 @@
+// A plain, URDF-shaped description of a serial chain, shared by the test
+// references (random generator, URDF writer, dense KKT reference, KDL bridge).
+// It deliberately does not use the zwang model classes: the references must
+// stay independent of the code they test.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace zwang::testing {
+
+// One URDF <link>. The inertia is about the COM, in the inertial frame whose
+// pose in the link frame is (com, inertial_rpy) — exactly URDF's <inertial>.
+// mass 0 with a zero inertia is a massless link (written without <inertial>).
+struct LinkSpec {
+  std::string name;
+  double mass = 0.0;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  Eigen::Vector3d inertial_rpy = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+};
+
+// One URDF <joint>. Semantics (URDF, SPEC "Conventions"):
+//  - (xyz, rpy) is the pose of the joint frame in the parent link frame, with
+//    fixed-axis roll-pitch-yaw: R = Rz(yaw)·Ry(pitch)·Rx(roll);
+//  - the child link frame is the joint frame after the joint motion: a rotation
+//    by q about `axis` (revolute, continuous) or a translation by q along
+//    `axis` (prismatic); `axis` is a unit vector in the joint frame;
+//  - the reflected rotor inertia on the joint is rotor_inertia·gear_ratio².
+struct JointSpec {
+  std::string name;
+  std::string type = "revolute";  // "revolute", "continuous", "prismatic", "fixed"
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double lower = 0.0, upper = 0.0, effort = 0.0, velocity = 0.0;  // <limit>
+  double friction = 0.0, damping = 0.0;                           // <dynamics>
+  double rotor_inertia = 0.0;  // <drake:rotor_inertia>; 0: no <transmission>
+  double gear_ratio = 1.0;     // <drake:gear_ratio>
+
+  bool isFixed() const { return type == "fixed"; }
+  bool isPrismatic() const { return type == "prismatic"; }
+  // rotor_inertia · gear_ratio² (SPEC "Conventions"); 0 for fixed joints.
+  double reflectedInertia() const { return isFixed() ? 0.0 : rotor_inertia * gear_ratio * gear_ratio; }
+};
+
+// A serial chain: joints[k] connects parent links[k] to child links[k+1], so
+// links.size() == joints.size() + 1 and links[0] is the fixed base link.
+struct ChainSpec {
+  std::string name = "chain";
+  std::vector<LinkSpec> links;
+  std::vector<JointSpec> joints;
+
+  // Number of non-fixed joints (the length of q).
+  int dof() const;
+  // Indices into `joints` of the non-fixed joints, in chain order; the k-th
+  // entry is the joint whose position is q(k).
+  std::vector<int> movingJoints() const;
+  // Index into `links` of the link with this name; throws std::invalid_argument
+  // naming the link when there is none.
+  int linkIndex(const std::string& name) const;
+  // Throws std::invalid_argument when the sizes or joint types are inconsistent,
+  // an axis is not unit, or a name repeats.
+  void check() const;
+};
+
+// R = Rz(yaw)·Ry(pitch)·Rx(roll) for rpy = (roll, pitch, yaw) (URDF).
+Eigen::Matrix3d rpyToMatrix(const Eigen::Vector3d& rpy);
+
+// The single-joint arm of SPEC "Reference cases": revolute joint about z at the
+// base origin, a 1 m link along x of mass 1 kg with its COM at 0.5 m and
+// I_zz = 2 kg·m² at the COM (2.25 kg·m² about the joint), breakaway friction 10 N·m.
+ChainSpec oneDofArm();
+
+}  // namespace zwang::testing

@@ -1,0 +1,130 @@
+// Dense reference for constrained dynamics (SPEC §1 "Dense reference for
+// tests"), computed straight from a ChainSpec with the world pose of every link
+// — no recursive algorithm, no code shared with the library.
+//
+// Formulation: world-frame Plücker coordinates at the world origin, linear part
+// first (SPEC "Conventions"): motion [v; ω], force [f; n].
+//   J_i       6×n spatial Jacobian of link i, columns s_j = ⁰X_j S_j for the
+//             moving joints between the base and link i (zero otherwise);
+//   v_i       = J_i q̇ (spatial velocity);
+//   J̇_i q̇     = Σ_j (v_child(j) × s_j) q̇_j   (d/dt s_j = v × s_j, closed form);
+//   a_i       = J_i q̈ + J̇_i q̇  (the TRUE spatial acceleration; gravity is a force);
+//   I_i       world-frame spatial inertia of link i (every link, also those
+//             behind fixed joints, at its own pose);
+//   H         = Σ_i J_iᵀ I_i J_i + diag(d),  d = reflected rotor inertias;
+//   C         = Σ_i J_iᵀ (I_i J̇_i q̇ + v_i ×* I_i v_i − f_ext,i − f_grav,i),
+//               f_grav,i = I_i [g; 0];
+//   KKT       [H −Gᵀ; G 0] [q̈; ν] = [τ − C; γ]  (H q̈ + C = τ + Σ Jᵀ A ν).
+// A constraint column [l; r] (unit force l and moment r acting at the link
+// origin) constrains lᵀ p̈ + rᵀ ω̇ = b, p̈ the classical acceleration of the link
+// origin; the wrench A ν is applied to the link at its origin (SPEC sign).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "support/chain_spec.hpp"
+
+namespace zwang::testing {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+
+// Which axes the components of a link-attached quantity use. Either way it
+// refers to the link ORIGIN (a wrench acts there, an acceleration is that of the
+// origin); `World` is what SPEC also calls "aligned".
+enum class Axes { Local, World };
+
+// A wrench [f; n] applied to `link` at its origin.
+struct WrenchInput {
+  std::string link;
+  Vector6d wrench = Vector6d::Zero();
+  Axes axes = Axes::Local;
+};
+
+// Aᵀ Ẍ = b on `link`: A is 6×m (columns [l; r]), b the m set points in terms of
+// the true classical acceleration of the link origin.
+struct ConstraintInput {
+  std::string link;
+  Matrix6Xd A;
+  Eigen::VectorXd b;
+  Axes axes = Axes::Local;
+};
+
+struct DynamicsInput {
+  Eigen::VectorXd q, qd, tau;  // each of length spec.dof()
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+  std::vector<WrenchInput> wrenches;
+  std::vector<ConstraintInput> constraints;
+  int constraintRows() const;
+};
+
+// Everything that depends only on (q, q̇), for every link (index as spec.links).
+struct DenseKinematics {
+  std::vector<Eigen::Isometry3d> poses;  // ⁰T_link
+  std::vector<Eigen::MatrixXd> J;        // 6×n spatial Jacobian at the world origin
+  std::vector<Vector6d> v;               // spatial velocity J q̇
+  std::vector<Vector6d> bias;            // J̇ q̇
+  std::vector<Matrix6d> inertia;         // world-frame spatial inertia
+  std::vector<int> dof_of_joint;         // joints[k] → index in q, or −1 when fixed
+  Eigen::VectorXd reflected;             // d_j, one per dof
+};
+
+DenseKinematics denseKinematics(const ChainSpec& spec, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+
+struct DenseResult {
+  Eigen::MatrixXd H;        // n×n joint-space inertia
+  Eigen::VectorXd C;        // bias (Coriolis, centrifugal, gravity, −external)
+  Eigen::VectorXd qdd;      // q̈
+  Eigen::VectorXd nu;       // ν, rows in input order (constraint by constraint)
+  Eigen::VectorXd tau_c;    // Σ J_iᵀ A_i ν_i = Gᵀ ν (physical constraint torques)
+  double gauss = 0.0;       // Z(q̈) of SPEC §1 at the solution
+  Eigen::MatrixXd G;        // m×n constraint rows: G q̈ = gamma
+  Eigen::VectorXd gamma;
+  std::vector<Eigen::Isometry3d> poses;  // ⁰T_link for every link
+  std::vector<Vector6d> acc_world;       // classical [p̈; ω̇] of every link origin, world axes
+  std::vector<Vector6d> acc_local;       // the same in the link's own axes
+  // Conditioning, so that tests can skip ill-posed draws:
+  double h_condition = 0.0;         // cond₂(H)
+  int constraint_rank = 0;          // rank of G (relative threshold 1e-10)
+  double coupling_condition = 1.0;  // cond₂(G H⁻¹ Gᵀ) (1 without constraints)
+  double kkt_condition = 0.0;       // cond₂ of the KKT matrix
+  bool wellConditioned(double max_condition = 1e6) const {
+    return h_condition < max_condition && coupling_condition < max_condition;
+  }
+};
+
+// Solves the KKT system (full-pivot LU in long double, one refinement step).
+DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input);
+
+// Z(q̈) = Σ_i ½ a_iᵀ I_i a_i + (v_i ×* I_i v_i − f_ext,i − f_grav,i)ᵀ a_i
+//        + Σ_j ½ d_j q̈_j² − τ_j q̈_j    (SPEC §1; a_i true spatial accelerations),
+// for any q̈ (constraints are not applied). Frame-invariant.
+double gaussFunction(const ChainSpec& spec, const DynamicsInput& input, const Eigen::VectorXd& qdd);
+
+// τ = H q̈ + C for the given wrenches and gravity (inverse dynamics).
+Eigen::VectorXd denseInverseDynamics(const ChainSpec& spec, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                     const Eigen::VectorXd& qdd, const Eigen::Vector3d& gravity,
+                                     const std::vector<WrenchInput>& wrenches = {});
+
+// Classical 6×n Jacobian of `link`: maps q̇ to [ṗ; ω] of the link origin, with
+// components in world or link axes.
+Eigen::MatrixXd linkJacobian(const ChainSpec& spec, const Eigen::VectorXd& q, const std::string& link, Axes axes);
+
+// Classical acceleration [p̈; ω̇] of `link`'s origin for any (q, q̇, q̈).
+Vector6d linkAcceleration(const ChainSpec& spec, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                          const Eigen::VectorXd& qdd, const std::string& link, Axes axes);
+
+// Small spatial-algebra helpers of the reference (linear part first).
+Eigen::Matrix3d skew3(const Eigen::Vector3d& a);           // skew3(a) b = a × b
+Matrix6d motionCross(const Vector6d& v);                   // v× = [ω× v×; 0 ω×]
+Matrix6d forceCross(const Vector6d& v);                    // v×* = −(v×)ᵀ
+// Spatial inertia at the world origin of a body with mass m, COM c and
+// rotational inertia Ic about the COM (all world components).
+Matrix6d spatialInertia(double m, const Eigen::Vector3d& c, const Eigen::Matrix3d& Ic);
+
+}  // namespace zwang::testing

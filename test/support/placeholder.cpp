@@ -1,1 +1,0 @@
-namespace zwang::testing {}  // placeholder until the references land

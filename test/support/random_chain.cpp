@@ -1,0 +1,136 @@
+#include "support/random_chain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Geometry>
+
+namespace zwang::testing {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+// One of ±x, ±y, ±z.
+Eigen::Vector3d randomAxisAligned(std::mt19937_64& rng) {
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  axis(uniformInt(rng, 0, 2)) = uniform01(rng) < 0.5 ? -1.0 : 1.0;
+  return axis;
+}
+
+LinkSpec randomLink(std::mt19937_64& rng, const std::string& name) {
+  LinkSpec link;
+  link.name = name;
+  link.mass = uniform(rng, 0.2, 5.0);
+  link.com = randomVector(rng, 3, 0.2);
+  link.inertial_rpy = uniform01(rng) < 0.3 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(randomVector(rng, 3, kPi));
+  link.inertia = randomInertia(rng, link.mass);
+  return link;
+}
+}  // namespace
+
+double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
+
+int uniformInt(std::mt19937_64& rng, int lo, int hi) {
+  const auto span = static_cast<std::uint64_t>(hi - lo + 1);
+  return lo + static_cast<int>(rng() % span);
+}
+
+double gaussian(std::mt19937_64& rng) {
+  // Box–Muller; 1 - u lies in (0, 1], so the logarithm is finite.
+  const double u = 1.0 - uniform01(rng);
+  const double v = uniform01(rng);
+  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * kPi * v);
+}
+
+Eigen::Vector3d randomUnitVector(std::mt19937_64& rng) {
+  for (;;) {
+    const Eigen::Vector3d x(gaussian(rng), gaussian(rng), gaussian(rng));
+    if (x.norm() > 1e-6) return x.normalized();
+  }
+}
+
+Eigen::Matrix3d randomRotation(std::mt19937_64& rng) {
+  for (;;) {
+    Eigen::Quaterniond quat(gaussian(rng), gaussian(rng), gaussian(rng), gaussian(rng));
+    if (quat.norm() > 1e-6) return quat.normalized().toRotationMatrix();
+  }
+}
+
+Eigen::VectorXd randomVector(std::mt19937_64& rng, int n, double scale) {
+  Eigen::VectorXd x(n);
+  for (int i = 0; i < n; ++i) x(i) = uniform(rng, -scale, scale);
+  return x;
+}
+
+Eigen::Matrix3d randomInertia(std::mt19937_64& rng, double mass) {
+  // s_k = ∫ x_k² dm of a body of size ~3–30 cm; I_x = s_y + s_z, … are then the
+  // principal moments of a real mass distribution.
+  const Eigen::Vector3d s(mass * uniform(rng, 5e-4, 5e-2), mass * uniform(rng, 5e-4, 5e-2),
+                          mass * uniform(rng, 5e-4, 5e-2));
+  const Eigen::Vector3d principal(s.y() + s.z(), s.x() + s.z(), s.x() + s.y());
+  const Eigen::Matrix3d R = randomRotation(rng);
+  const Eigen::Matrix3d I = R * principal.asDiagonal() * R.transpose();
+  return 0.5 * (I + I.transpose());  // exactly symmetric
+}
+
+ChainSpec randomChain(std::mt19937_64& rng, const RandomChainOptions& options) {
+  const int n = uniformInt(rng, options.min_moving_joints, std::max(options.min_moving_joints, options.max_moving_joints));
+
+  // Joint sequence: maybe a fixed joint, then (moving joint, maybe a fixed joint) × n.
+  std::vector<bool> is_fixed;
+  if (uniform01(rng) < options.fixed_joint_probability) is_fixed.push_back(true);
+  for (int k = 0; k < n; ++k) {
+    is_fixed.push_back(false);
+    if (uniform01(rng) < options.fixed_joint_probability) is_fixed.push_back(true);
+  }
+
+  ChainSpec spec;
+  spec.name = "random_chain";
+  spec.links.push_back(randomLink(rng, "base"));
+  for (std::size_t k = 0; k < is_fixed.size(); ++k) {
+    const std::string index = std::to_string(k + 1);
+    JointSpec joint;
+    joint.name = "joint" + index;
+    if (is_fixed[k]) {
+      joint.type = "fixed";
+    } else if (uniform01(rng) < options.prismatic_probability) {
+      joint.type = "prismatic";
+    } else {
+      joint.type = uniform01(rng) < options.continuous_probability ? "continuous" : "revolute";
+    }
+    const double length = uniform(rng, 0.05, 0.5);
+    joint.xyz = length * (uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng)
+                                                                             : randomUnitVector(rng));
+    joint.rpy = uniform01(rng) < 0.2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(randomVector(rng, 3, kPi));
+    joint.axis = uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng) : randomUnitVector(rng);
+    if (!joint.isFixed()) {
+      if (joint.isPrismatic()) {
+        joint.lower = -uniform(rng, 0.1, 1.0);
+        joint.upper = uniform(rng, 0.1, 1.0);
+      } else if (joint.type == "revolute") {
+        joint.lower = -uniform(rng, 0.5, kPi);
+        joint.upper = uniform(rng, 0.5, kPi);
+      }
+      joint.effort = uniform(rng, 10.0, 300.0);
+      joint.velocity = uniform(rng, 1.0, 5.0);
+      joint.friction = uniform(rng, options.friction_min, options.friction_max);
+      joint.damping = uniform(rng, options.damping_min, options.damping_max);
+      if (options.rotor_inertia && uniform01(rng) < 0.8) {
+        joint.rotor_inertia = uniform(rng, 1e-5, 0.05);
+        joint.gear_ratio = uniform(rng, 1.0, 100.0);
+        // Keep the reflected inertia rotor·ratio² at most 0.5 (ratio stays ≥ √10).
+        const double reflected = joint.rotor_inertia * joint.gear_ratio * joint.gear_ratio;
+        if (reflected > 0.5) joint.gear_ratio = std::sqrt(0.5 / joint.rotor_inertia);
+      }
+    }
+    spec.joints.push_back(joint);
+    spec.links.push_back(randomLink(rng, "link" + index));
+  }
+  spec.check();
+  return spec;
+}
+
+}  // namespace zwang::testing

@@ -1,0 +1,83 @@
+#include "support/random_problem.hpp"
+
+#include "support/random_chain.hpp"
+#include "support/urdf_writer.hpp"
+
+namespace zwang::testing {
+
+namespace {
+
+Vector6d randomColumn(std::mt19937_64& rng) {
+  Vector6d a = Vector6d::Zero();
+  if (uniform01(rng) < 0.5) {
+    a[uniformInt(rng, 0, 5)] = 1.0;  // a pure force or moment along an axis
+  } else {
+    for (int k = 0; k < 6; ++k) a[k] = gaussian(rng);
+    a.normalize();
+  }
+  return a;
+}
+
+const std::string& randomLink(std::mt19937_64& rng, const ChainSpec& spec) {
+  // Any link but the base (constraints and wrenches on the fixed base are
+  // tested separately).
+  return spec.links[static_cast<std::size_t>(uniformInt(rng, 1, static_cast<int>(spec.links.size()) - 1))].name;
+}
+
+}  // namespace
+
+DynamicsInput randomProblem(std::mt19937_64& rng, const ChainSpec& spec, const RandomProblemOptions& options) {
+  DynamicsInput in;
+  const int n = spec.dof();
+  in.q = randomVector(rng, n, 3.0);
+  in.qd = randomVector(rng, n, 2.0);
+  in.tau = randomVector(rng, n, 10.0);
+  if (uniform01(rng) < options.gravity_probability)
+    in.gravity = 9.81 * randomUnitVector(rng);
+  else
+    in.gravity.setZero();
+  const int wrenches = uniformInt(rng, 0, options.max_wrenches);
+  for (int w = 0; w < wrenches; ++w) {
+    WrenchInput wi;
+    wi.link = randomLink(rng, spec);
+    for (int k = 0; k < 6; ++k) wi.wrench[k] = 5.0 * gaussian(rng);
+    wi.axes = uniform01(rng) < 0.5 ? Axes::Local : Axes::World;
+    in.wrenches.push_back(wi);
+  }
+  int rows = uniformInt(rng, 0, options.max_constraint_rows);
+  const int frames = options.end_effector_only ? 1 : uniformInt(rng, 1, options.max_constraint_frames);
+  for (int f = 0; f < frames && rows > 0; ++f) {
+    const int here = f == frames - 1 ? rows : uniformInt(rng, 1, rows);
+    rows -= here;
+    ConstraintInput c;
+    c.link = options.end_effector_only ? spec.links.back().name : randomLink(rng, spec);
+    c.A.resize(6, here);
+    for (int k = 0; k < here; ++k) c.A.col(k) = randomColumn(rng);
+    c.b = randomVector(rng, here, 3.0);
+    c.axes = uniform01(rng) < 0.5 ? Axes::Local : Axes::World;
+    in.constraints.push_back(c);
+  }
+  return in;
+}
+
+Model modelFromSpec(const ChainSpec& spec) { return loadUrdfString(toUrdf(spec)); }
+
+Task taskFromInput(const Model& model, const DynamicsInput& input) {
+  Task task(model);
+  task.gravity = input.gravity;
+  auto expressed = [](Axes axes) { return axes == Axes::Local ? Expressed::Local : Expressed::World; };
+  for (const WrenchInput& w : input.wrenches) task.wrench(task.addWrench(w.link, expressed(w.axes))) = w.wrench;
+  for (const ConstraintInput& c : input.constraints) {
+    const int first = task.addConstraint(c.link, c.A, expressed(c.axes));
+    task.targets().segment(first, c.b.size()) = c.b;
+  }
+  return task;
+}
+
+double relativeError(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
+  if (x.size() != y.size()) return std::numeric_limits<double>::infinity();
+  if (x.size() == 0) return 0.0;
+  return (x - y).cwiseAbs().maxCoeff() / std::max(1.0, y.cwiseAbs().maxCoeff());
+}
+
+}  // namespace zwang::testing

@@ -315,7 +315,7 @@ TEST_CASE("dense reference: the 1-DOF arm of the report", "[references][closed-f
     CHECK(r.qdd(0) == Approx((b + w * w * std::cos(phi)) / std::sin(phi)).epsilon(1e-14));
     CHECK(r.acc_world[2](0) == Approx(-w * w).epsilon(1e-14));
     // ν: the unit force d at 1 m gives a torque sin φ about z; H q̈ = τ + sin φ·ν.
-    CHECK(r.nu(0) == Approx(2.25 * r.qdd(0) / std::sin(phi)).epsilon(1e-13));
+    CHECK(r.nu(0) == Approx((2.25 * r.qdd(0) - in.tau(0)) / std::sin(phi)).epsilon(1e-13));
   }
 }
 
@@ -433,7 +433,7 @@ TEST_CASE("dense reference: KKT solution, symmetry, constraint rows, Gauss", "[r
     int row = 0;
     for (const ConstraintInput& c : in.constraints) {
       const int link = spec.linkIndex(c.link);
-      const Eigen::Matrix3d R = c.axes == Axes::Local ? r.poses[static_cast<std::size_t>(link)].linear()
+      const Eigen::Matrix3d R = c.axes == Axes::Local ? Eigen::Matrix3d(r.poses[static_cast<std::size_t>(link)].linear())
                                                       : Eigen::Matrix3d::Identity();
       Matrix6Xd A_world(6, c.A.cols());
       A_world << R * c.A.topRows<3>(), R * c.A.bottomRows<3>();
@@ -563,7 +563,7 @@ TEST_CASE("dense reference: H and C from Lagrange's equations by finite differen
       G_fd(k) = (V_plus - V_minus) / (2.0 * h);
       for (const WrenchInput& w : in.wrenches) {
         const auto i = static_cast<std::size_t>(spec.linkIndex(w.link));
-        const Eigen::Matrix3d R = w.axes == Axes::Local ? here[i].linear() : Eigen::Matrix3d::Identity();
+        const Eigen::Matrix3d R = w.axes == Axes::Local ? Eigen::Matrix3d(here[i].linear()) : Eigen::Matrix3d::Identity();
         const Eigen::Vector3d dp = (plus[i].translation() - minus[i].translation()) / (2.0 * h);
         const Eigen::Vector3d dtheta = rotationVector(plus[i].linear() * minus[i].linear().transpose()) / (2.0 * h);
         Q_fd(k) += (R * w.wrench.head<3>()).dot(dp) + (R * w.wrench.tail<3>()).dot(dtheta);
@@ -732,7 +732,7 @@ TEST_CASE("KDL conventions: the sign of ν and what constraint_torques are", "[r
       const int f = n - 1 - j;
       articulated(j) = physical(j);
       if (f > 0)
-        articulated(j) -= dense.H.block(j, j + 1, 1, f).dot(dense.H.block(j + 1, j + 1, f, f).ldlt().solve(physical.tail(f)));
+        articulated(j) -= dense.H.row(j).segment(j + 1, f).dot(dense.H.block(j + 1, j + 1, f, f).ldlt().solve(physical.tail(f)));
     }
     worst_articulated = std::max(worst_articulated, relErr(kdl.constraint_torques_kdl, articulated));
 

@@ -197,7 +197,7 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
     out.C += kin.J[i].transpose() *
              (I * kin.bias[i] + forceCross(kin.v[i]) * I * kin.v[i] - f_ext[i] - I * g);
   }
-  out.H = 0.5 * (out.H + out.H.transpose());
+  out.H = (0.5 * (out.H + out.H.transpose())).eval();  // eval: the transpose aliases H
 
   // Constraint rows. A column [l; r] at the link origin p, in world axes, is the
   // Plücker force Ã = [l; r + p × l] at the world origin, and

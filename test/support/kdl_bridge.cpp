@@ -304,7 +304,7 @@ ChainSpec mergeFixedJoints(const ChainSpec& spec) {
     link.com = lump.mass > 0.0 ? Eigen::Vector3d(lump.moment / lump.mass) : Eigen::Vector3d::Zero();
     const Eigen::Matrix3d cx = skew3(link.com);
     link.inertia = lump.Ibar + lump.mass * cx * cx;
-    link.inertia = 0.5 * (link.inertia + link.inertia.transpose());
+    link.inertia = (0.5 * (link.inertia + link.inertia.transpose())).eval();  // eval: aliasing
   };
 
   ChainSpec out;

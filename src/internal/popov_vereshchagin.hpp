@@ -1,0 +1,49 @@
+// The stages of the Popov–Vereshchagin solver (Algorithm 1), callable one by
+// one so that the friction extension can run the same sweeps with extra
+// right-hand sides. Not installed; the public entry is solveHybridDynamics.
+#pragma once
+
+#include "zwang/status.hpp"
+#include "zwang/workspace.hpp"
+
+namespace zwang::internal {
+
+using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
+
+// Input checks shared by every solve.
+Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
+                        const VectorRef& tau, const Workspace& ws);
+
+// Lines 2–10: kinematics, F_bias (with the task's wrenches), I^A = I, F^A = F_bias,
+// and the task's constraints in body form.
+void outwardSweep(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd, Workspace& ws);
+
+// Lines 11–22 for the joint torques `tau`: D, I^A S, u, A_i, U_0, 𝓛_0.
+// Fails (Degenerate) when a joint has no inertia to move.
+Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws);
+
+// Line 25: ν = 𝓛⁻¹(b − A₀ᵀẌ₀ − U₀) into ws.nu (solver order), diagonalising 𝓛
+// (kept in ws.eigvec / ws.eigval for balanceSolve) and filling
+// ws.solution.coupling.
+void balance(const Task& task, Workspace& ws);
+
+// ν for another right-hand side r with the factorisation and damping of the
+// last balance(): out = Σ σ_k/(σ_k² + λ²)(e_kᵀ r) e_k. `out` and `r` have m rows.
+void balanceSolve(const Workspace& ws, int m, const VectorRef& r, Eigen::Ref<Eigen::VectorXd> out);
+
+// Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.
+void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd);
+
+// τ_c = Σ J_iᵀ A_i ν_i for ν in solver order (one inward pass of the wrenches A ν).
+void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
+                       Eigen::Ref<Eigen::VectorXd> tau_c);
+
+// Gauss function of the true accelerations ws.a − gravity shift, with joint
+// torques `tau`; also fills the solution's body accelerations.
+double gaussAndBodyAccelerations(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
+                                 Workspace& ws);
+
+// ws.nu (solver order) into the solution's ν (the task's row order).
+void publishNu(const Task& task, Workspace& ws);
+
+}  // namespace zwang::internal

@@ -114,7 +114,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     sA.noalias() = A.transpose() * S;                                // (Sᵀ A_i)ᵀ
     ws.U.head(k).noalias() += A.transpose() * c;                     // line 20: Aᵀ Ẍ_bias …
     ws.U.head(k) += sA * (ws.u[at(i)] / D);                          //          … + Aᵀ S D⁻¹ u
-    ws.L.topLeftCorner(k, k).noalias() += sA * sA.transpose() / D;  // line 21 (sign: see top)
+    for (int r = 0; r < k; ++r) ws.L.col(r).head(k) += sA * (sA[r] / D);  // line 21 (sign: see top)
 
     const Transform& X = ws.Xup[at(i)];
     if (i > 1) {
@@ -133,7 +133,8 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
 void balance(const Task& task, Workspace& ws) {
   const int m = task.constraintRows();
   const Vec6 a0 = gravityShift(ws, 0, task.gravity);  // Ẍ₀ = [−g; 0]
-  ws.rhs.head(m) = ws.b_body.head(m) - ws.Ahat[0].leftCols(m).transpose() * a0 - ws.U.head(m);  // line 25
+  ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);  // line 25 …
+  ws.rhs.head(m).noalias() -= ws.Ahat[0].leftCols(m).transpose() * a0;  // … − A₀ᵀẌ₀
   ws.solution.coupling = solveBalance(ws.L.topLeftCorner(m, m), ws.rhs.head(m), ws.nu.head(m),
                                       ws.eigvec.topLeftCorner(m, m), ws.eigval.head(m), ws.scratch.head(m), task.balance);
 }
@@ -155,7 +156,8 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   for (int i = 1; i <= model.dof(); ++i) {
     const Vec6 Xa = ws.Xup[at(i)].applyMotion(ws.a[at(i - 1)]);
     const int k = task.activeColumns(i);
-    const double constraint = (ws.Ahat[at(i)].leftCols(k).transpose() * ws.S[at(i)]).dot(ws.nu.head(k));
+    const Vec6 Anu = ws.Ahat[at(i)].leftCols(k) * ws.nu.head(k);  // the constraint force felt at body i
+    const double constraint = ws.S[at(i)].dot(Anu);
     qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(Xa) + constraint) / ws.D[at(i)];  // line 28
     ws.a[at(i)] = Xa + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                     // line 29
   }

@@ -701,8 +701,8 @@ TEST_CASE("KDL Vereshchagin agrees with the dense KKT solution", "[references][k
 TEST_CASE("KDL conventions: the sign of ν and what constraint_torques are", "[references][kdl]") {
   std::mt19937_64 rng(19);
   int compared = 0;
-  double worst_sign = 0.0, best_wrong_sign = 1e300, worst_last = 0.0, worst_articulated = 0.0, worst_replay = 0.0,
-         best_kdl_replay = 1e300;
+  int kdl_replay_fails = 0;  // draws where τ + KDL's constraint_torques does NOT replay q̈
+  double worst_sign = 0.0, best_wrong_sign = 1e300, worst_last = 0.0, worst_articulated = 0.0, worst_replay = 0.0;
   for (int trial = 0; trial < 120; ++trial) {
     RandomChainOptions options = noFixed();
     options.min_moving_joints = 2;
@@ -737,24 +737,26 @@ TEST_CASE("KDL conventions: the sign of ν and what constraint_torques are", "[r
     worst_articulated = std::max(worst_articulated, relErr(kdl.constraint_torques_kdl, articulated));
 
     // Closure (SPEC §1): the unconstrained arm driven by τ + τ_c replays q̈;
-    // driven by τ + KDL's constraint_torques it does not.
+    // driven by τ + KDL's constraint_torques it does not (except in special
+    // draws where the tip wrench loads no distal joint, J_fᵀ W = 0).
     DynamicsInput free = in;
     free.constraints.clear();
     free.tau = in.tau + kdl.tau_c;
     worst_replay = std::max(worst_replay, relErr(kdlHybridDynamics(spec, free).qdd, kdl.qdd));
     free.tau = in.tau + kdl.constraint_torques_kdl;
-    best_kdl_replay = std::min(best_kdl_replay, relErr(kdlHybridDynamics(spec, free).qdd, kdl.qdd));
+    if (relErr(kdlHybridDynamics(spec, free).qdd, kdl.qdd) > 1e-6) ++kdl_replay_fails;
   }
   INFO("compared " << compared << "; ν = −ν_KDL to " << worst_sign << " (with +: " << best_wrong_sign
                    << "); last constraint torque " << worst_last << "; articulated formula " << worst_articulated
-                   << "; replay with τ_c " << worst_replay << ", with KDL's constraint_torques (smallest error) "
-                   << best_kdl_replay);
+                   << "; replay with τ_c " << worst_replay << "; KDL's constraint_torques fail to replay in "
+                   << kdl_replay_fails << " draws");
   CHECK(compared >= 60);
   CHECK(worst_sign < 1e-9);
   CHECK(best_wrong_sign > 1e-3);
   CHECK(worst_last < 1e-10);
   CHECK(worst_articulated < 1e-9);
   CHECK(worst_replay < 1e-9);
+  CHECK(kdl_replay_fails >= compared * 9 / 10);
 }
 
 TEST_CASE("KDL Vereshchagin and fixed segments", "[references][kdl]") {

@@ -110,7 +110,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
 
     const int k = task.activeColumns(i);
     const auto A = ws.Ahat[at(i)].leftCols(k);
-    auto sA = ws.scratch.head(k);
+    auto sA = ws.SA.col(i).head(k);
     sA.noalias() = A.transpose() * S;                                // (Sᵀ A_i)ᵀ
     ws.U.head(k).noalias() += A.transpose() * c;                     // line 20: Aᵀ Ẍ_bias …
     ws.U.head(k) += sA * (ws.u[at(i)] / D);                          //          … + Aᵀ S D⁻¹ u
@@ -156,10 +156,40 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   for (int i = 1; i <= model.dof(); ++i) {
     const Vec6 Xa = ws.Xup[at(i)].applyMotion(ws.a[at(i - 1)]);
     const int k = task.activeColumns(i);
-    const Vec6 Anu = ws.Ahat[at(i)].leftCols(k) * ws.nu.head(k);  // the constraint force felt at body i
-    const double constraint = ws.S[at(i)].dot(Anu);
+    const double constraint = ws.SA.col(i).head(k).dot(ws.nu.head(k));  // Sᵀ A_i ν
     qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(Xa) + constraint) / ws.D[at(i)];  // line 28
     ws.a[at(i)] = Xa + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                     // line 29
+  }
+}
+
+void unitTorqueColumn(const Model& model, const Task& task, Workspace& ws, int joint, Eigen::Ref<Eigen::VectorXd> du,
+                      Eigen::Ref<Eigen::VectorXd> dU, Eigen::Ref<Eigen::VectorXd> dnu,
+                      Eigen::Ref<Eigen::VectorXd> dqdd) {
+  // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
+  // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
+  const int N = model.dof();
+  const int m = task.constraintRows();
+  const int s = joint + 1;
+  du.setZero();
+  dU.head(m).setZero();
+  Vec6 dFA = Vec6::Zero();  // δF^A arriving at body i from its child
+  for (int i = s; i >= 1; --i) {
+    du[i] = (i == s ? 1.0 : 0.0) - ws.S[at(i)].dot(dFA);
+    const double du_D = du[i] / ws.D[at(i)];
+    const int k = task.activeColumns(i);
+    dU.head(k) += ws.SA.col(i).head(k) * du_D;                        // line 20
+    dFA = ws.Xup[at(i)].inverseApplyForce(dFA + ws.IAS[at(i)] * du_D);  // lines 17–18
+  }
+  auto r = dnu.head(m);  // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+  dU.head(m) *= -1.0;
+  balanceSolve(ws, m, dU.head(m), r);
+  Vec6 da = Vec6::Zero();
+  for (int i = 1; i <= N; ++i) {  // lines 28–29 for the differences
+    const Vec6 Xda = ws.Xup[at(i)].applyMotion(da);
+    const int k = task.activeColumns(i);
+    const double dq = (du[i] - ws.IAS[at(i)].dot(Xda) + ws.SA.col(i).head(k).dot(dnu.head(k))) / ws.D[at(i)];
+    dqdd[i - 1] = dq;
+    da = Xda + ws.S[at(i)] * dq;
   }
 }
 

@@ -1,5 +1,7 @@
 #include "zwang/workspace.hpp"
 
+#include "internal/friction_scratch.hpp"
+
 namespace zwang {
 
 Workspace::Workspace(const Model& model, int max_constraint_rows)
@@ -24,6 +26,7 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   IAS.assign(bodies, Vec6::Zero());
   D.assign(bodies, 0.0);
   u.assign(bodies, 0.0);
+  SA.setZero(m, static_cast<Eigen::Index>(bodies));
   Ahat.assign(bodies, ConstraintMatrix::Zero(6, m));
   U.setZero(m);
   L.setZero(m, m);
@@ -39,7 +42,18 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   Ic.assign(bodies, Mat6::Zero());
   H.setZero(n, n);
   tau.setZero(n);
+
+  friction.mu.setZero(n);
+  friction.state.assign(static_cast<std::size_t>(n), JointState::Moving);
+  friction.tau_friction.setZero(n);
+  friction.dqdd_dmu.setZero(n, n);
+  friction.stuck.reserve(static_cast<std::size_t>(n));
+  friction_scratch_ = std::make_unique<internal::FrictionScratch>(n, static_cast<int>(bodies), m);
 }
+
+Workspace::~Workspace() = default;
+Workspace::Workspace(Workspace&&) noexcept = default;
+Workspace& Workspace::operator=(Workspace&&) noexcept = default;
 
 Workspace::Workspace(const Model& model, const Task& task) : Workspace(model, task.constraintRows()) {
   solution.nu.setZero(task.constraintRows());

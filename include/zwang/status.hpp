@@ -13,6 +13,8 @@ enum class StatusCode {
   WorkspaceTooSmall, // the workspace was sized for fewer constraint rows
   ModelMismatch,     // task or workspace built for another model
   Degenerate,        // a joint has no inertia to move (D_j ≤ 0) in this configuration
+  BadOption,         // an option or per-solve override is out of range
+  Infeasible,        // the task drives a joint into its position limit (outputs finite, not physical)
 };
 
 struct Status {

@@ -6,11 +6,17 @@
 // is a body (0 = the fixed base), joint i−1 moves body i.
 #pragma once
 
+#include <memory>
 #include <vector>
 
+#include "zwang/friction_result.hpp"
 #include "zwang/task.hpp"
 
 namespace zwang {
+
+namespace internal {
+struct FrictionScratch;
+}
 
 // State of the constraint coupling matrix L at the balance (docs/solver.md).
 struct CouplingDiagnostics {
@@ -43,11 +49,15 @@ class Workspace {
   explicit Workspace(const Model& model, int max_constraint_rows = 6);
   // Sized exactly for this task (solution.nu has its row count from the start).
   Workspace(const Model& model, const Task& task);
+  ~Workspace();
+  Workspace(Workspace&&) noexcept;
+  Workspace& operator=(Workspace&&) noexcept;
 
   int dof() const { return dof_; }
   int constraintCapacity() const { return capacity_; }
 
   Solution solution;
+  FrictionResult friction;  // filled by solveWithFriction
 
   // --- outward sweep: poses, velocities, bias terms (Algorithm 1, lines 2–10)
   std::vector<Transform> Xup;     // ⁱX_{i−1}(q_i)
@@ -63,6 +73,7 @@ class Workspace {
   std::vector<Vec6> IAS;               // I^A_i S_i
   std::vector<double> D;               // D_i = d_i + S_iᵀ I^A_i S_i
   std::vector<double> u;               // τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
+  Eigen::MatrixXd SA;                  // column i: (S_iᵀ A_i)ᵀ, capacity × bodies
   std::vector<ConstraintMatrix> Ahat;  // A_i: unit constraint forces felt at body i (6 × capacity)
   Eigen::VectorXd U;                   // U_0, acceleration energy of bias forces and torques
   Eigen::MatrixXd L;                   // 𝓛_0, constraint coupling matrix (capacity²)
@@ -87,9 +98,13 @@ class Workspace {
   Eigen::MatrixXd H;        // joint-space inertia (CRBA)
   Eigen::VectorXd tau;      // inverse dynamics result (RNEA)
 
+ // Scratch of the friction extension (src/friction.cpp).
+  internal::FrictionScratch& frictionScratch() { return *friction_scratch_; }
+
  private:
   int dof_;
   int capacity_;
+  std::unique_ptr<internal::FrictionScratch> friction_scratch_;
 };
 
 }  // namespace zwang

@@ -9,3 +9,4 @@
 #include "zwang/task.hpp"
 #include "zwang/urdf.hpp"
 #include "zwang/workspace.hpp"
+#include "zwang/friction.hpp"

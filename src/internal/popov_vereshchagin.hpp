@@ -34,6 +34,14 @@ void balanceSolve(const Workspace& ws, int m, const VectorRef& r, Eigen::Ref<Eig
 // Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd);
 
+// One extra right-hand side through the same sweeps: a unit torque at `joint`,
+// everything else zero. Gives δu_i (bodies), δν (m, solver order; uses dU as
+// scratch) and δq̈ = ∂q̈/∂τ_joint (n). Needs inwardSweep and balance first.
+// O(N + m²) per column: the sensitivity K_Θ of the friction extension.
+void unitTorqueColumn(const Model& model, const Task& task, Workspace& ws, int joint, Eigen::Ref<Eigen::VectorXd> du,
+                      Eigen::Ref<Eigen::VectorXd> dU, Eigen::Ref<Eigen::VectorXd> dnu,
+                      Eigen::Ref<Eigen::VectorXd> dqdd);
+
 // τ_c = Σ J_iᵀ A_i ν_i for ν in solver order (one inward pass of the wrenches A ν).
 void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c);

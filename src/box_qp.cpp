@@ -1,0 +1,307 @@
+#include "internal/box_qp.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "internal/coupling.hpp"
+
+namespace zwang::internal {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+using Index = Eigen::Index;
+}  // namespace
+
+QpScratch::QpScratch(int n)
+    : M(n, n),
+      V(n, n),
+      lambda(n),
+      g(n),
+      p(n),
+      t1(n),
+      t2(n),
+      C(2 * n, n),
+      d(2 * n),
+      free_index(n),
+      working(2 * n),
+      side(2 * n) {}
+
+double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
+                        const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                        const Eigen::Ref<const Eigen::VectorXd>& x) {
+  double r = 0.0;
+  for (Index j = 0; j < x.size(); ++j) {
+    const double g = P.row(j).dot(x) - c[j];
+    const double projected = std::min(hi[j], std::max(lo[j], x[j] - g));
+    r = std::max(r, std::abs(x[j] - projected));
+  }
+  return r;
+}
+
+QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
+                        const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
+                        double zero_curvature) {
+  QpReport report;
+  const Index k = x.size();
+  if (k == 0) {
+    report.converged = true;
+    return report;
+  }
+  double x_scale = 1.0;
+  for (Index j = 0; j < k; ++j) {
+    if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
+    if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
+  }
+  // working[j] = 1: x_j held at a bound. Start with the variables whose box is
+  // a point, and those already on a bound.
+  auto on_bound = [&](Index j) { return x[j] <= lo[j] || x[j] >= hi[j]; };
+  for (Index j = 0; j < k; ++j) s.working[j] = on_bound(j) ? 1 : 0;
+
+  for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
+    s.g.head(k).noalias() = P * x;
+    s.g.head(k) -= c;  // ∇φ = P x − c
+    Index nf = 0;
+    for (Index j = 0; j < k; ++j)
+      if (!s.working[j]) s.free_index[nf++] = static_cast<int>(j);
+
+    // The step on the free variables: minimise ½ pᵀ P_FF p + g_Fᵀ p. None
+    // when the free gradient already vanishes (to the tolerance).
+    double free_gradient = 0.0;
+    for (Index a = 0; a < nf; ++a) free_gradient = std::max(free_gradient, std::abs(s.g[s.free_index[a]]));
+    bool moved = false;
+    if (nf > 0 && free_gradient > tolerance) {
+      auto M = s.M.topLeftCorner(nf, nf);
+      for (Index a = 0; a < nf; ++a)
+        for (Index b = 0; b < nf; ++b) M(a, b) = P(s.free_index[a], s.free_index[b]);
+      auto V = s.V.topLeftCorner(nf, nf);
+      auto lam = s.lambda.head(nf);
+      jacobiEigen(M, lam, V);
+      auto rho = s.t1.head(nf);
+      for (Index a = 0; a < nf; ++a) s.t2[a] = -s.g[s.free_index[a]];
+      rho.noalias() = V.transpose() * s.t2.head(nf);  // −g_F in the eigenbasis
+      // Zero-curvature descent component: φ falls linearly along it.
+      auto step = s.p.head(nf);
+      step.setZero();
+      bool linear = false;
+      for (Index e = 0; e < nf; ++e)
+        if (lam[e] <= zero_curvature && std::abs(rho[e]) > tolerance) {
+          step += rho[e] * V.col(e);
+          linear = true;
+        }
+      if (!linear)
+        for (Index e = 0; e < nf; ++e)
+          if (lam[e] > zero_curvature) step += (rho[e] / lam[e]) * V.col(e);  // Newton step
+
+      if (step.cwiseAbs().maxCoeff() > 1e-15 * x_scale) {
+        // Longest feasible step along `step` (capped at 1 for a Newton step).
+        double alpha = linear ? kInf : 1.0;
+        Index blocking = -1;
+        for (Index a = 0; a < nf; ++a) {
+          const Index j = s.free_index[a];
+          const double room = step[a] > 0 ? hi[j] - x[j] : step[a] < 0 ? lo[j] - x[j] : kInf;
+          const double t = step[a] != 0.0 ? room / step[a] : kInf;
+          if (t < alpha) {
+            alpha = t;
+            blocking = j;
+          }
+        }
+        if (!std::isfinite(alpha)) {  // a linear descent with no bound ahead
+          report.unbounded = true;
+          Index worst = 0;
+          for (Index a = 1; a < nf; ++a)
+            if (std::abs(step[a]) > std::abs(step[worst])) worst = a;
+          report.unbounded_index = s.free_index[worst];
+          break;
+        }
+        for (Index a = 0; a < nf; ++a) x[s.free_index[a]] += alpha * step[a];
+        if (blocking >= 0) {
+          // Snap the blocking variable exactly onto its bound.
+          for (Index a = 0; a < nf; ++a)
+            if (s.free_index[a] == blocking) x[blocking] = step[a] > 0 ? hi[blocking] : lo[blocking];
+          s.working[blocking] = 1;
+        }
+        moved = true;
+      }
+    }
+    if (moved) continue;
+
+    // Stationary on the free set: release the bound whose multiplier has the
+    // wrong sign (at the upper bound ∇φ_j must be ≤ 0, at the lower ≥ 0).
+    Index release = -1;
+    double worst = tolerance;
+    for (Index j = 0; j < k; ++j) {
+      if (!s.working[j] || lo[j] == hi[j]) continue;
+      const double wrong = x[j] >= hi[j] ? s.g[j] : -s.g[j];
+      if (wrong > worst) {
+        worst = wrong;
+        release = j;
+      }
+    }
+    if (release < 0) {
+      report.converged = true;
+      break;
+    }
+    s.working[release] = 0;
+  }
+  report.kkt_residual = boxQpKktResidual(P, c, lo, hi, x);
+  return report;
+}
+
+QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
+                                const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance) {
+  QpReport report;
+  const Index k = x.size();
+  if (k == 0) {
+    report.converged = true;
+    return report;
+  }
+  auto clamp = [&](Eigen::Ref<Eigen::VectorXd> v) {
+    for (Index j = 0; j < k; ++j) v[j] = std::min(hi[j], std::max(lo[j], v[j]));
+  };
+  // Lipschitz constant of ∇φ: the largest eigenvalue of P.
+  auto M = s.M.topLeftCorner(k, k);
+  M = P;
+  jacobiEigen(M, s.lambda.head(k), s.V.topLeftCorner(k, k));
+  const double L = std::max(0.0, s.lambda.head(k).maxCoeff());
+  if (L <= 1e-12 * std::max(1.0, c.cwiseAbs().maxCoeff()) && L <= 1e-300 + 1e-12 * P.cwiseAbs().maxCoeff()) {
+    // φ is linear: each variable goes to the bound its gradient points away from.
+    for (Index j = 0; j < k; ++j) {
+      x[j] = c[j] > 0 ? hi[j] : c[j] < 0 ? lo[j] : std::min(hi[j], std::max(lo[j], 0.0));
+      if (!std::isfinite(x[j])) {
+        report.unbounded = true;
+        report.unbounded_index = static_cast<int>(j);
+        x[j] = 0.0;
+      }
+    }
+    report.converged = !report.unbounded;
+    report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
+    return report;
+  }
+  const double step = 1.0 / L;
+  double x_scale = 1.0;
+  for (Index j = 0; j < k; ++j) {
+    if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
+    if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
+  }
+  x_scale = std::max(x_scale, c.cwiseAbs().maxCoeff() / L);
+  auto y = s.t1.head(k);       // extrapolated point
+  auto x_prev = s.t2.head(k);  // previous iterate
+  y = x;
+  x_prev = x;
+  double t = 1.0;
+  for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
+    s.g.head(k).noalias() = P * y;
+    s.g.head(k) -= c;
+    x = y - step * s.g.head(k);
+    clamp(x);
+    if (x.cwiseAbs().maxCoeff() > 1e12 * x_scale) {  // running off along an infinite bound
+      report.unbounded = true;
+      Index worst = 0;
+      for (Index j = 1; j < k; ++j)
+        if (std::abs(x[j]) > std::abs(x[worst])) worst = j;
+      report.unbounded_index = static_cast<int>(worst);
+      break;
+    }
+    if (boxQpKktResidual(P, c, lo, hi, x) <= tolerance) {
+      report.converged = true;
+      break;
+    }
+    // FISTA momentum, restarted when it stops helping (gradient test).
+    const double t_next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t));
+    s.p.head(k) = x - x_prev;
+    if (s.g.head(k).dot(s.p.head(k)) > 0.0) {
+      t = 1.0;
+      y = x;
+    } else {
+      y = x + ((t - 1.0) / t_next) * s.p.head(k);
+      t = t_next;
+    }
+    x_prev = x;
+  }
+  report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
+  return report;
+}
+
+QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen::Ref<const Eigen::VectorXd>& a,
+                         const Eigen::Ref<const Eigen::VectorXd>& x0, const Eigen::Ref<const Eigen::VectorXd>& lo,
+                         const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> z, QpScratch& s,
+                         int max_iterations) {
+  // Constraint rows, each "row·z ≤ bound": for joint j, N_j z ≤ hi_j − x0_j and
+  // −N_j z ≤ x0_j − lo_j (rows with an infinite bound are skipped).
+  QpReport report;
+  const Index q = N.cols(), k = N.rows();
+  Index rows = 0;
+  for (Index j = 0; j < k; ++j) {
+    if (std::isfinite(hi[j])) {
+      s.C.row(rows).head(q) = N.row(j);
+      s.d[rows++] = hi[j] - x0[j];
+    }
+    if (std::isfinite(lo[j])) {
+      s.C.row(rows).head(q) = -N.row(j);
+      s.d[rows++] = x0[j] - lo[j];
+    }
+  }
+  const double scale = 1.0 + a.cwiseAbs().maxCoeff() + s.d.head(rows).cwiseAbs().maxCoeff();
+  const double tol = 1e-12 * scale;
+  Index nw = 0;  // working set: indices into the rows, s.working[0..nw)
+  for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
+    // Minimise ½‖z' − a‖² with C_W z' = d_W:  z' = a − C_Wᵀ λ,  (C_W C_Wᵀ) λ = C_W a − d_W.
+    auto lam = s.p.head(nw);
+    if (nw > 0) {
+      auto G = s.M.topLeftCorner(nw, nw);
+      for (Index u = 0; u < nw; ++u)
+        for (Index v = 0; v < nw; ++v) G(u, v) = s.C.row(s.working[u]).head(q).dot(s.C.row(s.working[v]).head(q));
+      for (Index u = 0; u < nw; ++u) s.t1[u] = s.C.row(s.working[u]).head(q).dot(a) - s.d[s.working[u]];
+      auto V = s.V.topLeftCorner(nw, nw);
+      auto ev = s.lambda.head(nw);
+      jacobiEigen(G, ev, V);
+      const double ev_tol = 1e-12 * std::max(1e-300, ev.maxCoeff());
+      s.t2.head(nw).noalias() = V.transpose() * s.t1.head(nw);
+      for (Index u = 0; u < nw; ++u) s.t2[u] = ev[u] > ev_tol ? s.t2[u] / ev[u] : 0.0;
+      lam.noalias() = V * s.t2.head(nw);
+    }
+    // Candidate z' and the step towards it.
+    auto target = s.g.head(q);
+    target = a;
+    for (Index u = 0; u < nw; ++u) target -= lam[u] * s.C.row(s.working[u]).head(q).transpose();
+    auto step = s.t1.head(q);
+    step = target - z;
+    if (step.cwiseAbs().maxCoeff() <= tol) {
+      // At the subproblem's minimum: optimal when every multiplier is ≥ 0.
+      Index drop = -1;
+      double most_negative = -tol;
+      for (Index u = 0; u < nw; ++u)
+        if (lam[u] < most_negative) {
+          most_negative = lam[u];
+          drop = u;
+        }
+      if (drop < 0) {
+        report.converged = true;
+        break;
+      }
+      s.working[drop] = s.working[--nw];
+      continue;
+    }
+    double alpha = 1.0;
+    Index blocking = -1;
+    for (Index r = 0; r < rows; ++r) {
+      bool active = false;
+      for (Index u = 0; u < nw; ++u) active = active || s.working[u] == r;
+      if (active) continue;
+      const double rate = s.C.row(r).head(q).dot(step);
+      if (rate <= 1e-15 * scale) continue;
+      const double t = (s.d[r] - s.C.row(r).head(q).dot(z)) / rate;
+      if (t < alpha) {
+        alpha = std::max(0.0, t);
+        blocking = r;
+      }
+    }
+    z += alpha * step;
+    if (blocking >= 0) s.working[nw++] = static_cast<int>(blocking);
+  }
+  return report;
+}
+
+}  // namespace zwang::internal

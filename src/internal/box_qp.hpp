@@ -1,0 +1,58 @@
+// Small dense convex QPs for the friction maximiser (no allocation: all
+// memory comes from a scratch sized once for n variables).
+#pragma once
+
+#include <Eigen/Core>
+
+namespace zwang::internal {
+
+struct QpScratch {
+  explicit QpScratch(int n = 0);
+  Eigen::MatrixXd M, V;                       // n × n
+  Eigen::VectorXd lambda, g, p, t1, t2;       // n
+  Eigen::MatrixXd C;                          // 2n × n, constraint rows (least-distance QP)
+  Eigen::VectorXd d;                          // 2n
+  Eigen::VectorXi free_index, working, side;  // n, 2n, 2n
+};
+
+struct QpReport {
+  int iterations = 0;
+  double kkt_residual = 0.0;  // ‖x − clamp(x − ∇φ)‖∞ (box QP)
+  bool converged = false;
+  bool unbounded = false;
+  int unbounded_index = -1;   // a variable that runs off to an infinite bound
+};
+
+// min φ(x) = ½ xᵀ P x − cᵀ x  over lo ≤ x ≤ hi (entries may be ±∞, lo ≤ 0 ≤ hi),
+// P symmetric positive SEMI-definite (k × k). x is the start (feasible) and the
+// result. Primal active-set method: Newton steps on the free variables
+// (eigen-decomposed, so a singular P_FF is fine), and along a zero-curvature
+// descent direction straight to the next bound — never a division by zero
+// curvature. Finite; `tolerance` is on the projected gradient; eigenvalues of
+// P_FF at or below `zero_curvature` count as zero.
+QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
+                        const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
+                        double zero_curvature);
+
+// The same problem by accelerated projected gradient (FISTA with adaptive
+// restart), step 1/λ_max(P); a linear problem (P = 0) goes to its vertex.
+QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
+                                const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance);
+
+// ‖x − clamp(x − (P x − c))‖∞: zero exactly at a minimiser of the box QP.
+double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
+                        const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                        const Eigen::Ref<const Eigen::VectorXd>& x);
+
+// Least-distance problem  min ½‖z − a‖²  s.t.  lo ≤ x0 + N z ≤ hi  (q = N.cols()
+// unknowns, k = N.rows() two-sided rows), from the feasible start z (usually 0).
+// Primal active set; z is the result. Used to pick among several friction
+// maximisers μ* + null(K_ΘΘ).
+QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen::Ref<const Eigen::VectorXd>& a,
+                         const Eigen::Ref<const Eigen::VectorXd>& x0, const Eigen::Ref<const Eigen::VectorXd>& lo,
+                         const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> z, QpScratch& s,
+                         int max_iterations);
+
+}  // namespace zwang::internal

@@ -11,7 +11,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
-#include <Eigen/SVD>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>

@@ -299,7 +299,13 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
       }
     }
     z += alpha * step;
-    if (blocking >= 0) s.working[nw++] = static_cast<int>(blocking);
+    if (blocking >= 0) {
+      // A blocking row is independent of the working rows (the step keeps
+      // those at zero rate), so at most q of them can be active; more would
+      // only be rounding — stop there rather than overrun the scratch.
+      if (nw == q) break;
+      s.working[nw++] = static_cast<int>(blocking);
+    }
   }
   return report;
 }

@@ -92,6 +92,11 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
       if (!linear)
         for (Index e = 0; e < nf; ++e)
           if (lam[e] > zero_curvature) step += (rho[e] / lam[e]) * V.col(e);  // Newton step
+      // Components at rounding level are zero: a 1e-39 cross term must not
+      // turn an unbounded direction into a huge finite step.
+      const double step_size = step.cwiseAbs().maxCoeff();
+      for (Index a = 0; a < nf; ++a)
+        if (std::abs(step[a]) <= 1e-12 * step_size) step[a] = 0.0;
 
       if (step.cwiseAbs().maxCoeff() > 1e-15 * x_scale) {
         // Longest feasible step along `step` (capped at 1 for a Newton step).
@@ -206,6 +211,7 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
     }
     if (boxQpKktResidual(P, c, lo, hi, x) <= tolerance) {
       report.converged = true;
+      ++report.iterations;  // count this gradient step
       break;
     }
     // FISTA momentum, restarted when it stops helping (gradient test).

@@ -159,6 +159,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
                                           options.max_iterations, tolerance);
   }
   fr.iterations = report.iterations;
+  fr.converged = k == 0 || report.converged;
 
   // ---- Several maximisers? They all give the same q̈* (SPEC §2), so they
   // differ only along null(K_ΘΘ); and g is linear there with slope q̈*_Θ, so a
@@ -170,14 +171,16 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
     Eigen::Index ns = 0;
     for (Eigen::Index a = 0; a < k; ++a)
       if (std::abs(fs.c[a] - P.row(a).dot(mu)) <= acc_tol) fs.sub_index[ns++] = static_cast<int>(a);
-    auto Pss = fs.null_basis.topLeftCorner(ns, ns);
-    for (Eigen::Index a = 0; a < ns; ++a)
-      for (Eigen::Index b = 0; b < ns; ++b) Pss(a, b) = P(fs.sub_index[a], fs.sub_index[b]);
-    auto V = fs.V.topLeftCorner(ns, ns);
-    jacobiEigen(Pss, fs.eig.head(ns), V);
     Eigen::Index nullity = 0;
-    for (Eigen::Index e = 0; e < ns; ++e)
-      if (fs.eig[e] <= zero_curvature) fs.null_basis.col(nullity++).head(ns) = V.col(e);
+    if (ns > 0) {  // (none when every stuck joint slips: μ* is then unique)
+      auto Pss = fs.null_basis.topLeftCorner(ns, ns);
+      for (Eigen::Index a = 0; a < ns; ++a)
+        for (Eigen::Index b = 0; b < ns; ++b) Pss(a, b) = P(fs.sub_index[a], fs.sub_index[b]);
+      auto V = fs.V.topLeftCorner(ns, ns);
+      jacobiEigen(Pss, fs.eig.head(ns), V);
+      for (Eigen::Index e = 0; e < ns; ++e)
+        if (fs.eig[e] <= zero_curvature) fs.null_basis.col(nullity++).head(ns) = V.col(e);
+    }
     if (nullity > 0) {
       const auto N = fs.null_basis.topLeftCorner(ns, nullity);
       auto x = fs.sub_mu.head(ns), lo = fs.sub_lo.head(ns), hi = fs.sub_hi.head(ns);

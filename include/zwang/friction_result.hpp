@@ -23,6 +23,7 @@ struct FrictionResult {
   std::vector<int> stuck;            // Θ₀: the stuck joints, ascending
   double gauss_dual = 0.0;           // g(μ*) = Z(q̈*) + μ*ᵀ W q̈*
   int iterations = 0;                // of the maximiser
+  bool converged = true;             // the maximiser met its KKT tolerance within max_iterations
   double kkt_residual = 0.0;         // max violation of the optimality conditions [rad/s² or m/s²]
   bool indeterminate = false;        // μ* is not unique; the effort-minimising one was chosen
   bool limit_impact = false;         // a joint on a limit moves into it (needs an impulse; not modelled)

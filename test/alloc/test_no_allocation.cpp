@@ -84,3 +84,28 @@ TEST_CASE("RNEA, CRBA, kinematics and Jacobians allocate nothing") {
   CHECK(std::isfinite(sink));
   CHECK(count == 0);
 }
+
+TEST_CASE("the friction solve allocates nothing (all joints stuck, indeterminate, both maximisers)") {
+  const Model model = panda();
+  Task task(model);
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  ConstraintMatrix elbow = ConstraintMatrix::Zero(6, 1);
+  elbow(5, 0) = 1.0;
+  task.addConstraint("panda_link1", elbow);
+  Workspace ws(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), zero = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd qd = zero;
+  qd[3] = 0.4;  // one moving joint: kinetic friction
+  FrictionOptions active, gradient;
+  gradient.method = FrictionMethod::ProjectedGradient;
+  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws, active));  // warm
+  bool ok = true;
+  const long count = allocationsDuring([&] {
+    ok = solveWithFriction(model, task, q, zero, zero, ws, active).ok() && ok;
+    ok = solveWithFriction(model, task, q, qd, zero, ws, active).ok() && ok;
+    ok = solveWithFriction(model, task, q, zero, zero, ws, gradient).ok() && ok;
+  });
+  CHECK(ok);
+  CHECK(count == 0);
+  CHECK(ws.friction.stuck.size() == 7);
+}

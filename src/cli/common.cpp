@@ -1,0 +1,176 @@
+// Argument parsing, usage texts and file helpers of the zwang tool.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "cli.hpp"
+
+namespace zwang::cli {
+
+const char* usageText(const std::string& command) {
+  if (command == "solve")
+    return "usage: zwang solve PROBLEM.json [-o FILE] [--pretty]\n"
+           "\n"
+           "Solve the constrained hybrid dynamics problem in PROBLEM.json (with static\n"
+           "friction when it has a \"friction\" section) and print the solution as JSON.\n"
+           "\n"
+           "  -o, --output FILE  write the solution to FILE instead of stdout\n"
+           "  --pretty           indent the JSON for humans\n"
+           "\n"
+           "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage,\n"
+           "3 infeasible task (the solution is still written, status.infeasible = true).\n"
+           "The problem and solution schemas are in docs/cli.md.\n";
+  if (command == "info")
+    return "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--json]\n"
+           "\n"
+           "Print the chain loaded from MODEL.urdf: joints (type, axis, limits, friction,\n"
+           "damping, rotor inertia, effort limit), frames and total mass.\n"
+           "\n"
+           "  --root LINK  the chain starts at LINK (default: the URDF's root link)\n"
+           "  --tip LINK   the chain ends at LINK (default: the unique leaf)\n"
+           "  --json       print JSON instead of a table\n";
+  if (command == "scenarios")
+    return "usage: zwang scenarios [--out DIR] [--models DIR] [--no-plots]\n"
+           "\n"
+           "Reproduce the report's chapter 6 (scenarios 1 and 2) and Fig. 5.5 with the\n"
+           "1-DOF arm: print the friction-aware results next to the report's numbers and\n"
+           "write DIR/<name>.csv (g, qdd, tau over 201 friction values) and, with gnuplot,\n"
+           "DIR/<name>_g.png, _qdd.png, _tau.png.\n"
+           "\n"
+           "  --out DIR     output directory (default: ./scenarios; created if missing)\n"
+           "  --models DIR  where one_dof_arm.urdf is (default: the source tree's models/)\n"
+           "  --no-plots    write the CSVs only (no gnuplot script, no PNG)\n"
+           "\n"
+           "Exit code 1 when a result disagrees with the report's.\n";
+  return "usage: zwang <command> [options]\n"
+         "\n"
+         "commands:\n"
+         "  solve PROBLEM.json [-o FILE] [--pretty]        solve a JSON problem, print the solution as JSON\n"
+         "  info MODEL.urdf [--root L] [--tip L] [--json]  joints, frames and mass of a URDF chain\n"
+         "  scenarios [--out DIR] [--models DIR]           the report's chapter 6 and Fig. 5.5, with plots\n"
+         "\n"
+         "  zwang <command> --help   a command's options\n"
+         "  zwang --version          the version\n"
+         "\n"
+         "Exit codes: 0 ok, 1 error, 2 usage, 3 infeasible task. See docs/cli.md.\n";
+}
+
+bool Arguments::has(const std::string& name) const {
+  for (const auto& option : options)
+    if (option.first == name) return true;
+  return false;
+}
+
+std::string Arguments::value(const std::string& name, const std::string& fallback) const {
+  std::string result = fallback;
+  for (const auto& option : options)
+    if (option.first == name) result = option.second;  // the last one wins
+  return result;
+}
+
+Arguments parseArguments(const std::string& command, int argc, char** argv, int first,
+                         const std::vector<std::string>& flags, const std::vector<std::string>& with_value) {
+  auto contains = [](const std::vector<std::string>& list, const std::string& name) {
+    for (const auto& entry : list)
+      if (entry == name) return true;
+    return false;
+  };
+  Arguments args;
+  bool only_positional = false;
+  for (int i = first; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (only_positional || arg.size() < 2 || arg[0] != '-') {
+      args.positional.push_back(arg);
+      continue;
+    }
+    if (arg == "--") {
+      only_positional = true;
+      continue;
+    }
+    if (arg == "--help" || arg == "-h") {
+      args.help = true;
+      continue;
+    }
+    std::string name = arg, value;
+    bool inline_value = false;
+    if (const auto eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
+      name = arg.substr(0, eq);
+      value = arg.substr(eq + 1);
+      inline_value = true;
+    }
+    if (contains(flags, name)) {
+      if (inline_value) throw UsageError(command, "option " + name + " takes no value");
+      args.options.emplace_back(name, "");
+    } else if (contains(with_value, name)) {
+      if (!inline_value) {
+        if (i + 1 >= argc) throw UsageError(command, "option " + name + " needs a value");
+        value = argv[++i];
+      }
+      args.options.emplace_back(name, value);
+    } else {
+      throw UsageError(command, "unknown option '" + printable(arg, 60) + "'");
+    }
+  }
+  return args;
+}
+
+std::string printable(const std::string& text, std::size_t max_length) {
+  std::string out;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7f) {
+      out += ch;
+    } else {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\x%02X", static_cast<unsigned>(c));
+      out += buffer;
+    }
+    if (out.size() > max_length) {
+      out.resize(max_length);
+      out += "...";
+      break;
+    }
+  }
+  return out;
+}
+
+std::string readFile(const std::string& path, std::size_t max_bytes) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw CliError(kExitError, path + ": cannot read the file: it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int err = errno;
+    throw CliError(kExitError, path + ": cannot read the file (" + (err ? std::strerror(err) : "unknown error") + ")");
+  }
+  std::string content;
+  char buffer[65536];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    content.append(buffer, static_cast<std::size_t>(in.gcount()));
+    if (content.size() > max_bytes)
+      throw CliError(kExitError, path + ": the file is larger than " + std::to_string(max_bytes) + " bytes");
+  }
+  if (in.bad()) throw CliError(kExitError, path + ": cannot read the file");
+  return content;
+}
+
+void writeOutput(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::cout << text << std::flush;
+    if (!std::cout) throw CliError(kExitError, "cannot write to stdout");
+    return;
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) {
+    const int err = errno;
+    throw CliError(kExitError, path + ": cannot write the file (" + (err ? std::strerror(err) : "unknown error") + ")");
+  }
+  out << text;
+  out.close();
+  if (!out) throw CliError(kExitError, path + ": cannot write the file");
+}
+
+}  // namespace zwang::cli

@@ -1,0 +1,123 @@
+// `zwang info MODEL.urdf [--root L] [--tip L] [--json]`: what the loader made
+// of a URDF chain.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "json_reader.hpp"
+#include "solution_writer.hpp"
+#include "zwang/zwang.hpp"
+
+namespace zwang::cli {
+
+namespace {
+
+// Limits may be infinite ("none"): null in JSON, "-" in the table.
+Json finiteOrNull(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
+std::string cell(double x) {
+  if (!std::isfinite(x)) return "-";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", x);
+  return buffer;
+}
+
+// Left-aligned text columns, right-aligned numbers (cells starting with a digit, '-' or '.').
+void printTable(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> width;
+  for (const auto& row : rows)
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      if (width.size() <= c) width.push_back(0);
+      width[c] = std::max(width[c], row[c].size());
+    }
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    std::string line = "";
+    for (std::size_t c = 0; c < rows[r].size(); ++c) {
+      const std::string& text = rows[r][c];
+      const bool numeric = r > 0 && !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '-');
+      const std::string pad(width[c] - text.size(), ' ');
+      line += "  " + (numeric ? pad + text : text + pad);
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    std::printf("%s\n", line.c_str());
+  }
+}
+
+}  // namespace
+
+int commandInfo(int argc, char** argv) {
+  const Arguments args = parseArguments("info", argc, argv, 2, {"--json"}, {"--root", "--tip"});
+  if (args.help) {
+    std::fputs(usageText("info"), stdout);
+    return kExitOk;
+  }
+  if (args.positional.size() != 1)
+    throw UsageError("info", args.positional.empty() ? "no URDF file given" : "more than one URDF file given");
+  const std::string path = args.positional[0];
+  UrdfOptions options;
+  options.root = args.value("--root");
+  options.tip = args.value("--tip");
+  Model model;
+  try {
+    model = loadUrdfFile(path, options);
+  } catch (const ModelError& e) {
+    throw CliError(kExitError, e.what());
+  }
+
+  double total_mass = 0.0, moving_mass = 0.0;
+  for (int b = 0; b < model.bodyCount(); ++b) {
+    total_mass += model.inertia(b).mass;
+    if (b > 0) moving_mass += model.inertia(b).mass;
+  }
+  auto bodyName = [&](int b) { return model.frame(model.bodyFrame(b)).name; };
+
+  if (args.has("--json")) {
+    Json joints = Json::array();
+    for (const Joint& j : model.joints())
+      joints.push_back({{"name", j.name},
+                        {"type", toString(j.type)},
+                        {"axis", {j.axis.x(), j.axis.y(), j.axis.z()}},
+                        {"lower", finiteOrNull(j.lower)},
+                        {"upper", finiteOrNull(j.upper)},
+                        {"effort_limit", finiteOrNull(j.effort_limit)},
+                        {"velocity_limit", finiteOrNull(j.velocity_limit)},
+                        {"breakaway_friction", j.breakaway_friction},
+                        {"kinetic_friction", j.kinetic_friction},
+                        {"damping", j.damping},
+                        {"rotor_inertia", j.rotor_inertia}});
+    Json frames = Json::array();
+    for (const Frame& f : model.frames()) frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyName(f.body)}});
+    const Json out = {{"file", path},          {"model", model.name()},   {"dof", model.dof()},
+                      {"joints", std::move(joints)}, {"frames", std::move(frames)},
+                      {"total_mass", total_mass}, {"moving_mass", moving_mass}};
+    writeOutput("", prettyDump(out) + "\n");
+    return kExitOk;
+  }
+
+  std::printf("%s: %d moving joint%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
+              model.dof() == 1 ? "" : "s", model.frames().size(), path.c_str());
+  std::vector<std::vector<std::string>> rows{{"#", "name", "type", "axis", "lower", "upper", "effort", "velocity",
+                                              "breakaway", "kinetic", "damping", "rotor_inertia"}};
+  for (int k = 0; k < model.dof(); ++k) {
+    const Joint& j = model.joint(k);
+    char axis[64];
+    std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
+    rows.push_back({std::to_string(k), j.name, toString(j.type), axis, cell(j.lower), cell(j.upper), cell(j.effort_limit),
+                    cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction), cell(j.damping),
+                    cell(j.rotor_inertia)});
+  }
+  printTable(rows);
+  std::printf("\nframes\n");
+  rows = {{"name", "body", "body link"}};
+  for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyName(f.body)});
+  printTable(rows);
+  std::printf("\ntotal mass %s kg (moving bodies %s kg)\n", cell(total_mass).c_str(), cell(moving_mass).c_str());
+  std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (damping), kg·m² or kg (rotor inertia)\n");
+  return kExitOk;
+}
+
+}  // namespace zwang::cli

@@ -1,0 +1,220 @@
+// Reading the JSON problem of `zwang solve` and binding it to its model.
+#include "problem.hpp"
+
+#include <filesystem>
+
+#include "cli.hpp"
+#include "json_reader.hpp"
+
+namespace zwang::cli {
+
+namespace {
+
+Expressed parseExpressed(const JsonReader& in, const Json& value, const std::string& path, bool allow_aligned) {
+  const std::string text = in.string(value, path);
+  if (text == "local") return Expressed::Local;
+  if (text == "world") return Expressed::World;
+  if (allow_aligned && text == "aligned") return Expressed::Aligned;
+  in.fail(path, "unknown value \"" + printable(text, 40) + "\" (expected " +
+                    (allow_aligned ? "\"local\", \"world\" or \"aligned\"" : "\"local\" or \"world\"") + ")");
+}
+
+WrenchSpec parseWrench(const JsonReader& in, const Json& value, const std::string& path) {
+  in.object(value, path, {"frame", "expressed_in", "force", "torque"});
+  WrenchSpec w;
+  w.path = path;
+  if (!value.contains("frame")) in.fail(path, "missing key \"frame\" (the link the wrench acts on)");
+  w.frame = in.string(value["frame"], childPath(path, "frame"));
+  if (value.contains("expressed_in"))
+    w.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), false);
+  if (value.contains("force")) w.value.head<3>() = in.numbers(value["force"], childPath(path, "force"), 3, "fx, fy, fz");
+  if (value.contains("torque"))
+    w.value.tail<3>() = in.numbers(value["torque"], childPath(path, "torque"), 3, "nx, ny, nz");
+  return w;
+}
+
+ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const std::string& path) {
+  in.object(value, path, {"frame", "expressed_in", "directions", "acceleration"});
+  ConstraintSpec c;
+  c.path = path;
+  if (!value.contains("frame")) in.fail(path, "missing key \"frame\" (the link whose acceleration is constrained)");
+  c.frame = in.string(value["frame"], childPath(path, "frame"));
+  if (value.contains("expressed_in"))
+    c.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), true);
+  if (!value.contains("directions")) in.fail(path, "missing key \"directions\" (a list of 6-vectors, linear part first)");
+  const std::string dpath = childPath(path, "directions");
+  const Json& directions = in.array(value["directions"], dpath);
+  if (directions.empty()) in.fail(dpath, "needs at least one direction");
+  c.A.resize(6, static_cast<Eigen::Index>(directions.size()));
+  for (std::size_t k = 0; k < directions.size(); ++k)
+    c.A.col(static_cast<Eigen::Index>(k)) =
+        in.numbers(directions[k], childPath(dpath, k), 6, "linear part first: lx, ly, lz, rx, ry, rz");
+  if (value.contains("acceleration"))
+    c.acceleration = in.numbers(value["acceleration"], childPath(path, "acceleration"), c.A.cols(), "one per direction");
+  else
+    c.acceleration = Eigen::VectorXd::Zero(c.A.cols());
+  return c;
+}
+
+FrictionSpec parseFriction(const JsonReader& in, const Json& value, const std::string& path) {
+  in.object(value, path, {"enabled", "velocity_tolerance", "margin", "limits"});
+  FrictionSpec f;
+  f.present = true;
+  if (value.contains("enabled")) f.enabled = in.boolean(value["enabled"], childPath(path, "enabled"));
+  if (value.contains("velocity_tolerance")) {
+    const std::string p = childPath(path, "velocity_tolerance");
+    f.options.velocity_tolerance = in.number(value["velocity_tolerance"], p);
+    if (f.options.velocity_tolerance < 0) in.fail(p, "must be >= 0");
+  }
+  if (value.contains("margin")) {
+    const std::string p = childPath(path, "margin");
+    f.options.margin = in.number(value["margin"], p);
+    if (!(f.options.margin >= 0.0 && f.options.margin <= 1.0)) in.fail(p, "must be between 0 and 1");
+  }
+  if (value.contains("limits")) f.options.joint_limits = in.boolean(value["limits"], childPath(path, "limits"));
+  return f;
+}
+
+// Per-joint overrides must be non-negative.
+Eigen::VectorXd nonNegative(const JsonReader& in, const Json& value, const std::string& path) {
+  Eigen::VectorXd v = in.numbers(value, path);
+  for (Eigen::Index j = 0; j < v.size(); ++j)
+    if (v[j] < 0) in.fail(childPath(path, static_cast<std::size_t>(j)), "is " + formatNumber(v[j]) + ", must be >= 0");
+  return v;
+}
+
+std::string jointList(const Model& model) {
+  std::string list;
+  for (const Joint& joint : model.joints()) list += (list.empty() ? "" : ", ") + joint.name;
+  return list;
+}
+
+std::string frameList(const Model& model) {
+  std::string list;
+  for (const Frame& frame : model.frames()) list += (list.empty() ? "" : ", ") + frame.name;
+  return list;
+}
+
+}  // namespace
+
+Problem readProblem(const std::string& file) {
+  const std::string text = readFile(file, kMaxInputBytes);
+  const Json doc = parseJson(text, file);
+  const JsonReader in(file);
+  if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
+  in.object(doc, "",
+            {"model", "root", "tip", "gravity", "q", "qd", "tau", "rotor_inertia", "breakaway", "wrenches",
+             "constraints", "friction"});
+
+  Problem p;
+  p.file = file;
+  if (!doc.contains("model")) in.fail("model", "missing (the URDF file, relative to the problem file)");
+  const std::string model = in.string(doc["model"], "model");
+  if (model.empty()) in.fail("model", "is empty");
+  const std::filesystem::path model_path(model);
+  p.model_path = model_path.is_absolute() ? model : (std::filesystem::path(file).parent_path() / model_path).string();
+
+  if (doc.contains("root")) p.root = in.string(doc["root"], "root");
+  if (doc.contains("tip")) p.tip = in.string(doc["tip"], "tip");
+  if (doc.contains("gravity")) p.gravity = Vec3(in.numbers(doc["gravity"], "gravity", 3, "gx, gy, gz"));
+  for (const char* key : {"q", "qd", "tau"})
+    if (doc.contains(key)) {
+      Eigen::VectorXd v = in.numbers(doc[key], key);
+      (key[1] == '\0' ? p.q : key[1] == 'd' ? p.qd : p.tau) = std::move(v);
+    }
+  if (doc.contains("rotor_inertia")) p.rotor_inertia = nonNegative(in, doc["rotor_inertia"], "rotor_inertia");
+  if (doc.contains("breakaway")) p.breakaway = nonNegative(in, doc["breakaway"], "breakaway");
+  if (doc.contains("wrenches")) {
+    const Json& list = in.array(doc["wrenches"], "wrenches");
+    for (std::size_t k = 0; k < list.size(); ++k) p.wrenches.push_back(parseWrench(in, list[k], childPath("wrenches", k)));
+  }
+  if (doc.contains("constraints")) {
+    const Json& list = in.array(doc["constraints"], "constraints");
+    for (std::size_t k = 0; k < list.size(); ++k)
+      p.constraints.push_back(parseConstraint(in, list[k], childPath("constraints", k)));
+  }
+  if (doc.contains("friction")) p.friction = parseFriction(in, doc["friction"], "friction");
+  if (p.breakaway && !p.friction.present)
+    in.fail("breakaway", "has no effect without a \"friction\" section (add \"friction\": {} to solve with friction)");
+  return p;
+}
+
+BoundProblem bindProblem(const Problem& p) {
+  const JsonReader in(p.file);
+  UrdfOptions urdf;
+  urdf.root = p.root;
+  urdf.tip = p.tip;
+  Model model;
+  try {
+    model = loadUrdfFile(p.model_path, urdf);
+  } catch (const ModelError& e) {
+    in.fail("model", e.what());
+  }
+  const int n = model.dof();
+  const std::string per_joint = "one per moving joint: " + jointList(model);
+  auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key) {
+    if (v && v->size() != n)
+      in.fail(key, "has " + std::to_string(v->size()) + (v->size() == 1 ? " entry" : " entries") + ", expected " +
+                       std::to_string(n) + " (" + per_joint + ")");
+  };
+  checkLength(p.q, "q");
+  checkLength(p.qd, "qd");
+  checkLength(p.tau, "tau");
+  checkLength(p.rotor_inertia, "rotor_inertia");
+  checkLength(p.breakaway, "breakaway");
+
+  if (p.rotor_inertia) {
+    ModelBuilder builder(model);
+    for (int j = 0; j < n; ++j) {
+      try {
+        builder.setRotorInertia(model.joint(j).name, (*p.rotor_inertia)[j]);
+      } catch (const ModelError& e) {
+        in.fail(childPath("rotor_inertia", static_cast<std::size_t>(j)), e.what());
+      }
+    }
+    try {
+      model = builder.build();
+    } catch (const ModelError& e) {
+      in.fail("rotor_inertia", e.what());
+    }
+  }
+
+  BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, {}, {}};
+  const Model& m = b.model;
+  b.q = p.q ? *p.q : Eigen::VectorXd::Zero(n);
+  b.qd = p.qd ? *p.qd : Eigen::VectorXd::Zero(n);
+  b.tau = p.tau ? *p.tau : Eigen::VectorXd::Zero(n);
+  b.task = std::make_unique<Task>(m);
+  Task& task = *b.task;
+  if (p.gravity) task.gravity = *p.gravity;
+
+  auto frameIndex = [&](const std::string& name, const std::string& path) {
+    if (!m.hasFrame(name))
+      in.fail(childPath(path, "frame"), "unknown frame \"" + printable(name, 60) + "\" (the chain's frames: " + frameList(m) + ")");
+    const int f = m.frameIndex(name);
+    bool seen = false;
+    for (const int g : b.reported_frames) seen = seen || g == f;
+    if (!seen) b.reported_frames.push_back(f);
+    return f;
+  };
+  try {
+    for (const ConstraintSpec& c : p.constraints) {
+      const int f = frameIndex(c.frame, c.path);
+      const int first = task.addConstraint(f, c.A, c.expressed);
+      task.targets().segment(first, c.acceleration.size()) = c.acceleration;
+    }
+    for (const WrenchSpec& w : p.wrenches) {
+      const int f = frameIndex(w.frame, w.path);
+      task.wrench(task.addWrench(f, w.expressed)) = w.value;
+    }
+  } catch (const ModelError& e) {
+    in.fail("constraints", e.what());
+  }
+
+  b.with_friction = p.friction.present && p.friction.enabled;
+  b.friction_options = p.friction.options;
+  if (p.breakaway) b.friction_options.breakaway = *p.breakaway;
+  return b;
+}
+
+}  // namespace zwang::cli

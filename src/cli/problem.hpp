@@ -1,0 +1,64 @@
+// The JSON problem of `zwang solve` (docs/cli.md, "Problem"): reading and
+// checking it, then binding it to the loaded model as a Task.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "zwang/zwang.hpp"
+
+namespace zwang::cli {
+
+struct WrenchSpec {
+  std::string path;  // "wrenches[k]", for messages
+  std::string frame;
+  Expressed expressed = Expressed::Local;
+  Vec6 value = Vec6::Zero();  // [force; torque]
+};
+
+struct ConstraintSpec {
+  std::string path;  // "constraints[k]"
+  std::string frame;
+  Expressed expressed = Expressed::Local;
+  ConstraintMatrix A;            // 6 × directions
+  Eigen::VectorXd acceleration;  // one per direction (default 0)
+};
+
+struct FrictionSpec {
+  bool present = false;  // the problem has a "friction" section
+  bool enabled = true;
+  FrictionOptions options;
+};
+
+// The problem as written, checked for everything that does not need the model.
+struct Problem {
+  std::string file;        // the problem file, as given on the command line
+  std::string model_path;  // resolved against the problem file's directory
+  std::string root, tip;
+  std::optional<Vec3> gravity;
+  std::optional<Eigen::VectorXd> q, qd, tau, rotor_inertia, breakaway;
+  std::vector<WrenchSpec> wrenches;
+  std::vector<ConstraintSpec> constraints;
+  FrictionSpec friction;
+};
+
+// Read, parse and check a problem file; CliError "FILE: PATH: what" on any fault.
+Problem readProblem(const std::string& file);
+
+// The problem bound to its model: every length and frame checked.
+struct BoundProblem {
+  Model model;
+  std::unique_ptr<Task> task;
+  Eigen::VectorXd q, qd, tau;
+  bool with_friction = false;  // run solveWithFriction (else solveHybridDynamics)
+  FrictionOptions friction_options;
+  std::vector<int> reported_frames;  // constrained or loaded frames, first appearance order
+};
+
+// Load the model (rotor_inertia applied), check lengths and frames, build the
+// Task. CliError "FILE: PATH: what" on any fault.
+BoundProblem bindProblem(const Problem& problem);
+
+}  // namespace zwang::cli

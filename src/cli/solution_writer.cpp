@@ -1,0 +1,86 @@
+// Writing the solution of `zwang solve` as JSON.
+#include "solution_writer.hpp"
+
+namespace zwang::cli {
+
+namespace {
+
+Json array(const Eigen::Ref<const Eigen::VectorXd>& v) {
+  Json out = Json::array();
+  for (Eigen::Index k = 0; k < v.size(); ++k) out.push_back(v[k]);
+  return out;
+}
+
+void pretty(const Json& value, int indent, std::string& out) {
+  const std::string pad(static_cast<std::size_t>(indent), ' ');
+  if (value.is_object() && !value.empty()) {
+    out += "{\n";
+    std::size_t k = 0;
+    for (const auto& item : value.items()) {
+      out += pad + "  " + Json(item.key()).dump() + ": ";
+      pretty(item.value(), indent + 2, out);
+      out += ++k < value.size() ? ",\n" : "\n";
+    }
+    out += pad + "}";
+  } else if (value.is_array() && !value.empty()) {
+    bool flat = true;
+    for (const Json& element : value) flat = flat && !element.is_structured();
+    if (flat) {
+      out += "[";
+      for (std::size_t k = 0; k < value.size(); ++k) out += (k ? ", " : "") + value[k].dump();
+      out += "]";
+    } else {
+      out += "[\n";
+      for (std::size_t k = 0; k < value.size(); ++k) {
+        out += pad + "  ";
+        pretty(value[k], indent + 2, out);
+        out += k + 1 < value.size() ? ",\n" : "\n";
+      }
+      out += pad + "]";
+    }
+  } else {
+    out += value.dump();
+  }
+}
+
+}  // namespace
+
+std::string prettyDump(const Json& value) {
+  std::string out;
+  pretty(value, 0, out);
+  return out;
+}
+
+Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, const Status& status,
+                  const std::vector<int>& frames) {
+  const Solution& s = ws.solution;
+  Json out = Json::object();
+  Json joints = Json::array();
+  for (const Joint& joint : model.joints()) joints.push_back(joint.name);
+  out["joints"] = std::move(joints);
+  out["qdd"] = array(s.qdd);
+  out["tau_constraint"] = array(s.tau_constraint);
+  out["tau_control"] = array(s.tau_control);
+  out["nu"] = array(s.nu);
+  out["gauss"] = s.gauss;
+  if (with_friction) {
+    const FrictionResult& f = ws.friction;
+    Json states = Json::array();
+    for (const JointState state : f.state) states.push_back(toString(state));
+    out["friction"] = {{"mu", array(f.mu)},
+                       {"state", std::move(states)},
+                       {"indeterminate", f.indeterminate},
+                       {"iterations", f.iterations},
+                       {"kkt_residual", f.kkt_residual}};
+  }
+  out["status"] = {{"singular", s.coupling.singular},
+                   {"rank", s.coupling.rank},
+                   {"infeasible", status.code == StatusCode::Infeasible}};
+  Json frame_map = Json::object();
+  for (const int f : frames)
+    frame_map[model.frame(f).name] = {{"acceleration_world", array(frameAcceleration(model, ws, f, Expressed::World))}};
+  out["frames"] = std::move(frame_map);
+  return out;
+}
+
+}  // namespace zwang::cli

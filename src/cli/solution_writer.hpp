@@ -1,0 +1,21 @@
+// The solution JSON of `zwang solve` (docs/cli.md, "Solution").
+#pragma once
+
+#include <vector>
+
+#include "json_reader.hpp"
+#include "zwang/zwang.hpp"
+
+namespace zwang::cli {
+
+// Keys, in this order: joints, qdd, tau_constraint, tau_control, nu, gauss,
+// friction (only when `with_friction`), status, frames. Numbers are written
+// by nlohmann::json in their shortest form that reads back exactly.
+Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, const Status& status,
+                  const std::vector<int>& frames);
+
+// Indented JSON for humans (--pretty): objects one key per line, arrays of
+// numbers, strings or booleans on one line.
+std::string prettyDump(const Json& value);
+
+}  // namespace zwang::cli

@@ -1,0 +1,39 @@
+// `zwang solve PROBLEM.json [-o FILE] [--pretty]`.
+#include <cstdio>
+
+#include "cli.hpp"
+#include "problem.hpp"
+#include "solution_writer.hpp"
+
+namespace zwang::cli {
+
+int commandSolve(int argc, char** argv) {
+  const Arguments args = parseArguments("solve", argc, argv, 2, {"--pretty"}, {"-o", "--output"});
+  if (args.help) {
+    std::fputs(usageText("solve"), stdout);
+    return kExitOk;
+  }
+  if (args.positional.size() != 1)
+    throw UsageError("solve", args.positional.empty() ? "no problem file given" : "more than one problem file given");
+  const std::string output = args.has("--output") ? args.value("--output") : args.value("-o");
+
+  const Problem problem = readProblem(args.positional[0]);
+  BoundProblem bound = bindProblem(problem);
+  Workspace ws(bound.model, *bound.task);
+  const Status status =
+      bound.with_friction
+          ? solveWithFriction(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws, bound.friction_options)
+          : solveHybridDynamics(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws);
+  const bool infeasible = status.code == StatusCode::Infeasible;
+  if (!status && !infeasible) throw CliError(kExitError, problem.file + ": solve: " + status.message);
+
+  const Json solution = solutionJson(bound.model, ws, bound.with_friction, status, bound.reported_frames);
+  writeOutput(output, (args.has("--pretty") ? prettyDump(solution) : solution.dump()) + "\n");
+  if (infeasible) {
+    std::fprintf(stderr, "zwang: %s: infeasible: %s\n", problem.file.c_str(), status.message);
+    return kExitInfeasible;
+  }
+  return kExitOk;
+}
+
+}  // namespace zwang::cli

@@ -1,0 +1,145 @@
+// Independent references for static friction (SPEC §2–§3), built only on the
+// dense KKT reference (dense_reference.hpp) — no code of zwang's solver.
+//
+// Notation (SPEC §2): Θ₀ = the stuck joints (k of them), W the k×n selector of
+// their rows, f_j the breakaway torques. A stuck joint feels the torque −μ_j
+// (τ_eff = τ − Wᵀμ, μ_j > 0 opposes positive motion); a moving joint the
+// kinetic torque −f_c,j sign(q̇_j) − b_j q̇_j, added to τ as a feed-forward.
+//   g(μ) = min_q̈ Z(q̈) + μᵀ W q̈  (over the task's constraints G q̈ = γ),
+// Z the dense Gauss function with τ + τ_kinetic; μ* = argmax over the box.
+//
+// 1. bruteForceFriction enumerates every stick / slip+ / slip− pattern of the
+//    stuck joints and solves each pattern's augmented KKT system:
+//      [H  −Gᵀ −E_Sᵀ] [q̈ ]   [τ + τ_kin − Σ_{slip±} (±f_j) e_j − C]
+//      [G   0    0  ] [ν ] = [γ                                   ]
+//      [E_S 0    0  ] [λ ]   [0                                   ]
+//    (E_S: rows e_jᵀ of the sticking joints). The stick multiplier λ_j is the
+//    torque the joint's reaction adds, so μ_j = −λ_j. A pattern is kept when it
+//    satisfies maximum dissipation: stick ⇒ |μ_j| ≤ f_j, slip+ ⇒ q̈_j ≥ 0,
+//    slip− ⇒ q̈_j ≤ 0 (each a KKT point of the concave maximisation, hence a
+//    maximiser).
+//    Singular patterns: when [G; E_S] is rank deficient (a stick row the task
+//    already implies, e.g. a fully constrained arm) the pattern is SKIPPED.
+//    This loses nothing: the maximisers form a polytope (μ* + null K_ΘΘ) ∩ box
+//    and null K_ΘΘ = {d : Wᵀd ∈ range Gᵀ}; at a vertex of that polytope no
+//    direction supported on the strictly interior (sticking) joints stays in it,
+//    i.e. the interior joints' rows are independent of G. Classifying the
+//    vertex's bound joints as slip gives a regular, valid pattern. So a valid
+//    regular pattern always exists (the task's G itself must have full row rank;
+//    tests skip draws where it has not). Rank test: the eigenvalues of the
+//    augmented coupling matrix [G; E_S] H⁻¹ [G; E_S]ᵀ, singular below
+//    `singular_threshold`·λ_max.
+//    Joint limits (SPEC §3): a stuck joint resting on its lower limit has
+//    μ_j ∈ (−∞, f_j]: patterns stick (q̈_j = 0, μ_j ≤ f_j, no lower bound — a
+//    μ_j below −f_j is the limit pushing back, "at limit") and slip+ (μ_j = f_j,
+//    q̈_j ≥ 0); slip− (into the limit) does not exist. The upper limit mirrors
+//    it. No valid pattern at all ⇒ `feasible = false` (the task drives a joint
+//    into its limit: g is unbounded).
+// 2. sampledFriction is the report's own method (chapter 5, "Implementation"):
+//    g(μ) evaluated by a full dense forward-dynamics solve on a regular grid
+//    over the box, k = 1 or 2; returns the grid maximiser.
+#pragma once
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "support/chain_spec.hpp"
+#include "support/dense_reference.hpp"
+
+namespace zwang::testing {
+
+// The friction part of a problem, per dof (length spec.dof()).
+struct FrictionSetup {
+  std::vector<int> stuck;      // Θ₀, dof indices, ascending
+  Eigen::VectorXd breakaway;   // f_j ≥ 0
+  Eigen::VectorXd kinetic;     // f_c,j ≥ 0 (moving joints)
+  Eigen::VectorXd damping;     // b_j ≥ 0 (moving joints)
+  // −1: stuck on its lower limit, +1: on its upper limit, 0: free. Empty = all free.
+  Eigen::VectorXi limit_side;
+};
+
+// Friction data as the model would read it from the spec's URDF: breakaway =
+// kinetic = <dynamics friction>, damping = <dynamics damping>; Θ₀ = joints
+// with |q̇_j| ≤ velocity_tolerance; no limits.
+FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd& qd,
+                                    double velocity_tolerance = 1e-6);
+
+// −f_c,j sign(q̇_j) − b_j q̇_j on the moving joints, 0 on the stuck ones.
+Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd& qd);
+
+struct BruteForceOptions {
+  double torque_tolerance = 1e-9;        // slack on |μ_j| ≤ f_j, × max(1, max f, max |μ|)
+  double acceleration_tolerance = 1e-10; // slack on the slip signs, × max(1, max |q̈|)
+  double singular_threshold = 1e-10;     // λ_min/λ_max of the augmented coupling matrix
+};
+
+struct FrictionReference {
+  bool feasible = false;      // some pattern is valid
+  Eigen::VectorXd qdd;        // q̈*
+  Eigen::VectorXd mu;         // a valid μ* (per dof, 0 off Θ₀)
+  Eigen::VectorXd nu;         // the task's multipliers for that pattern
+  Eigen::VectorXd tau_kinetic;
+  double gauss_dual = 0.0;    // g(μ*) = Z(q̈*) + μ*ᵀ W q̈*
+  std::string pattern;        // one char per stuck joint: 's' stick, '+' slip+, '-' slip−, 'L' stick beyond f at a limit
+  int patterns = 0;           // enumerated
+  int valid_patterns = 0;
+  int singular_patterns = 0;  // skipped as rank deficient
+  // Spread among the valid patterns (uniqueness checks): q̈ and g must agree;
+  // μ differs only when μ* is not unique (statically indeterminate).
+  double qdd_spread = 0.0;    // max relativeError between valid patterns' q̈
+  double gauss_spread = 0.0;  // max |Δg| / max(1, |g|)
+  double mu_spread = 0.0;     // max |Δμ|
+};
+
+FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
+                                     const BruteForceOptions& options = {});
+
+// q̈(μ) and g(μ) for a given μ (per dof; entries off Θ₀ ignored) by one full
+// dense solve with τ + τ_kinetic − Wᵀμ.
+struct FrictionDual {
+  Eigen::VectorXd qdd;
+  double g = 0.0;
+};
+FrictionDual denseFrictionDual(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
+                               const Eigen::VectorXd& mu);
+
+// K = ∂q̈/∂τ of the constrained dynamics (n×n, symmetric PSD), from the dense
+// KKT with unit right-hand sides; q̈(μ) = q̈(0) − K Wᵀ μ.
+Eigen::MatrixXd denseConstrainedInverseInertia(const ChainSpec& spec, const DynamicsInput& input);
+
+struct SampledFriction {
+  Eigen::VectorXd mu;       // grid maximiser, per dof (0 off Θ₀)
+  Eigen::VectorXd qdd;      // q̈ at it
+  double g = 0.0;           // g there
+  Eigen::VectorXd spacing;  // grid spacing per stuck joint (k)
+  int evaluations = 0;
+};
+// `points` samples per axis (k = 1 or 2; throws otherwise), endpoints included.
+// Each sample is one forward-dynamics solve of the dense KKT system (factorised
+// once: only the right-hand side changes with μ) and g = Z(q̈) + μᵀWq̈.
+SampledFriction sampledFriction(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
+                                int points);
+
+// A random friction problem: a chain with min_dof..max_dof moving joints
+// (randomChain), a problem with 0..min(max_rows, dof) constraint rows (randomProblem),
+// q strictly inside the position limits (at least 5 % of the range away),
+// 1..max_stuck stuck joints with q̇_j = 0 exactly and every other joint moving
+// with 0.1 ≤ |q̇_j| ≤ 2. Friction from the spec (breakaway 0–5, kinetic =
+// breakaway, damping 0–1).
+struct FrictionDraw {
+  ChainSpec spec;
+  DynamicsInput input;
+  FrictionSetup setup;
+};
+FrictionDraw randomFrictionDraw(std::mt19937_64& rng, int min_dof = 2, int max_dof = 7, int min_stuck = 1,
+                                int max_stuck = 5, int max_rows = 6);
+
+// The task itself is well posed (as test_dense filters): H and the coupling
+// matrix conditioned below max_condition and every constraint row independent
+// and reachable (smallest singular value of G ≥ 1e-6).
+bool wellPosed(const DenseResult& dense, int rows, double max_condition = 1e6);
+
+}  // namespace zwang::testing

@@ -1,0 +1,637 @@
+// Tests of the `zwang` command-line tool (docs/cli.md): they run the built
+// binary and check exit codes, stderr and the JSON/CSV it writes. Numbers are
+// compared numerically, never as strings.
+//
+// Tags (one ctest test each): [golden] [errors] [robustness] [usage] [info] [scenarios]
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "cli_runner.hpp"
+#include "zwang/zwang.hpp"
+
+using cli_test::Run;
+using cli_test::run;
+using Json = nlohmann::ordered_json;  // keeps the key order of the output
+
+namespace {
+
+const std::string kProblems = ZWANG_CLI_PROBLEMS;
+std::string problem(const std::string& name) { return kProblems + "/" + name; }
+
+Json parse(const std::string& text) {
+  INFO(text);
+  REQUIRE(Json::accept(text));
+  return Json::parse(text);
+}
+
+// Solve a problem file that must succeed; the parsed solution.
+Json solve(const std::string& file, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args{"solve", file};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const Run r = run(args);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  return parse(r.out);
+}
+
+std::vector<double> numbers(const Json& j) { return j.get<std::vector<double>>(); }
+
+// One line on stderr, "zwang: ..." and nothing on stdout.
+void checkOneLineError(const Run& r, int exit_code) {
+  INFO("stdout: " << r.out << "\nstderr: " << r.err);
+  CHECK_FALSE(r.signaled);
+  CHECK(r.exit_code == exit_code);
+  CHECK(r.out.empty());
+  REQUIRE(r.err.size() > 7);
+  CHECK(r.err.rfind("zwang: ", 0) == 0);
+  CHECK(r.err.back() == '\n');
+  CHECK(r.err.find('\n') == r.err.size() - 1);
+  CHECK(r.err.size() < 700);
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Golden tests: the SPEC's reference cases through the tool.
+
+TEST_CASE("1-DOF arm, tip force -5 N: stick, mu* = -5, qdd = 0, tau_control = 0", "[golden]") {
+  const Json s = solve(problem("arm_stick.json"));
+  CHECK(s["joints"] == Json::array({"joint1"}));
+  CHECK(s["friction"]["mu"][0].get<double>() == Approx(-5.0).margin(1e-9));
+  CHECK(s["qdd"][0].get<double>() == Approx(0.0).margin(1e-12));
+  CHECK(s["tau_control"][0].get<double>() == Approx(0.0).margin(1e-12));
+  CHECK(s["tau_constraint"][0].get<double>() == Approx(0.0).margin(1e-12));
+  CHECK(s["friction"]["state"][0] == "stick");
+  CHECK(s["friction"]["indeterminate"] == false);
+  CHECK(s["nu"].empty());
+  CHECK(s["status"]["infeasible"] == false);
+  CHECK(s["status"]["singular"] == false);
+  CHECK(s["status"]["rank"] == 0);
+  // the loaded frame is reported; its acceleration is zero
+  for (const double a : numbers(s["frames"]["tip"]["acceleration_world"])) CHECK(a == Approx(0.0).margin(1e-12));
+  // g(mu*) = Z0 + mu* qdd* = 0 for a resting arm
+  CHECK(s["gauss"].get<double>() == Approx(0.0).margin(1e-12));
+}
+
+TEST_CASE("1-DOF arm, tip force -11 N: slip, mu* = -10, qdd = -1/2.25", "[golden]") {
+  const Json s = solve(problem("arm_slip.json"));
+  const double qdd = -1.0 / 2.25;
+  CHECK(s["friction"]["mu"][0].get<double>() == Approx(-10.0).margin(1e-12));
+  CHECK(s["qdd"][0].get<double>() == Approx(qdd).margin(1e-12));
+  CHECK(s["tau_control"][0].get<double>() == Approx(0.0).margin(1e-12));
+  CHECK(s["friction"]["state"][0] == "slip-");
+  CHECK(s["friction"]["kkt_residual"].get<double>() <= 1e-12);
+  // the tip, 1 m out along x, accelerates along y with qdd; the angular part is qdd about z
+  const std::vector<double> a = numbers(s["frames"]["tip"]["acceleration_world"]);
+  REQUIRE(a.size() == 6);
+  const double expected[6] = {0, qdd, 0, 0, 0, qdd};
+  for (int k = 0; k < 6; ++k) CHECK(a[static_cast<std::size_t>(k)] == Approx(expected[k]).margin(1e-12));
+  // gauss is Z0(qdd*) = 1/2 I qdd² - tau_ext qdd with tau_ext = -11 N·m
+  CHECK(s["gauss"].get<double>() == Approx(0.5 * 2.25 * qdd * qdd + 11.0 * qdd).margin(1e-12));
+}
+
+TEST_CASE("Fig. 5.5: fully constrained, mu* = +10, tau_control = 2.25*5 + 10", "[golden]") {
+  const Json s = solve(problem("arm_fig55.json"));
+  CHECK(s["friction"]["mu"][0].get<double>() == Approx(10.0).margin(1e-12));
+  CHECK(s["qdd"][0].get<double>() == Approx(5.0).margin(1e-12));
+  CHECK(s["tau_control"][0].get<double>() == Approx(2.25 * 5 + 10).margin(1e-12));
+  CHECK(s["tau_constraint"][0].get<double>() == Approx(2.25 * 5 + 10).margin(1e-12));
+  REQUIRE(s["nu"].size() == 1);
+  CHECK(s["nu"][0].get<double>() == Approx(2.25 * 5 + 10).margin(1e-12));  // a torque about z on link1
+  CHECK(s["friction"]["state"][0] == "slip+");
+  CHECK(s["status"]["rank"] == 1);
+  CHECK(s["frames"]["link1"]["acceleration_world"][5].get<double>() == Approx(5.0).margin(1e-12));
+}
+
+TEST_CASE("Panda holds its tool still: the tool does not move; the tool and the library agree", "[golden]") {
+  const Json s = solve(problem("panda_hold.json"));
+  CHECK(s["joints"].size() == 7);
+  CHECK(s["status"]["rank"] == 6);
+  CHECK(s["status"]["singular"] == false);
+  for (const double a : numbers(s["frames"]["tool0"]["acceleration_world"])) CHECK(a == Approx(0.0).margin(1e-9));
+
+  // The same problem through the C++ API.
+  const zwang::Model model = zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  zwang::Task task(model);
+  task.addConstraint("tool0", zwang::ConstraintMatrix::Identity(6, 6), zwang::Expressed::World);
+  zwang::Workspace ws(model, task);
+  Eigen::VectorXd q(7);
+  q << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  REQUIRE(zwang::solveWithFriction(model, task, q, zero, zero, ws).ok());
+  auto same = [](const Json& j, const Eigen::VectorXd& v) {
+    REQUIRE(j.size() == static_cast<std::size_t>(v.size()));
+    for (Eigen::Index k = 0; k < v.size(); ++k) CHECK(j[static_cast<std::size_t>(k)].get<double>() == Approx(v[k]).margin(1e-12));
+  };
+  same(s["qdd"], ws.solution.qdd);
+  same(s["tau_constraint"], ws.solution.tau_constraint);
+  same(s["tau_control"], ws.solution.tau_control);
+  same(s["nu"], ws.solution.nu);
+  same(s["friction"]["mu"], ws.friction.mu);
+  CHECK(s["gauss"].get<double>() == Approx(ws.solution.gauss).margin(1e-12));
+  for (int j = 0; j < 7; ++j)
+    CHECK(s["friction"]["state"][static_cast<std::size_t>(j)] == zwang::toString(ws.friction.state[static_cast<std::size_t>(j)]));
+  CHECK(s["friction"]["indeterminate"] == ws.friction.indeterminate);
+  // friction within its bounds
+  for (int j = 0; j < 7; ++j)
+    CHECK(std::abs(s["friction"]["mu"][static_cast<std::size_t>(j)].get<double>()) <= model.joint(j).breakaway_friction + 1e-12);
+}
+
+TEST_CASE("No friction section: the plain solver, no friction key", "[golden]") {
+  const Json s = solve(problem("arm_plain.json"));
+  CHECK_FALSE(s.contains("friction"));
+  CHECK(s["qdd"][0].get<double>() == Approx(-11.0 / 2.25).margin(1e-12));
+  // the keys, in the documented order
+  std::vector<std::string> keys;
+  for (const auto& item : s.items()) keys.push_back(item.key());
+  CHECK(keys == std::vector<std::string>{"joints", "qdd", "tau_constraint", "tau_control", "nu", "gauss", "status", "frames"});
+  // friction disabled explicitly: the same
+  const Json d = solve(problem("arm_friction_disabled.json"));
+  CHECK_FALSE(d.contains("friction"));
+  CHECK(d["qdd"][0].get<double>() == Approx(-11.0 / 2.25).margin(1e-12));
+}
+
+TEST_CASE("Overrides: rotor_inertia and breakaway replace the model's values", "[golden]") {
+  // I = 2.25 + 0.75 = 3, f = 2: the -5 N·m load slips, qdd = (-5 + 2) / 3 = -1
+  const Json s = solve(problem("arm_overrides.json"));
+  CHECK(s["friction"]["mu"][0].get<double>() == Approx(-2.0).margin(1e-12));
+  CHECK(s["qdd"][0].get<double>() == Approx(-1.0).margin(1e-12));
+  CHECK(s["friction"]["state"][0] == "slip-");
+}
+
+TEST_CASE("Feed-forward torque, velocities, gravity, local wrench, world constraint", "[golden]") {
+  // A problem using every key; compared with the C++ API on the same inputs.
+  const Json s = solve(problem("panda_everything.json"));
+  const Json p = parse(cli_test::readText(problem("panda_everything.json")));
+  const zwang::Model model = zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  zwang::Task task(model);
+  task.gravity = Eigen::Vector3d(numbers(p["gravity"]).data());
+  const Json& c = p["constraints"][0];
+  zwang::ConstraintMatrix A(6, static_cast<Eigen::Index>(c["directions"].size()));
+  for (std::size_t k = 0; k < c["directions"].size(); ++k)
+    A.col(static_cast<Eigen::Index>(k)) = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(numbers(c["directions"][k]).data());
+  const int row = task.addConstraint(c["frame"].get<std::string>(), A, zwang::Expressed::World);
+  const std::vector<double> acc = numbers(c["acceleration"]);
+  for (std::size_t k = 0; k < acc.size(); ++k) task.targets()[row + static_cast<int>(k)] = acc[k];
+  const Json& w = p["wrenches"][0];
+  const int wi = task.addWrench(w["frame"].get<std::string>(), zwang::Expressed::Local);
+  const std::vector<double> force = numbers(w["force"]), torque = numbers(w["torque"]);
+  task.wrench(wi) << force[0], force[1], force[2], torque[0], torque[1], torque[2];
+  zwang::ModelBuilder builder(model);
+  const std::vector<double> rotor = numbers(p["rotor_inertia"]);
+  for (int j = 0; j < 7; ++j) builder.setRotorInertia(model.joint(j).name, rotor[static_cast<std::size_t>(j)]);
+  const zwang::Model m2 = builder.build();
+  zwang::Task task2(m2);
+  task2.gravity = task.gravity;
+  task2.addConstraint(c["frame"].get<std::string>(), A, zwang::Expressed::World);
+  task2.targets() = task.targets();
+  task2.wrench(task2.addWrench(w["frame"].get<std::string>(), zwang::Expressed::Local)) = task.wrench(wi);
+  zwang::Workspace ws(m2, task2);
+  const std::vector<double> q = numbers(p["q"]), qd = numbers(p["qd"]), tau = numbers(p["tau"]);
+  zwang::FrictionOptions options;
+  options.velocity_tolerance = p["friction"]["velocity_tolerance"].get<double>();
+  options.margin = p["friction"]["margin"].get<double>();
+  options.joint_limits = p["friction"]["limits"].get<bool>();
+  options.breakaway = Eigen::Map<const Eigen::VectorXd>(numbers(p["breakaway"]).data(), 7);
+  REQUIRE(zwang::solveWithFriction(m2, task2, Eigen::Map<const Eigen::VectorXd>(q.data(), 7),
+                                   Eigen::Map<const Eigen::VectorXd>(qd.data(), 7),
+                                   Eigen::Map<const Eigen::VectorXd>(tau.data(), 7), ws, options)
+              .ok());
+  for (int j = 0; j < 7; ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    CHECK(s["qdd"][k].get<double>() == Approx(ws.solution.qdd[j]).margin(1e-12));
+    CHECK(s["tau_control"][k].get<double>() == Approx(ws.solution.tau_control[j]).margin(1e-12));
+    CHECK(s["friction"]["mu"][k].get<double>() == Approx(ws.friction.mu[j]).margin(1e-12));
+    CHECK(s["friction"]["state"][k] == zwang::toString(ws.friction.state[k]));
+  }
+  // moving joints are reported as such (qd above the tolerance)
+  CHECK(s["friction"]["state"][0] == "moving");
+  // frames: the constrained one first, then the loaded one
+  std::vector<std::string> frames;
+  for (const auto& item : s["frames"].items()) frames.push_back(item.key());
+  CHECK(frames == std::vector<std::string>{"tool0", "panda_link5"});
+  const zwang::Vec6 a = zwang::frameAcceleration(m2, ws, m2.frameIndex("panda_link5"), zwang::Expressed::World);
+  for (int k = 0; k < 6; ++k)
+    CHECK(s["frames"]["panda_link5"]["acceleration_world"][static_cast<std::size_t>(k)].get<double>() == Approx(a[k]).margin(1e-12));
+}
+
+TEST_CASE("--pretty and -o give the same numbers", "[golden]") {
+  const Json compact = solve(problem("panda_hold.json"));
+  const Json pretty = solve(problem("panda_hold.json"), {"--pretty"});
+  CHECK(compact == pretty);
+  const std::string out = cli_test::scratchDir() + "/solution.json";
+  const Run r = run({"solve", problem("panda_hold.json"), "-o", out});
+  CHECK(r.exit_code == 0);
+  CHECK(r.out.empty());
+  CHECK(parse(cli_test::readText(out)) == compact);
+}
+
+TEST_CASE("An infeasible task: the solution with status.infeasible, exit code 3", "[golden]") {
+  const Run r = run({"solve", problem("arm_infeasible.json")});
+  CHECK(r.exit_code == 3);
+  const Json s = parse(r.out);
+  CHECK(s["status"]["infeasible"] == true);
+  CHECK(contains(r.err, "arm_infeasible.json"));
+  CHECK(contains(r.err, "infeasible"));
+  CHECK(contains(r.err, "joint1"));
+  CHECK(contains(r.err, "upper limit"));
+}
+
+// ---------------------------------------------------------------------------
+// Every error path: exit code and a one-line message naming file, path and what.
+
+TEST_CASE("Errors in the problem file", "[errors]") {
+  struct Case {
+    const char* file;
+    std::vector<std::string> parts;  // what the message must contain (besides the file name)
+  };
+  const std::vector<Case> cases = {
+      {"err_malformed.json", {"line 3, column 1", "syntax error"}},
+      {"err_not_object.json", {"must be a JSON object", "array"}},
+      {"err_unknown_key.json", {": gravtiy: unknown key", "gravity"}},
+      {"err_unknown_key_nested.json", {": constraints[1].acceleraton: unknown key", "acceleration"}},
+      {"err_wrong_type.json", {": constraints[0].directions[0][5]: expected a number", "string"}},
+      {"err_wrong_type_q.json", {": q: expected an array", "a number"}},
+      {"err_wrong_type_enabled.json", {": friction.enabled: expected true or false", "string"}},
+      {"err_direction_length.json", {": constraints[1].directions[2]: has 5 entries, expected 6"}},
+      {"err_acceleration_length.json", {": constraints[0].acceleration: has 2 entries, expected 1", "one per direction"}},
+      {"err_q_length.json", {": q: has 2 entries, expected 1", "joint1"}},
+      {"err_nonfinite.json", {": wrenches[0].force[1]: ", "1e400", "out of range"}},
+      {"err_huge.json", {": gravity[2]: ", "-1e+300", "too large"}},
+      {"err_unknown_frame.json", {": wrenches[1].frame: unknown frame \"hand\"", "base, link1, tip"}},
+      {"err_expressed_in.json", {": constraints[0].expressed_in: unknown value \"global\"", "aligned"}},
+      {"err_wrench_aligned.json", {": wrenches[0].expressed_in: unknown value \"aligned\"", "\"local\" or \"world\""}},
+      {"err_missing_model.json", {": model: ", "no_such_robot.urdf", "cannot open"}},
+      {"err_no_model.json", {": model: missing"}},
+      {"err_duplicate_key.json", {": q: duplicate key"}},
+      {"err_breakaway_without_friction.json", {": breakaway: has no effect", "friction"}},
+      {"err_margin.json", {": friction.margin: must be between 0 and 1"}},
+      {"err_negative_rotor.json", {": rotor_inertia[0]: is -1, must be >= 0"}},
+      {"err_missing_frame_key.json", {": constraints[0]: missing key \"frame\""}},
+      {"err_no_directions.json", {": constraints[0].directions: needs at least one direction"}},
+      {"err_bad_tip.json", {": model: ", "nowhere"}},
+  };
+  for (const Case& c : cases) {
+    SECTION(c.file) {
+      const Run r = run({"solve", problem(c.file)});
+      checkOneLineError(r, 1);
+      CHECK(contains(r.err, "zwang: " + problem(c.file) + ": "));
+      for (const std::string& part : c.parts) {
+        INFO("stderr: " << r.err << "expected part: " << part);
+        CHECK(contains(r.err, part));
+      }
+    }
+  }
+}
+
+TEST_CASE("Errors outside the problem's content", "[errors]") {
+  SECTION("a missing problem file") {
+    const Run r = run({"solve", cli_test::scratchDir() + "/no_such_problem.json"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "no_such_problem.json: cannot read the file (No such file or directory)"));
+  }
+  SECTION("a directory") {
+    const Run r = run({"solve", kProblems});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "it is a directory"));
+  }
+  SECTION("an empty file") {
+    const std::string file = cli_test::scratchDir() + "/empty.json";
+    cli_test::writeText(file, "");
+    const Run r = run({"solve", file});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, file + ": line 1, column 1: syntax error while parsing value - unexpected end of input"));
+  }
+  SECTION("an output file that cannot be written") {
+    const Run r = run({"solve", problem("arm_slip.json"), "-o", cli_test::scratchDir() + "/no/such/dir/out.json"});
+    CHECK(r.exit_code == 1);
+    CHECK(contains(r.err, "out.json: cannot write the file"));
+  }
+  SECTION("info: a missing URDF") {
+    const Run r = run({"info", cli_test::scratchDir() + "/no_such_robot.urdf"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "no_such_robot.urdf: cannot open the file"));
+  }
+  SECTION("info: an unknown tip link") {
+    const Run r = run({"info", std::string(ZWANG_MODELS_DIR) + "/panda.urdf", "--tip", "nowhere"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "nowhere"));
+  }
+  SECTION("scenarios: no model") {
+    const Run r = run({"scenarios", "--models", cli_test::scratchDir() + "/nothing", "--out", cli_test::scratchDir() + "/sc-none"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "one_dof_arm.urdf"));
+    CHECK(contains(r.err, "--models"));
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Hostile input fails cleanly: exit 1, one line, no crash.
+
+TEST_CASE("2 MB of random bytes", "[robustness]") {
+  std::mt19937 rng(12345);
+  for (int trial = 0; trial < 3; ++trial) {
+    std::string bytes(2u << 20, '\0');
+    for (char& b : bytes) b = static_cast<char>(rng() & 0xFF);
+    if (trial == 1) bytes[0] = '{';  // starts like JSON
+    if (trial == 2) bytes[0] = '[';
+    const std::string file = cli_test::scratchDir() + "/random.json";
+    cli_test::writeText(file, bytes);
+    const Run r = run({"solve", file});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "random.json: "));
+  }
+}
+
+TEST_CASE("Deeply nested arrays and objects", "[robustness]") {
+  const std::size_t depth = 100000;
+  struct Case {
+    std::string text, part;
+  };
+  const std::vector<Case> cases = {
+      {std::string(depth, '[') + std::string(depth, ']'), "nested deeper than 64 levels"},
+      {"{\"model\": \"x.urdf\", \"q\": " + std::string(depth, '[') + std::string(depth, ']') + "}", "q[0][0][0]"},
+      {[&] {
+         std::string s;
+         for (std::size_t k = 0; k < depth; ++k) s += "{\"a\":";
+         return s + "1" + std::string(depth, '}');
+       }(),
+       "nested deeper than 64 levels"},
+      {std::string(depth, '['), "nested deeper than 64 levels"},  // unterminated
+  };
+  for (const Case& c : cases) {
+    const std::string file = cli_test::scratchDir() + "/deep.json";
+    cli_test::writeText(file, c.text);
+    const Run r = run({"solve", file});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, c.part));
+  }
+}
+
+TEST_CASE("Huge numbers", "[robustness]") {
+  const std::string arm = "\"" + std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf\"";
+  struct Case {
+    std::string text, part;
+  };
+  const std::vector<Case> cases = {
+      {"{\"model\": " + arm + ", \"q\": [1e400]}", "q[0]: line 1, column"},
+      {"{\"model\": " + arm + ", \"q\": [-1e400]}", "out of range"},
+      {"{\"model\": " + arm + ", \"tau\": [1e300]}", "tau[0]: the number 1e+300 is too large"},
+      {"{\"model\": " + arm + ", \"tau\": [1e13]}", "tau[0]: the number 1e+13 is too large"},
+      {"{\"model\": " + arm + ", \"q\": [123456789012345678901234567890]}", "q[0]: the number 1.2345678901234568e+29 is too large"},
+      {"{\"model\": " + arm + ", \"q\": [1" + std::string(5000, '0') + "]}", "out of range"},
+      {"{\"model\": " + arm + ", \"gravity\": [0, 0, 1e-400]}", ""},  // underflows to 0: fine
+      {"{\"model\": " + arm + ", \"q\": [" + [] {
+         std::string s = "0";
+         for (int k = 0; k < 300000; ++k) s += ",0";
+         return s;
+       }() + "]}",
+       "q: has 300001 entries, expected 1"},
+  };
+  for (const Case& c : cases) {
+    const std::string file = cli_test::scratchDir() + "/huge.json";
+    cli_test::writeText(file, c.text);
+    const Run r = run({"solve", file});
+    if (c.part.empty()) {
+      CHECK(r.exit_code == 0);
+      continue;
+    }
+    checkOneLineError(r, 1);
+    INFO(r.err);
+    CHECK(contains(r.err, c.part));
+  }
+}
+
+TEST_CASE("Mutated problem files never crash", "[robustness]") {
+  // Random byte edits of a valid problem: each run ends with 0, 1 or 3 and,
+  // unless 0, one line on stderr.
+  std::string text = cli_test::readText(problem("arm_fig55.json"));
+  const std::string model = "\"" + std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf\"";
+  text.replace(text.find("\"../../../models/one_dof_arm.urdf\""), 34, model);
+  const std::string alphabet = "{}[],:\"0123456789.eE+-tfnul \\x";
+  std::mt19937 rng(2024);
+  int failures = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    std::string mutated = text;
+    const int edits = 1 + static_cast<int>(rng() % 3);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at = rng() % mutated.size();
+      switch (rng() % 3) {
+        case 0: mutated[at] = alphabet[rng() % alphabet.size()]; break;
+        case 1: mutated.erase(at, 1); break;
+        default: mutated.insert(at, 1, alphabet[rng() % alphabet.size()]); break;
+      }
+    }
+    const std::string file = cli_test::scratchDir() + "/mutated.json";
+    cli_test::writeText(file, mutated);
+    const Run r = run({"solve", file});
+    INFO("problem: " << mutated << "\nstderr: " << r.err);
+    REQUIRE_FALSE(r.signaled);
+    REQUIRE((r.exit_code == 0 || r.exit_code == 1 || r.exit_code == 3));
+    if (r.exit_code == 1) {
+      ++failures;
+      CHECK(r.err.find('\n') == r.err.size() - 1);
+      CHECK(r.out.empty());
+    }
+  }
+  CHECK(failures > 20);  // most edits break something
+}
+
+// ---------------------------------------------------------------------------
+// Usage.
+
+TEST_CASE("Usage: help, unknown commands and options", "[usage]") {
+  SECTION("no command") {
+    const Run r = run({});
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.empty());
+    CHECK(contains(r.err, "usage: zwang <command>"));
+  }
+  SECTION("--help") {
+    const Run r = run({"--help"});
+    CHECK(r.exit_code == 0);
+    CHECK(contains(r.out, "usage: zwang <command>"));
+    CHECK(r.err.empty());
+  }
+  SECTION("--version") {
+    const Run r = run({"--version"});
+    CHECK(r.exit_code == 0);
+    CHECK(r.out.rfind("zwang ", 0) == 0);
+  }
+  SECTION("unknown command") {
+    const Run r = run({"frobnicate"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "zwang: unknown command 'frobnicate'"));
+    CHECK(contains(r.err, "usage: zwang <command>"));
+  }
+  for (const std::string command : {"solve", "info", "scenarios"}) {
+    SECTION(command + " --help") {
+      const Run r = run({command, "--help"});
+      CHECK(r.exit_code == 0);
+      CHECK(contains(r.out, "usage: zwang " + command));
+    }
+    SECTION(command + " with an unknown option") {
+      const Run r = run({command, "--frobnicate"});
+      CHECK(r.exit_code == 2);
+      CHECK(r.out.empty());
+      CHECK(contains(r.err, "zwang: " + command + ": unknown option '--frobnicate'"));
+      CHECK(contains(r.err, "usage: zwang " + command));
+    }
+  }
+  SECTION("solve without a file") {
+    const Run r = run({"solve"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "no problem file given"));
+  }
+  SECTION("solve with two files") {
+    const Run r = run({"solve", "a.json", "b.json"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "more than one problem file"));
+  }
+  SECTION("-o without a value") {
+    const Run r = run({"solve", problem("arm_slip.json"), "-o"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "option -o needs a value"));
+  }
+  SECTION("a flag given a value") {
+    const Run r = run({"solve", problem("arm_slip.json"), "--pretty=yes"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "option --pretty takes no value"));
+  }
+  SECTION("info without a file") {
+    const Run r = run({"info"});
+    CHECK(r.exit_code == 2);
+  }
+  SECTION("scenarios with an argument") {
+    const Run r = run({"scenarios", "extra"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "unexpected argument 'extra'"));
+  }
+}
+
+// ---------------------------------------------------------------------------
+// info.
+
+TEST_CASE("info: table and JSON", "[info]") {
+  const std::string arm = std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf";
+  SECTION("table") {
+    const Run r = run({"info", arm});
+    CHECK(r.exit_code == 0);
+    for (const char* part : {"one_dof_arm: 1 moving joint, 3 frames", "joint1", "revolute", "(0, 0, 1)", "breakaway",
+                             "rotor_inertia", "link1", "tip", "total mass 1 kg"})
+      CHECK(contains(r.out, part));
+  }
+  SECTION("json") {
+    const Run r = run({"info", arm, "--json"});
+    REQUIRE(r.exit_code == 0);
+    const Json j = parse(r.out);
+    CHECK(j["dof"] == 1);
+    CHECK(j["model"] == "one_dof_arm");
+    CHECK(j["joints"][0]["name"] == "joint1");
+    CHECK(j["joints"][0]["type"] == "revolute");
+    CHECK(numbers(j["joints"][0]["axis"]) == std::vector<double>{0, 0, 1});
+    CHECK(j["joints"][0]["breakaway_friction"].get<double>() == 10.0);
+    CHECK(j["joints"][0]["damping"].get<double>() == 0.0);
+    CHECK(j["joints"][0]["upper"].get<double>() == Approx(M_PI).margin(1e-15));
+    CHECK(j["joints"][0]["effort_limit"].get<double>() == 100.0);
+    CHECK(j["total_mass"].get<double>() == Approx(1.0).margin(1e-15));
+    std::vector<std::string> frames;
+    for (const Json& f : j["frames"]) frames.push_back(f["name"]);
+    CHECK(frames == std::vector<std::string>{"base", "link1", "tip"});
+    CHECK(j["frames"][2]["body"] == 1);
+  }
+  SECTION("--root/--tip") {
+    const Run r = run({"info", std::string(ZWANG_MODELS_DIR) + "/panda.urdf", "--tip", "panda_link4", "--json"});
+    REQUIRE(r.exit_code == 0);
+    const Json j = parse(r.out);
+    CHECK(j["dof"] == 4);
+    CHECK(j["joints"][3]["name"] == "panda_joint4");
+  }
+}
+
+// ---------------------------------------------------------------------------
+// scenarios: the committed CSVs (docs/scenarios) are what the tool computes.
+
+namespace {
+
+std::vector<std::vector<double>> readCsv(const std::string& path, std::string& header) {
+  std::istringstream in(cli_test::readText(path));
+  std::getline(in, header);
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    std::vector<double> row;
+    std::istringstream cells(line);
+    std::string cell;
+    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("scenarios regenerates the committed CSVs within 1e-12", "[scenarios]") {
+  const std::string out = cli_test::scratchDir() + "/scenarios";
+  const Run r = run({"scenarios", "--out", out});
+  INFO("stdout: " << r.out << "\nstderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK_FALSE(contains(r.out, "MISMATCH"));
+  for (const char* name : {"scenario1", "scenario2", "fig5_5"}) {
+    INFO(name);
+    CHECK(contains(r.out, name));
+    std::string header_new, header_old;
+    const auto fresh = readCsv(out + "/" + name + ".csv", header_new);
+    const auto committed = readCsv(std::string(ZWANG_SCENARIOS_DIR) + "/" + name + ".csv", header_old);
+    CHECK(header_new == "mu,g,qdd,tau_control,tau_net");
+    CHECK(header_new == header_old);
+    REQUIRE(fresh.size() == 201);
+    REQUIRE(committed.size() == fresh.size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < fresh.size(); ++i) {
+      REQUIRE(fresh[i].size() == 5);
+      REQUIRE(committed[i].size() == 5);
+      for (std::size_t k = 0; k < 5; ++k) worst = std::max(worst, std::abs(fresh[i][k] - committed[i][k]));
+    }
+    CHECK(worst <= 1e-12);
+    // the grid spans [-f, f] = [-10, 10]
+    CHECK(fresh.front()[0] == -10.0);
+    CHECK(fresh.back()[0] == 10.0);
+    if (cli_test::fileExists("/usr/bin/gnuplot") || cli_test::fileExists("/usr/local/bin/gnuplot")) {
+      for (const char* plot : {"_g.png", "_qdd.png", "_tau.png"}) CHECK(cli_test::fileExists(out + "/" + name + plot));
+    }
+  }
+  // The sampled g peaks where the exact maximiser is (the grid holds -5, -10 and +10).
+  std::string header;
+  const auto s1 = readCsv(out + "/scenario1.csv", header);
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < s1.size(); ++i)
+    if (s1[i][1] > s1[best][1]) best = i;
+  CHECK(s1[best][0] == Approx(-5.0).margin(1e-12));
+  CHECK(s1[best][2] == Approx(0.0).margin(1e-12));  // q̈(μ*) = 0
+}
+
+TEST_CASE("scenarios without gnuplot keeps the CSVs and says so", "[scenarios]") {
+  const std::string out = cli_test::scratchDir() + "/scenarios-nognuplot";
+  const std::string empty_bin = cli_test::scratchDir() + "/empty-bin";
+  std::filesystem::create_directories(empty_bin);
+  const Run r = run({"scenarios", "--out", out}, {{"PATH", empty_bin}});
+  CHECK(r.exit_code == 0);
+  CHECK(contains(r.err, "gnuplot is not on PATH"));
+  CHECK(r.err.find('\n') == r.err.size() - 1);
+  for (const char* name : {"scenario1", "scenario2", "fig5_5"}) {
+    CHECK(cli_test::fileExists(out + "/" + std::string(name) + ".csv"));
+    CHECK_FALSE(cli_test::fileExists(out + "/" + std::string(name) + "_g.png"));
+  }
+  const Run quiet = run({"scenarios", "--out", out + "-csv", "--no-plots"}, {{"PATH", empty_bin}});
+  CHECK(quiet.exit_code == 0);
+  CHECK(quiet.err.empty());
+}

@@ -1,0 +1,387 @@
+#!/usr/bin/env python3
+"""Writes docs/benchmarks.md (and a log-log plot) from zwang_bench's JSON output.
+
+Standard library only. Called by bench/run.sh; can be rerun on an existing JSON:
+  python3 bench/report.py --json bench/results/zwang_bench.json \
+      --markdown docs/benchmarks.md --plot bench/results/cost_vs_n.png
+"""
+import argparse
+import json
+import math
+import os
+import platform
+import shutil
+import subprocess
+import tempfile
+
+SIZES = [1, 2, 4, 7, 16, 32, 64, 128]
+MODELS = [f"N={n}" for n in SIZES] + ["panda"]
+SLOPE_SIZES = [16, 32, 64, 128]
+
+# Table rows, in order, with a description.
+FAMILIES = [
+    ("ours_hd_m0", "ours: solveHybridDynamics, no constraint"),
+    ("ours_hd_m1", "ours: solveHybridDynamics, 1 end-effector row"),
+    ("ours_hd_m6", "ours: solveHybridDynamics, 6 end-effector rows"),
+    ("ours_hd_m6x2", "ours: solveHybridDynamics, 6 rows on 2 frames (3 last link, 3 middle link)"),
+    ("ours_rnea", "ours: inverseDynamics (RNEA)"),
+    ("ours_crba", "ours: jointSpaceInertia (CRBA)"),
+    ("kdl_hd_m0", "KDL: ChainHdSolver_Vereshchagin, one zero column"),
+    ("kdl_hd_m1", "KDL: ChainHdSolver_Vereshchagin, 1 row"),
+    ("kdl_hd_m6", "KDL: ChainHdSolver_Vereshchagin, 6 rows"),
+    ("kdl_rne", "KDL: ChainIdSolver_RNE"),
+]
+for method, method_text in (("as", "active set"), ("pg", "projected gradient")):
+    for task, task_text in (("free", "no constraint"), ("ee6", "6 end-effector rows")):
+        for k, k_text in (("k0", "k = 0"), ("k1", "k = 1"), ("k2", "k = 2"), ("khalf", "k = N/2"), ("kall", "k = N")):
+            FAMILIES.append((f"fric_{method}_{task}_{k}", f"ours: solveWithFriction, {method_text}, {task_text}, {k_text}"))
+for task, task_text in (("free", "no constraint"), ("ee6", "6 end-effector rows")):
+    for k in (1, 2):
+        FAMILIES.append((f"grid_{task}_k{k}", f"report's grid: 21^{k} full solves, {task_text}, k = {k}"))
+for task, task_text in (("free", "no constraint"), ("ee6", "6 end-effector rows")):
+    for k in (1, 2):
+        FAMILIES.append((f"naivepg_{task}_k{k}",
+                         f"projected gradient, one full solve per gradient, {task_text}, k = {k}"))
+
+PLOT_SERIES = [
+    ("ours_hd_m0", "ours hybrid, m = 0"),
+    ("ours_hd_m6", "ours hybrid, m = 6"),
+    ("kdl_hd_m0", "KDL Vereshchagin, m = 0"),
+    ("kdl_hd_m6", "KDL Vereshchagin, m = 6"),
+    ("ours_rnea", "ours RNEA"),
+    ("kdl_rne", "KDL RNE"),
+    ("ours_crba", "ours CRBA"),
+    ("fric_as_ee6_k1", "ours friction, m = 6, k = 1"),
+    ("fric_as_ee6_kall", "ours friction, m = 6, k = N"),
+    ("grid_ee6_k1", "grid method, m = 6, k = 1"),
+    ("grid_ee6_k2", "grid method, m = 6, k = 2"),
+]
+
+
+COLORS = ["#1f77b4", "#d62728", "#17becf", "#ff7f0e", "#2ca02c", "#8c564b", "#9467bd", "#000000", "#e377c2",
+          "#7f7f7f", "#bcbd22"]
+
+
+def load(path):
+    with open(path) as f:
+        data = json.load(f)
+    medians, cvs, counters, errors, plain = {}, {}, {}, {}, {}
+    for b in data["benchmarks"]:
+        run = b.get("run_name", b["name"])
+        if b.get("error_occurred"):
+            errors[run] = b.get("error_message", "error")
+            continue
+        scale = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}[b.get("time_unit", "ns")]
+        if b.get("run_type") == "aggregate":
+            if b.get("aggregate_name") == "median":
+                medians[run] = b["cpu_time"] * scale
+                counters[run] = b
+            elif b.get("aggregate_name") == "cv":
+                cvs[run] = b["cpu_time"]
+        else:  # no repetitions: the single run
+            plain.setdefault(run, []).append(b["cpu_time"] * scale)
+            counters.setdefault(run, b)
+    for run, times in plain.items():
+        if run not in medians:
+            times.sort()
+            medians[run] = times[len(times) // 2]
+    return data["context"], medians, cvs, counters, errors
+
+
+def fmt_ns(x):
+    if x is None:
+        return "—"
+    return f"{x:,.0f}" if x >= 100 else f"{x:.1f}"
+
+
+def fmt_ratio(x):
+    if x is None:
+        return "—"
+    return f"{x:,.0f}×" if x >= 100 else f"{x:.2f}×"
+
+
+def slope(medians, family):
+    pts = [(math.log(n), math.log(medians[f"{family}/N={n}"])) for n in SLOPE_SIZES if f"{family}/N={n}" in medians]
+    if len(pts) < 2:
+        return None
+    mx = sum(p[0] for p in pts) / len(pts)
+    my = sum(p[1] for p in pts) / len(pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
+
+
+def ratio(medians, num, den):
+    if num in medians and den in medians and medians[den] > 0:
+        return medians[num] / medians[den]
+    return None
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def git_revision(root):
+    try:
+        return subprocess.run(["git", "-C", root, "describe", "--always", "--dirty"], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def make_plot(medians, png):
+    gnuplot = shutil.which("gnuplot")
+    if not gnuplot:
+        return "gnuplot not found: no plot (Debian: gnuplot-nox)."
+    with tempfile.TemporaryDirectory() as tmp:
+        plots = []
+        for i, (family, title) in enumerate(PLOT_SERIES):
+            rows = [(n, medians[f"{family}/N={n}"]) for n in SIZES if f"{family}/N={n}" in medians]
+            if not rows:
+                continue
+            path = os.path.join(tmp, f"{family}.dat")
+            with open(path, "w") as f:
+                for n, t in rows:
+                    f.write(f"{n} {t}\n")
+            dash = "" if family.startswith(("ours", "fric")) else " dt 2"
+            color = COLORS[i % len(COLORS)]
+            plots.append(f"'{path}' using 1:2 with linespoints lw 2 pt {i % 13 + 1} lc rgb '{color}'{dash} "
+                         f"title '{title}'")
+        script = "\n".join([
+            "set terminal pngcairo size 1100,750 font ',11'",
+            f"set output '{png}'",
+            "set logscale xy",
+            "set xrange [0.85:150]",
+            "set xlabel 'N (revolute joints)'",
+            "set ylabel 'median CPU time per call [ns]'",
+            "set title 'zwang vs KDL vs the grid method: cost per call against chain length'",
+            "set key outside right top",
+            "set grid",
+            "set xtics (1, 2, 4, 7, 16, 32, 64, 128)",
+            "set format y '10^{%L}'",
+            "plot " + ", \\\n     ".join(plots),
+        ])
+        result = subprocess.run([gnuplot], input=script, capture_output=True, text=True)
+        if result.returncode != 0:
+            return "gnuplot failed: " + result.stderr.strip()
+    return None
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--json", required=True)
+    ap.add_argument("--markdown", required=True)
+    ap.add_argument("--plot", required=True)
+    ap.add_argument("--command", default="bash bench/run.sh")
+    ap.add_argument("--settings", default="")
+    ap.add_argument("--load-after", default="")
+    args = ap.parse_args()
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ctx, med, cvs, counters, errors = load(args.json)
+    md_dir = os.path.dirname(os.path.abspath(args.markdown))
+    plot_rel = os.path.relpath(os.path.abspath(args.plot), md_dir)
+    json_rel = os.path.relpath(os.path.abspath(args.json), md_dir)
+
+    out = []
+    w = out.append
+    w("# Benchmarks")
+    w("")
+    w("Cost per call of zwang's solvers, KDL's on the same chains, and the report's way of finding the")
+    w("static friction torques, measured in one run of `zwang_bench` (issue 5). This file is generated by")
+    w("`bench/report.py`; do not edit it by hand.")
+    w("")
+    w("## Reproduce")
+    w("")
+    w("```sh")
+    w(args.command)
+    w("```")
+    w("")
+    w("(from the repository root: builds `zwang_bench` in Release in `build-bench/` if needed, runs it once with")
+    w(f"repetitions, writes this file, `{json_rel}` and the plot.)")
+    w("")
+    w("To see where one benchmark spends its time: `bash bench/profile.sh '<benchmark regex>'` (perf), or")
+    w("`bash bench/profile.sh '<regex>' '*solveHybridDynamics*'` (callgrind, collecting inside that function).")
+    w("")
+    w("## Machine and build")
+    w("")
+    load_before = ", ".join(f"{x:.2f}" for x in ctx.get("load_avg", []))
+    w("| | |")
+    w("|---|---|")
+    w(f"| CPU | {cpu_model()} ({ctx.get('num_cpus', os.cpu_count())} logical cores, {ctx.get('mhz_per_cpu', '?')} MHz) |")
+    caches = ", ".join(f"L{c['level']} {c['type'].lower()} {c['size'] // 1024} KiB" for c in ctx.get("caches", []))
+    w(f"| caches | {caches} |")
+    w(f"| OS | {platform.system()} {platform.release()} |")
+    w(f"| compiler | {ctx.get('zwang_compiler', '?')} |")
+    w(f"| flags | `{ctx.get('zwang_cxx_flags', '?')}` ({ctx.get('zwang_build_type', '?')}; library and bench alike; "
+      f"warnings `-Wall -Wextra -Wpedantic -Werror`) |")
+    w(f"| Google Benchmark | Debian libbenchmark-dev (its own build type: {ctx.get('library_build_type', '?')}; "
+      "this only concerns the timing harness) |")
+    w(f"| run | {ctx.get('date', '?')}, {args.settings or 'see the command'}; source `{git_revision(root)}` |")
+    w(f"| load average | {load_before or '?'} before the run{', ' + args.load_after + ' after' if args.load_after else ''} |")
+    w("")
+    w("Times are the **median CPU time per call** over the repetitions, in nanoseconds (CPU time rather than wall")
+    w("time, so that other processes on a shared machine do not count; with a quiet machine the two agree).")
+    w("Chains: `randomChain` (test/support) with a fixed seed, N revolute joints with limits, rotor inertias on,")
+    w("no fixed or prismatic joints; the Panda is `models/panda.urdf`. Every joint moves (0.1 ≤ |q̇| ≤ 2 rad/s);")
+    w("for the friction rows the k stuck joints (spread evenly along the chain) have q̇ = 0. Constraints hold")
+    w("the end effector still in world axes (m = 1: the vertical force row). Ours and KDL are given the same")
+    w("problem; before timing, the bench checks that they agree (largest relative error of q̈ over m = 0, 1, 6")
+    w(f"where m ≤ N, and of the RNEA torques): {ctx.get('zwang_check_vs_kdl_max_rel_err', 'not recorded')}.")
+    w("")
+
+    # ---- The issue's ratios
+    rows = []
+
+    def target_row(text, value, target_text, ok, fmt=fmt_ratio):
+        if value is None:
+            status = "—"
+        elif ok is None:
+            status = "(info)"
+        else:
+            status = "**met**" if ok(value) else "**not met**"
+        rows.append(f"| {text} | {fmt(value) if value is not None else '—'} | {target_text} | {status} |")
+
+    for n, t in ((7, 4.0), (64, 3.0)):
+        target_row(f"KDL Vereshchagin / ours, 6 end-effector rows, N = {n}",
+                   ratio(med, f"kdl_hd_m6/N={n}", f"ours_hd_m6/N={n}"), f"≥ {t:g}×", lambda v, t=t: v >= t)
+    target_row("KDL Vereshchagin / ours, 6 end-effector rows, Panda",
+               ratio(med, "kdl_hd_m6/panda", "ours_hd_m6/panda"), "—", None)
+    for n in (7, 64):
+        target_row(f"KDL Vereshchagin / ours, no constraint, N = {n}",
+                   ratio(med, f"kdl_hd_m0/N={n}", f"ours_hd_m0/N={n}"), "—", None)
+        target_row(f"KDL RNE / ours RNEA, N = {n}", ratio(med, f"kdl_rne/N={n}", f"ours_rnea/N={n}"), "—", None)
+    for n in (7, 64):
+        target_row(f"ours hybrid (no constraint) / ours RNEA, N = {n}",
+                   ratio(med, f"ours_hd_m0/N={n}", f"ours_rnea/N={n}"), "≤ 2×", lambda v: v <= 2.0)
+    target_row("Panda, all 7 joints stuck, 6 end-effector rows: friction (active set) / plain solve",
+               ratio(med, "fric_as_ee6_kall/panda", "ours_hd_m6/panda"), "≤ 2.5×", lambda v: v <= 2.5)
+    target_row("the same with the projected-gradient maximiser",
+               ratio(med, "fric_pg_ee6_kall/panda", "ours_hd_m6/panda"), "≤ 2.5×", lambda v: v <= 2.5)
+    fmt_slope = lambda v: f"{v:.2f}"
+    for method, mtext in (("as", "active set"), ("pg", "projected gradient")):
+        for task, ttext in (("free", "no constraint"), ("ee6", "6 rows")):
+            for k in ("k0", "k1"):
+                if method == "pg" and k == "k0":
+                    continue  # k = 0 does not reach the maximiser
+                target_row(f"log–log slope N = 16…128, friction ({mtext}, {ttext}), {k.replace('k', 'k = ')}",
+                           slope(med, f"fric_{method}_{task}_{k}"), "1.0 ± 0.1", lambda v: abs(v - 1.0) <= 0.1,
+                           fmt_slope)
+    for method, mtext in (("as", "active set"), ("pg", "projected gradient")):
+        for task, ttext in (("free", "no constraint"), ("ee6", "6 rows")):
+            target_row(f"log–log slope N = 16…128, friction ({mtext}, {ttext}), k = N",
+                       slope(med, f"fric_{method}_{task}_kall"), "≤ 2", lambda v: v <= 2.0, fmt_slope)
+    for model, mtext in (("N=7", "N = 7"), ("panda", "Panda")):
+        for k in (1, 2):
+            target = "> 1× (beats it)" if k == 1 else "≥ 100× (orders of magnitude)"
+            limit = 1.0 if k == 1 else 100.0
+            target_row(f"grid method / ours (active set), 6 rows, k = {k}, {mtext}",
+                       ratio(med, f"grid_ee6_k{k}/{model}", f"fric_as_ee6_k{k}/{model}"), target,
+                       lambda v, limit=limit: v > limit if limit == 1.0 else v >= limit)
+    w("## The issue's targets")
+    w("")
+    w("| ratio | measured | target | |")
+    w("|---|---|---|---|")
+    out.extend(rows)
+    w("")
+    w("Slopes are least-squares fits of log(time) against log(N) over N = 16, 32, 64, 128. Other slopes (no")
+    w("target): " + ", ".join(
+        f"{fam} {slope(med, fam):.2f}" for fam in ("ours_hd_m0", "ours_hd_m6", "ours_rnea", "ours_crba", "kdl_hd_m0",
+                                                   "kdl_hd_m6", "kdl_rne", "fric_as_ee6_khalf", "fric_pg_ee6_khalf",
+                                                   "grid_ee6_k1", "grid_ee6_k2")
+        if slope(med, fam) is not None) + ".")
+    w("")
+
+    # ---- Friction versus the report's methods, at every size
+    w("## Friction solve versus the report's methods")
+    w("")
+    w("Time of the method divided by the time of `solveWithFriction` (active set) on the same problem.")
+    w("*grid*: 21 friction values per stuck joint, one full `solveHybridDynamics` per grid point (21 or 441")
+    w("calls), keep the largest g(μ) (with the torques τ − Wᵀμ passed in, `Solution::gauss` is g(μ)).")
+    w("*naive PG*: projected gradient on g with one full solve per gradient ∇g = q̈_Θ(μ), step 1/L with")
+    w("L = λ_max(K_ΘΘ) estimated once per call from k unit-torque solves, stopped at the tolerance")
+    w("`solveWithFriction` uses (no ∂q̈/∂μ reuse). Below the table: how many solver calls the naive method")
+    w("needed, and how far the grid's μ is from μ* (the grid is exact only when μ* lies on the grid, e.g. when")
+    w("the joint slips at ±f).")
+    w("")
+    w("| method | " + " | ".join(m.replace("N=", "N = ") for m in MODELS) + " |")
+    w("|---|" + "---|" * len(MODELS))
+    for prefix in ("grid", "naivepg"):
+        for task in ("free", "ee6"):
+            for k in (1, 2):
+                cells = [fmt_ratio(ratio(med, f"{prefix}_{task}_k{k}/{m}", f"fric_as_{task}_k{k}/{m}")) for m in MODELS]
+                name = "grid" if prefix == "grid" else "naive PG"
+                w(f"| {name}, {'no constraint' if task == 'free' else '6 rows'}, k = {k} | " + " | ".join(cells) + " |")
+    for task in ("free", "ee6"):
+        for k in (1, 2):
+            cells = []
+            for m in MODELS:
+                c = counters.get(f"naivepg_{task}_k{k}/{m}")
+                cells.append("—" if c is None else f"{c.get('solves', float('nan')):.0f}")
+            w(f"| naive PG solver calls, {'no constraint' if task == 'free' else '6 rows'}, k = {k} | "
+              + " | ".join(cells) + " |")
+    for task in ("free", "ee6"):
+        for k in (1, 2):
+            cells = []
+            for m in MODELS:
+                c = counters.get(f"grid_{task}_k{k}/{m}")
+                cells.append("—" if c is None else f"{c.get('mu_err', float('nan')):.2g}")
+            w(f"| grid: max abs(μ − μ*) [N·m], {'no constraint' if task == 'free' else '6 rows'}, k = {k} | "
+              + " | ".join(cells) + " |")
+    w("")
+
+    # ---- The full table
+    w("## Median CPU time per call [ns]")
+    w("")
+    w("| benchmark | " + " | ".join(m.replace("N=", "N = ") for m in MODELS) + " |")
+    w("|---|" + "---|" * len(MODELS))
+    for family, text in FAMILIES:
+        cells = [fmt_ns(med.get(f"{family}/{m}")) for m in MODELS]
+        if all(c == "—" for c in cells):
+            continue
+        w(f"| `{family}` {text} | " + " | ".join(cells) + " |")
+    w("")
+    w("— : not run (k > N, or the same problem as another row: k = N/2 is listed only when it differs from")
+    w("0, 1, 2 and N; k = N only for N > 1).")
+    iters = []
+    for family in ("fric_as_ee6_kall", "fric_pg_ee6_kall", "fric_as_free_kall", "fric_pg_free_kall"):
+        cells = [f"{m.replace('N=', '')}: {counters[f'{family}/{m}'].get('iterations', float('nan')):.0f}"
+                 for m in MODELS if f"{family}/{m}" in counters]
+        if cells:
+            iters.append(f"`{family}` " + ", ".join(cells))
+    if iters:
+        w("Maximiser iterations with k = N: " + "; ".join(iters) + ".")
+    if cvs:
+        worst = max(cvs.items(), key=lambda kv: kv[1])
+        noisy = sum(1 for v in cvs.values() if v > 0.05)
+        w(f"Spread over the repetitions: the largest coefficient of variation is {100 * worst[1]:.1f} % "
+          f"(`{worst[0]}`); {noisy} of {len(cvs)} benchmarks are above 5 %.")
+    if errors:
+        w("")
+        w("Benchmarks that reported an error: " + "; ".join(f"`{k}`: {v}" for k, v in sorted(errors.items())) + ".")
+    w("")
+
+    # ---- Plot
+    w("## Cost against N")
+    w("")
+    problem = make_plot(med, os.path.abspath(args.plot))
+    if problem:
+        w(f"({problem})")
+    else:
+        w(f"![median CPU time per call against N, log-log]({plot_rel})")
+        w("")
+        w("Solid lines: zwang; dashed: KDL and the grid method.")
+    w("")
+
+    with open(args.markdown, "w") as f:
+        f.write("\n".join(out))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,616 @@
+// zwang_bench: cost per call of zwang's solvers, side by side with KDL and with
+// the report's own way of finding the static friction torques (issue 5).
+//
+// Every benchmark is named  <family>/<model>,  <model> = "N=<dof>" for a random
+// revolute chain or "panda"; counters N (dof), m (constraint rows), k (stuck
+// joints). Families:
+//   ours_hd_m{0,1,6}       zwang::solveHybridDynamics, m end-effector rows (world axes)
+//   ours_hd_m6x2           6 rows on 2 frames: 3 linear on the last link, 3 angular on the middle link
+//   ours_rnea, ours_crba   zwang::inverseDynamics, zwang::jointSpaceInertia
+//   kdl_hd_m{0,1,6}        KDL::ChainHdSolver_Vereshchagin on the same chain (m = 0: one zero column)
+//   kdl_rne                KDL::ChainIdSolver_RNE
+//   fric_{as,pg}_{free,ee6}_k{0,1,2,half,all}
+//                          zwang::solveWithFriction, active set / projected gradient, no constraint /
+//                          the 6-row end-effector task, k = 0, 1, 2, N/2, N stuck joints (q̇_j = 0;
+//                          k = 2 is the grid method's case)
+//   grid_{free,ee6}_k{1,2} the report's method: 21 friction values per stuck joint, one full
+//                          solveHybridDynamics per grid point, keep the largest g(μ)
+//   naivepg_{free,ee6}_k{1,2}
+//                          projected gradient on g with one full solve per gradient (∇g = q̈_Θ(μ)),
+//                          step 1/L (L estimated once from k unit-torque solves), stopped at the
+//                          tolerance solveWithFriction uses; no ∂q̈/∂μ reuse
+// Solvers, workspaces, tasks and KDL arrays are made outside the timed loops.
+// Before anything is timed, main() checks that ours and KDL solve the same
+// problems (q̈ and RNEA torques) and puts the largest differences into the
+// benchmark context.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <kdl/chain.hpp>
+#include <kdl/chainhdsolver_vereshchagin.hpp>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/frames.hpp>
+#include <kdl/jacobian.hpp>
+#include <kdl/jntarray.hpp>
+#include <urdf_parser/urdf_parser.h>
+
+#include "support/kdl_bridge.hpp"
+#include "support/random_chain.hpp"
+#include "support/random_problem.hpp"
+#include "zwang/zwang.hpp"
+
+namespace {
+
+using namespace zwang;
+using namespace zwang::testing;
+
+// ---------------------------------------------------------------------------
+// The robots and their states
+
+struct Problem {
+  std::string label;  // "N=7" or "panda"
+  int n = 0;
+  ChainSpec spec;     // the same chain as a plain description, for KDL
+  Model model;        // ours
+  Eigen::VectorXd q, qd, qdd, tau;  // every joint moving: 0.1 ≤ |q̇_j| ≤ 2
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+  std::string tip, middle;  // link names: the last one, and one half way
+};
+
+constexpr std::uint64_t kSeed = 0x2a5eedULL;  // fixed: the same chains in every run
+
+std::unique_ptr<Problem> randomProblemOfSize(int n) {
+  auto p = std::make_unique<Problem>();
+  std::mt19937_64 rng(kSeed + static_cast<std::uint64_t>(n));
+  RandomChainOptions options;
+  options.min_moving_joints = options.max_moving_joints = n;
+  options.fixed_joint_probability = 0.0;
+  options.prismatic_probability = 0.0;
+  options.continuous_probability = 0.0;  // revolute, with limits
+  options.rotor_inertia = true;
+  p->spec = randomChain(rng, options);
+  p->label = "N=" + std::to_string(n);
+  p->n = n;
+  p->model = modelFromSpec(p->spec);
+  p->q.resize(n);
+  p->qd.resize(n);
+  const std::vector<int> moving = p->spec.movingJoints();
+  for (int j = 0; j < n; ++j) {
+    const JointSpec& joint = p->spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
+    const double margin = 0.05 * (joint.upper - joint.lower);  // well inside the limits
+    p->q[j] = uniform(rng, joint.lower + margin, joint.upper - margin);
+    p->qd[j] = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
+  }
+  p->qdd = randomVector(rng, n, 2.0);
+  p->tau = randomVector(rng, n, 10.0);
+  p->tip = p->spec.links.back().name;
+  p->middle = p->spec.links[static_cast<std::size_t>(std::max(1, n / 2))].name;
+  return p;
+}
+
+Eigen::Vector3d toEigen(const urdf::Vector3& v) { return Eigen::Vector3d(v.x, v.y, v.z); }
+Eigen::Vector3d rpyOf(const urdf::Rotation& r) {
+  double roll = 0, pitch = 0, yaw = 0;
+  r.getRPY(roll, pitch, yaw);
+  return Eigen::Vector3d(roll, pitch, yaw);
+}
+
+// The Panda's moving chain panda_link0 → panda_link7 as a ChainSpec (read with
+// urdfdom, independently of zwang's loader), for KDL. The fixed, massless
+// flange and tool0 frames behind panda_link7 change nothing in the dynamics.
+ChainSpec specFromUrdf(const std::string& path, const std::string& root, const std::string& tip) {
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDFFile(path);
+  if (!urdf) throw std::runtime_error("cannot parse " + path);
+  std::vector<urdf::JointConstSharedPtr> joints;
+  for (urdf::LinkConstSharedPtr link = urdf->getLink(tip); link && link->name != root; link = link->getParent())
+    joints.push_back(link->parent_joint);
+  std::reverse(joints.begin(), joints.end());
+  auto linkSpec = [&](const std::string& name) {
+    LinkSpec l;
+    l.name = name;
+    const urdf::LinkConstSharedPtr link = urdf->getLink(name);
+    if (link && link->inertial) {
+      const urdf::Inertial& in = *link->inertial;
+      l.mass = in.mass;
+      l.com = toEigen(in.origin.position);
+      l.inertial_rpy = rpyOf(in.origin.rotation);
+      l.inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    }
+    return l;
+  };
+  ChainSpec spec;
+  spec.name = urdf->getName();
+  spec.links.push_back(linkSpec(root));
+  for (const urdf::JointConstSharedPtr& j : joints) {
+    JointSpec js;
+    js.name = j->name;
+    js.type = j->type == urdf::Joint::PRISMATIC    ? "prismatic"
+              : j->type == urdf::Joint::CONTINUOUS ? "continuous"
+              : j->type == urdf::Joint::REVOLUTE   ? "revolute"
+                                                   : "fixed";
+    js.xyz = toEigen(j->parent_to_joint_origin_transform.position);
+    js.rpy = rpyOf(j->parent_to_joint_origin_transform.rotation);
+    js.axis = toEigen(j->axis);
+    if (j->limits) {
+      js.lower = j->limits->lower;
+      js.upper = j->limits->upper;
+      js.effort = j->limits->effort;
+      js.velocity = j->limits->velocity;
+    }
+    if (j->dynamics) {
+      js.friction = j->dynamics->friction;
+      js.damping = j->dynamics->damping;
+    }
+    spec.joints.push_back(js);
+    spec.links.push_back(linkSpec(j->child_link_name));
+  }
+  spec.check();
+  return spec;
+}
+
+std::unique_ptr<Problem> pandaProblem() {
+  const std::string path = std::string(ZWANG_BENCH_MODELS_DIR) + "/panda.urdf";
+  auto p = std::make_unique<Problem>();
+  p->label = "panda";
+  p->model = loadUrdfFile(path);
+  p->n = p->model.dof();
+  p->spec = specFromUrdf(path, "panda_link0", "panda_link7");
+  if (p->spec.dof() != p->n) throw std::runtime_error("panda: chain and model differ in dof");
+  p->q.resize(p->n);
+  p->q << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;  // the demo's "ready" pose
+  p->qd.resize(p->n);
+  for (int j = 0; j < p->n; ++j) p->qd[j] = j % 2 ? -0.5 : 0.5;
+  p->qdd = Eigen::VectorXd::Constant(p->n, 0.3);
+  p->tau = Eigen::VectorXd::Zero(p->n);  // motors off: friction and the task carry the arm
+  p->tip = "panda_link7";
+  p->middle = "panda_link3";
+  return p;
+}
+
+// ---------------------------------------------------------------------------
+// Tasks (as DynamicsInput, so the same problem goes to ours and to KDL)
+
+enum class TaskKind { None, Ee1, Ee6, Split6 };
+
+DynamicsInput makeInput(const Problem& p, TaskKind kind, const Eigen::VectorXd& qd) {
+  DynamicsInput in;
+  in.q = p.q;
+  in.qd = qd;
+  in.tau = p.tau;
+  in.gravity = p.gravity;
+  auto constraint = [](const std::string& link, Matrix6Xd A) {
+    ConstraintInput c;
+    c.link = link;
+    c.b = Eigen::VectorXd::Zero(A.cols());  // hold still
+    c.A = std::move(A);
+    c.axes = Axes::World;
+    return c;
+  };
+  switch (kind) {
+    case TaskKind::None:
+      break;
+    case TaskKind::Ee1: {  // one unit force along world z on the end effector
+      Matrix6Xd A = Matrix6Xd::Zero(6, 1);
+      A(2, 0) = 1.0;
+      in.constraints.push_back(constraint(p.tip, A));
+      break;
+    }
+    case TaskKind::Ee6:
+      in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6)));
+      break;
+    case TaskKind::Split6:
+      in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6).leftCols(3)));    // position
+      in.constraints.push_back(constraint(p.middle, Matrix6Xd::Identity(6, 6).rightCols(3)));  // orientation
+      break;
+  }
+  return in;
+}
+
+int rowsOf(TaskKind kind) { return kind == TaskKind::None ? 0 : kind == TaskKind::Ee1 ? 1 : 6; }
+
+// k stuck joints spread evenly along the chain (k = N: all of them).
+std::vector<int> stuckSet(int n, int k) {
+  std::vector<int> s;
+  for (int i = 0; i < k; ++i) s.push_back((2 * i + 1) * n / (2 * k));
+  return s;
+}
+
+Eigen::VectorXd stuckVelocities(const Problem& p, const std::vector<int>& stuck) {
+  Eigen::VectorXd qd = p.qd;
+  for (int j : stuck) qd[j] = 0.0;
+  return qd;
+}
+
+void setCounters(benchmark::State& state, const Problem& p, int m, int k) {
+  state.counters["N"] = p.n;
+  state.counters["m"] = m;
+  state.counters["k"] = k;
+}
+
+// ---------------------------------------------------------------------------
+// Ours
+
+void benchOursHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
+  const DynamicsInput in = makeInput(*p, kind, p->qd);
+  const Task task = taskFromInput(p->model, in);
+  Workspace ws(p->model, task);
+  if (Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws); !s) {
+    state.SkipWithError(s.message);
+    return;
+  }
+  for (auto _ : state) {
+    const Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  setCounters(state, *p, task.constraintRows(), 0);
+}
+
+void benchOursRnea(benchmark::State& state, const Problem* p) {
+  const Task task(p->model);  // gravity (0, 0, −9.81), no wrenches
+  Workspace ws(p->model, task);
+  for (auto _ : state) {
+    const Status s = inverseDynamics(p->model, task, p->q, p->qd, p->qdd, ws);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.tau.data());
+    benchmark::ClobberMemory();
+  }
+  setCounters(state, *p, 0, 0);
+}
+
+void benchOursCrba(benchmark::State& state, const Problem* p) {
+  Workspace ws(p->model, 0);
+  for (auto _ : state) {
+    const Status s = jointSpaceInertia(p->model, p->q, ws);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.H.data());
+    benchmark::ClobberMemory();
+  }
+  setCounters(state, *p, 0, 0);
+}
+
+// ---------------------------------------------------------------------------
+// KDL
+
+KDL::JntArray jnt(const Eigen::VectorXd& x) {
+  KDL::JntArray a(static_cast<unsigned int>(x.size()));
+  a.data = x;
+  return a;
+}
+
+void benchKdlHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
+  const DynamicsInput in = makeInput(*p, kind, p->qd);
+  // The bridge converts our problem to KDL's inputs (alpha, beta, root
+  // acceleration, f_ext) once; only CartToJnt is timed.
+  const KdlHybridResult ref = kdlHybridDynamics(p->spec, in);
+  const KDL::Chain chain = toKdlChain(p->spec);
+  const auto nc = static_cast<unsigned int>(ref.alpha.cols());
+  const KDL::Twist root_acc(KDL::Vector(ref.root_acc[0], ref.root_acc[1], ref.root_acc[2]),
+                            KDL::Vector(ref.root_acc[3], ref.root_acc[4], ref.root_acc[5]));
+  KDL::ChainHdSolver_Vereshchagin solver(chain, root_acc, nc);
+  const KDL::JntArray q = jnt(p->q), qd = jnt(p->qd), tau = jnt(p->tau), beta = jnt(ref.beta);
+  KDL::JntArray qdd(static_cast<unsigned int>(p->n)), constraint_tau(static_cast<unsigned int>(p->n));
+  KDL::Jacobian alpha(nc);
+  alpha.data = ref.alpha;
+  const KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  for (auto _ : state) {
+    const int error = solver.CartToJnt(q, qd, qdd, alpha, beta, f_ext, tau, constraint_tau);
+    benchmark::DoNotOptimize(error);
+    benchmark::DoNotOptimize(qdd.data.data());
+    benchmark::ClobberMemory();
+  }
+  setCounters(state, *p, rowsOf(kind), 0);
+}
+
+void benchKdlRne(benchmark::State& state, const Problem* p) {
+  const KDL::Chain chain = toKdlChain(p->spec);
+  KDL::ChainIdSolver_RNE solver(chain, KDL::Vector(p->gravity.x(), p->gravity.y(), p->gravity.z()));
+  const KDL::JntArray q = jnt(p->q), qd = jnt(p->qd), qdd = jnt(p->qdd);
+  KDL::JntArray tau(static_cast<unsigned int>(p->n));
+  const KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  for (auto _ : state) {
+    const int error = solver.CartToJnt(q, qd, qdd, f_ext, tau);
+    benchmark::DoNotOptimize(error);
+    benchmark::DoNotOptimize(tau.data.data());
+    benchmark::ClobberMemory();
+  }
+  setCounters(state, *p, 0, 0);
+}
+
+// ---------------------------------------------------------------------------
+// Static friction: ours
+
+void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int k, FrictionMethod method) {
+  const std::vector<int> stuck = stuckSet(p->n, k);
+  const Eigen::VectorXd qd = stuckVelocities(*p, stuck);
+  const Task task = taskFromInput(p->model, makeInput(*p, kind, qd));
+  Workspace ws(p->model, task);
+  FrictionOptions options;
+  options.method = method;
+  if (Status s = solveWithFriction(p->model, task, p->q, qd, p->tau, ws, options); !s) {
+    state.SkipWithError(s.message);
+    return;
+  }
+  if (static_cast<int>(ws.friction.stuck.size()) != k) {
+    state.SkipWithError("stuck set has the wrong size");
+    return;
+  }
+  for (auto _ : state) {
+    const Status s = solveWithFriction(p->model, task, p->q, qd, p->tau, ws, options);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  setCounters(state, *p, task.constraintRows(), k);
+  state.counters["iterations"] = ws.friction.iterations;
+}
+
+// ---------------------------------------------------------------------------
+// Static friction: the report's method and a naive gradient method, both
+// calling the full solver (solveHybridDynamics) for every evaluation of g.
+//
+// With the joint torques τ_eff − Wᵀμ passed in, Solution::gauss is
+// Z₀(q̈) + μᵀ W q̈ at the solution, i.e. exactly g(μ) (docs/friction.md), and
+// ∇g(μ) = W q̈(μ).
+
+struct FrictionSetupOurs {
+  std::vector<int> stuck;
+  Eigen::VectorXd qd, tau_eff, f;  // τ plus kinetic friction on the moving joints; f per stuck joint
+};
+
+FrictionSetupOurs frictionSetup(const Problem& p, int k) {
+  FrictionSetupOurs s;
+  s.stuck = stuckSet(p.n, k);
+  s.qd = stuckVelocities(p, s.stuck);
+  s.tau_eff = p.tau;
+  for (int j = 0; j < p.n; ++j) {
+    const Joint& joint = p.model.joint(j);
+    if (s.qd[j] != 0.0) s.tau_eff[j] += -joint.kinetic_friction * (s.qd[j] > 0 ? 1.0 : -1.0) - joint.damping * s.qd[j];
+  }
+  s.f.resize(k);
+  for (int a = 0; a < k; ++a) s.f[a] = p.model.joint(s.stuck[static_cast<std::size_t>(a)]).breakaway_friction;
+  return s;
+}
+
+// g(μ*) by our solver, for the accuracy counters of the comparison methods.
+double exactDual(const Problem& p, const Task& task, const FrictionSetupOurs& s, Eigen::VectorXd* mu_star) {
+  Workspace ws(p.model, task);
+  FrictionOptions options;
+  options.joint_limits = false;
+  if (Status st = solveWithFriction(p.model, task, p.q, s.qd, p.tau, ws, options); !st) return std::nan("");
+  mu_star->resize(static_cast<Eigen::Index>(s.stuck.size()));
+  for (std::size_t a = 0; a < s.stuck.size(); ++a)
+    (*mu_star)[static_cast<Eigen::Index>(a)] = ws.friction.mu[s.stuck[a]];
+  return ws.friction.gauss_dual;
+}
+
+constexpr int kGridPoints = 21;
+
+void benchGrid(benchmark::State& state, const Problem* p, TaskKind kind, int k) {
+  const FrictionSetupOurs s = frictionSetup(*p, k);
+  const Task task = taskFromInput(p->model, makeInput(*p, kind, s.qd));
+  Workspace ws(p->model, task);
+  Eigen::VectorXd torque(p->n), mu(k), best_mu(k), best_qdd(p->n);
+  int evaluations = 1;
+  for (int a = 0; a < k; ++a) evaluations *= kGridPoints;
+  double best = -std::numeric_limits<double>::infinity();
+  for (auto _ : state) {
+    best = -std::numeric_limits<double>::infinity();
+    for (int e = 0; e < evaluations; ++e) {
+      torque = s.tau_eff;
+      for (int a = 0, rest = e; a < k; ++a, rest /= kGridPoints) {
+        mu[a] = s.f[a] * (-1.0 + 2.0 * (rest % kGridPoints) / (kGridPoints - 1));
+        torque[s.stuck[static_cast<std::size_t>(a)]] -= mu[a];
+      }
+      const Status st = solveHybridDynamics(p->model, task, p->q, s.qd, torque, ws);
+      benchmark::DoNotOptimize(st.code);
+      if (ws.solution.gauss > best) {
+        best = ws.solution.gauss;
+        best_mu = mu;
+        best_qdd = ws.solution.qdd;
+      }
+    }
+    benchmark::DoNotOptimize(best);
+    benchmark::DoNotOptimize(best_qdd.data());
+    benchmark::ClobberMemory();
+  }
+  Eigen::VectorXd mu_star;
+  const double g_star = exactDual(*p, task, s, &mu_star);
+  setCounters(state, *p, task.constraintRows(), k);
+  state.counters["solves"] = evaluations;
+  state.counters["g_gap"] = g_star - best;  // ≥ 0: what the grid misses of max g
+  state.counters["mu_err"] = (best_mu - mu_star).cwiseAbs().maxCoeff();
+}
+
+void benchNaiveGradient(benchmark::State& state, const Problem* p, TaskKind kind, int k) {
+  const FrictionSetupOurs s = frictionSetup(*p, k);
+  const Task task = taskFromInput(p->model, makeInput(*p, kind, s.qd));
+  Workspace ws(p->model, task);
+  const FrictionOptions defaults;  // the same stopping rule as ours
+  constexpr int kMaxIterations = 100000;
+  Eigen::VectorXd torque(p->n), mu(k), grad(k), qdd0(p->n);
+  Eigen::MatrixXd K(k, k);
+  int solves = 0, iterations = 0;
+  bool converged = false;
+  auto solve = [&](const Eigen::VectorXd& t) {
+    const Status st = solveHybridDynamics(p->model, task, p->q, s.qd, t, ws);
+    benchmark::DoNotOptimize(st.code);
+    ++solves;
+  };
+  for (auto _ : state) {
+    solves = 0;
+    // q̈(0), and L = λ_max(K_ΘΘ) from k unit-torque solves (estimated once per call).
+    solve(s.tau_eff);
+    qdd0 = ws.solution.qdd;
+    for (int b = 0; b < k; ++b) {
+      torque = s.tau_eff;
+      torque[s.stuck[static_cast<std::size_t>(b)]] += 1.0;
+      solve(torque);
+      for (int a = 0; a < k; ++a)
+        K(a, b) = ws.solution.qdd[s.stuck[static_cast<std::size_t>(a)]] - qdd0[s.stuck[static_cast<std::size_t>(a)]];
+    }
+    double L = K(0, 0);
+    if (k == 2) {
+      const double mean = 0.5 * (K(0, 0) + K(1, 1)), half = 0.5 * (K(0, 0) - K(1, 1));
+      const double off = 0.5 * (K(0, 1) + K(1, 0));
+      L = mean + std::sqrt(half * half + off * off);
+    }
+    L = std::max(L, 1e-15);  // a stuck joint the task holds: g is linear, the step goes to a vertex
+    const double tolerance = defaults.kkt_tolerance * (1.0 + qdd0.cwiseAbs().maxCoeff());
+    mu.setZero();
+    for (int a = 0; a < k; ++a) grad[a] = qdd0[s.stuck[static_cast<std::size_t>(a)]];
+    converged = false;
+    for (iterations = 0; iterations < kMaxIterations; ++iterations) {
+      double residual = 0.0;  // ‖μ − Π(μ + ∇g)‖∞, as boxQpKktResidual
+      for (int a = 0; a < k; ++a)
+        residual = std::max(residual, std::abs(mu[a] - std::clamp(mu[a] + grad[a], -s.f[a], s.f[a])));
+      if (residual <= tolerance) {
+        converged = true;
+        break;
+      }
+      torque = s.tau_eff;
+      for (int a = 0; a < k; ++a) {
+        mu[a] = std::clamp(mu[a] + grad[a] / L, -s.f[a], s.f[a]);
+        torque[s.stuck[static_cast<std::size_t>(a)]] -= mu[a];
+      }
+      solve(torque);
+      for (int a = 0; a < k; ++a) grad[a] = ws.solution.qdd[s.stuck[static_cast<std::size_t>(a)]];
+    }
+    benchmark::DoNotOptimize(mu.data());
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  Eigen::VectorXd mu_star;
+  exactDual(*p, task, s, &mu_star);
+  setCounters(state, *p, task.constraintRows(), k);
+  state.counters["solves"] = solves;
+  state.counters["iterations"] = iterations;
+  state.counters["converged"] = converged ? 1 : 0;
+  state.counters["mu_err"] = (mu - mu_star).cwiseAbs().maxCoeff();
+}
+
+// ---------------------------------------------------------------------------
+// Same problem for ours and KDL?
+
+struct Check {
+  double hd = 0.0, rnea = 0.0;
+};
+
+Check checkAgainstKdl(const Problem& p) {
+  Check c;
+  for (TaskKind kind : {TaskKind::None, TaskKind::Ee1, TaskKind::Ee6}) {
+    if (rowsOf(kind) > p.n) continue;  // over-constrained: damped (ours) versus truncated SVD (KDL)
+    const DynamicsInput in = makeInput(p, kind, p.qd);
+    const Task task = taskFromInput(p.model, in);
+    Workspace ws(p.model, task);
+    if (!solveHybridDynamics(p.model, task, p.q, p.qd, p.tau, ws)) return {std::nan(""), std::nan("")};
+    c.hd = std::max(c.hd, relativeError(ws.solution.qdd, kdlHybridDynamics(p.spec, in).qdd));
+  }
+  const Task task(p.model);
+  Workspace ws(p.model, task);
+  if (!inverseDynamics(p.model, task, p.q, p.qd, p.qdd, ws)) return {std::nan(""), std::nan("")};
+  c.rnea = relativeError(ws.tau, kdlInverseDynamics(p.spec, p.q, p.qd, p.qdd, p.gravity));
+  return c;
+}
+
+std::string fmt(double x) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.3g", x);
+  return buffer;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::unique_ptr<Problem>> problems;
+  try {
+    for (int n : {1, 2, 4, 7, 16, 32, 64, 128}) problems.push_back(randomProblemOfSize(n));
+    problems.push_back(pandaProblem());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "zwang_bench: %s\n", e.what());
+    return 1;
+  }
+
+  std::string checks;
+  for (const auto& p : problems) {
+    const Check c = checkAgainstKdl(*p);
+    checks += (checks.empty() ? "" : ", ") + p->label + ": qdd " + fmt(c.hd) + ", rnea " + fmt(c.rnea);
+    if (!(c.hd <= 1e-6 && c.rnea <= 1e-6))
+      std::fprintf(stderr, "zwang_bench: WARNING: ours and KDL disagree on %s (qdd %g, rnea %g)\n", p->label.c_str(),
+                   c.hd, c.rnea);
+  }
+  benchmark::AddCustomContext("zwang_check_vs_kdl_max_rel_err", checks);
+  benchmark::AddCustomContext("zwang_compiler", ZWANG_BENCH_COMPILER);
+  benchmark::AddCustomContext("zwang_cxx_flags", ZWANG_BENCH_FLAGS);
+  benchmark::AddCustomContext("zwang_build_type", ZWANG_BENCH_BUILD_TYPE);
+  benchmark::AddCustomContext("zwang_chain_seed", std::to_string(kSeed));
+
+  auto reg = [](const std::string& family, const Problem& p, auto&& fn) {
+    benchmark::RegisterBenchmark((family + "/" + p.label).c_str(), fn)->Unit(benchmark::kNanosecond);
+  };
+  const std::pair<TaskKind, const char*> hd_tasks[] = {
+      {TaskKind::None, "m0"}, {TaskKind::Ee1, "m1"}, {TaskKind::Ee6, "m6"}, {TaskKind::Split6, "m6x2"}};
+  const std::pair<TaskKind, const char*> fric_tasks[] = {{TaskKind::None, "free"}, {TaskKind::Ee6, "ee6"}};
+  const std::pair<FrictionMethod, const char*> methods[] = {{FrictionMethod::ActiveSet, "as"},
+                                                            {FrictionMethod::ProjectedGradient, "pg"}};
+
+  for (const auto& [kind, name] : hd_tasks)
+    for (const auto& p : problems)
+      reg(std::string("ours_hd_") + name, *p,
+          [q = p.get(), kind = kind](benchmark::State& s) { benchOursHybrid(s, q, kind); });
+  for (const auto& p : problems) reg("ours_rnea", *p, [q = p.get()](benchmark::State& s) { benchOursRnea(s, q); });
+  for (const auto& p : problems) reg("ours_crba", *p, [q = p.get()](benchmark::State& s) { benchOursCrba(s, q); });
+  for (const auto& [kind, name] : hd_tasks) {
+    if (kind == TaskKind::Split6) continue;  // KDL constrains the end effector only
+    for (const auto& p : problems)
+      reg(std::string("kdl_hd_") + name, *p,
+          [q = p.get(), kind = kind](benchmark::State& s) { benchKdlHybrid(s, q, kind); });
+  }
+  for (const auto& p : problems) reg("kdl_rne", *p, [q = p.get()](benchmark::State& s) { benchKdlRne(s, q); });
+
+  for (const auto& [method, method_name] : methods)
+    for (const auto& [kind, task_name] : fric_tasks)
+      for (const char* k_name : {"k0", "k1", "k2", "khalf", "kall"})
+        for (const auto& p : problems) {
+          const std::string kn = k_name;
+          const int k = kn == "k0" ? 0 : kn == "k1" ? 1 : kn == "k2" ? 2 : kn == "khalf" ? p->n / 2 : p->n;
+          if (k > p->n) continue;
+          if (kn == "khalf" && (k <= 2 || k == p->n)) continue;  // the same as another row
+          if (kn == "kall" && p->n == 1) continue;               // = k1
+          reg(std::string("fric_") + method_name + "_" + task_name + "_" + kn, *p,
+              [q = p.get(), kind = kind, k, method = method](benchmark::State& s) {
+                benchFriction(s, q, kind, k, method);
+              });
+        }
+
+  for (const auto& [kind, task_name] : fric_tasks)
+    for (int k : {1, 2})
+      for (const auto& p : problems) {
+        if (k > p->n) continue;
+        reg(std::string("grid_") + task_name + "_k" + std::to_string(k), *p,
+            [q = p.get(), kind = kind, k](benchmark::State& s) { benchGrid(s, q, kind, k); });
+      }
+  for (const auto& [kind, task_name] : fric_tasks)
+    for (int k : {1, 2})
+      for (const auto& p : problems) {
+        if (k > p->n) continue;
+        reg(std::string("naivepg_") + task_name + "_k" + std::to_string(k), *p,
+            [q = p.get(), kind = kind, k](benchmark::State& s) { benchNaiveGradient(s, q, kind, k); });
+      }
+
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,556 @@
+// Python: Workspace, Constraint, Wrench, Friction, Result, solve() and the
+// kinematics / inverse-dynamics helpers.
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+
+namespace zwang::python {
+
+static_assert(sizeof(Vec6) == 6 * sizeof(double), "Vec6 rows are viewed as a dense (n, 6) array");
+
+namespace {
+
+std::uint64_t g_next_serial = 1;  // guarded by the GIL
+
+const Vec3 kDefaultGravity(0.0, 0.0, -9.81);
+
+[[noreturn]] void raiseModelError(const std::string& where, const std::exception& e) {
+  raise(exceptions().model_error, where + ": " + e.what());
+}
+
+// Unknown frame names are reported with the model's frames.
+void checkFrame(const Model& model, const std::string& where, const std::string& frame) {
+  if (model.hasFrame(frame)) return;
+  std::string known;
+  for (const Frame& f : model.frames()) known += (known.empty() ? "" : ", ") + f.name;
+  raise(exceptions().model_error,
+        where + ": unknown frame '" + frame + "' (model '" + model.name() + "' has the frames: " + known + ")");
+}
+
+PyWorkspace& workspaceArg(const std::shared_ptr<Model>& model, py::handle ws_obj) {
+  if (!py::isinstance<PyWorkspace>(ws_obj))
+    raise(PyExc_TypeError, "ws: expected a zwang.Workspace (model.workspace()), got " +
+                               std::string(py::str(py::type::handle_of(ws_obj).attr("__name__"))));
+  PyWorkspace& pw = ws_obj.cast<PyWorkspace&>();
+  if (!model) raise(PyExc_TypeError, "model: expected a zwang.Model, got None");
+  if (pw.model.get() != model.get()) {
+    Status s = Status::error(StatusCode::ModelMismatch, "the workspace was made for model '%s', not for this model '%s'",
+                             pw.model->name().c_str(), model->name().c_str());
+    raiseStatus(s, "solve");
+  }
+  return pw;
+}
+
+int frameArg(const Model& model, py::handle frame) {
+  if (py::isinstance<py::str>(frame)) return model.frameIndex(frame.cast<std::string>());
+  if (py::isinstance<py::int_>(frame) && !py::isinstance<py::bool_>(frame)) {
+    const long f = frame.cast<long>();
+    if (f < 0 || f >= static_cast<long>(model.frames().size()))
+      raise(exceptions().model_error, "frame index " + std::to_string(f) + " is out of range (the model has " +
+                                          std::to_string(model.frames().size()) + " frames)");
+    return static_cast<int>(f);
+  }
+  raise(PyExc_TypeError, "frame: expected a frame name (str) or index (int)");
+}
+
+// The items of a list or tuple of T (a single T is taken as a list of one).
+template <class T>
+void collect(const char* name, py::handle value, std::vector<T*>& out) {
+  out.clear();
+  if (value.is_none()) return;
+  if (py::isinstance<T>(value)) {
+    out.push_back(&value.cast<T&>());
+    return;
+  }
+  if (!py::isinstance<py::list>(value) && !py::isinstance<py::tuple>(value))
+    raise(PyExc_TypeError, std::string(name) + ": expected a list of zwang." +
+                               (std::is_same_v<T, Constraint> ? "Constraint" : "Wrench") + ", got " +
+                               std::string(py::str(py::type::handle_of(value).attr("__name__"))));
+  const py::sequence seq = py::reinterpret_borrow<py::sequence>(value);
+  const std::size_t n = seq.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    py::handle item = PySequence_Fast_GET_ITEM(seq.ptr(), static_cast<py::ssize_t>(k));
+    if (!py::isinstance<T>(item))
+      raise(PyExc_TypeError, std::string(name) + "[" + std::to_string(k) + "]: expected zwang." +
+                                 (std::is_same_v<T, Constraint> ? "Constraint" : "Wrench") + ", got " +
+                                 std::string(py::str(py::type::handle_of(item).attr("__name__"))));
+    out.push_back(&item.cast<T&>());
+  }
+}
+
+template <class T>
+bool sameSerials(const std::vector<T*>& items, const std::vector<std::uint64_t>& serials) {
+  if (items.size() != serials.size()) return false;
+  for (std::size_t k = 0; k < items.size(); ++k)
+    if (items[k]->serial != serials[k]) return false;
+  return true;
+}
+
+// Reused between calls (the GIL serialises them).
+std::vector<Constraint*> g_constraints;
+std::vector<Wrench*> g_wrenches;
+
+// The workspace's task for these constraints and wrenches: rebuilt (allocating)
+// only when the objects differ from the last call; then only b, the wrench
+// values and gravity are written.
+Task& solveTask(PyWorkspace& pw, py::handle constraints, py::handle wrenches, py::handle gravity) {
+  collect("constraints", constraints, g_constraints);
+  collect("wrenches", wrenches, g_wrenches);
+  if (!pw.task_valid || !sameSerials(g_constraints, pw.constraint_serials) ||
+      !sameSerials(g_wrenches, pw.wrench_serials)) {
+    auto task = std::make_unique<Task>(*pw.model);
+    std::vector<int> first_rows;
+    for (std::size_t k = 0; k < g_constraints.size(); ++k) {
+      const Constraint& c = *g_constraints[k];
+      checkFrame(*pw.model, "constraints[" + std::to_string(k) + "]", c.frame);
+      try {
+        first_rows.push_back(task->addConstraint(c.frame, c.A, c.expressed));
+      } catch (const ModelError& e) {
+        raiseModelError("constraints[" + std::to_string(k) + "]", e);
+      }
+    }
+    for (std::size_t k = 0; k < g_wrenches.size(); ++k) {
+      checkFrame(*pw.model, "wrenches[" + std::to_string(k) + "]", g_wrenches[k]->frame);
+      try {
+        task->addWrench(g_wrenches[k]->frame, g_wrenches[k]->expressed);
+      } catch (const ModelError& e) {
+        raiseModelError("wrenches[" + std::to_string(k) + "]", e);
+      }
+    }
+    pw.ensureCapacity(task->constraintRows());
+    pw.task = std::move(task);
+    pw.constraint_rows = std::move(first_rows);
+    pw.constraint_serials.clear();
+    for (const Constraint* c : g_constraints) pw.constraint_serials.push_back(c->serial);
+    pw.wrench_serials.clear();
+    for (const Wrench* w : g_wrenches) pw.wrench_serials.push_back(w->serial);
+    pw.task_valid = true;
+  }
+  Task& task = *pw.task;
+  for (std::size_t k = 0; k < g_constraints.size(); ++k)
+    task.targets().segment(pw.constraint_rows[k], g_constraints[k]->b.size()) = g_constraints[k]->b;
+  for (std::size_t k = 0; k < g_wrenches.size(); ++k) task.wrench(static_cast<int>(k)) = g_wrenches[k]->value;
+  task.gravity = gravity.is_none() ? kDefaultGravity : vec3Arg("gravity", gravity);
+  return task;
+}
+
+Task& idTask(PyWorkspace& pw, py::handle wrenches, py::handle gravity) {
+  collect("wrenches", wrenches, g_wrenches);
+  if (!pw.id_task_valid || !sameSerials(g_wrenches, pw.id_wrench_serials)) {
+    auto task = std::make_unique<Task>(*pw.model);
+    for (std::size_t k = 0; k < g_wrenches.size(); ++k) {
+      checkFrame(*pw.model, "wrenches[" + std::to_string(k) + "]", g_wrenches[k]->frame);
+      try {
+        task->addWrench(g_wrenches[k]->frame, g_wrenches[k]->expressed);
+      } catch (const ModelError& e) {
+        raiseModelError("wrenches[" + std::to_string(k) + "]", e);
+      }
+    }
+    pw.id_task = std::move(task);
+    pw.id_wrench_serials.clear();
+    for (const Wrench* w : g_wrenches) pw.id_wrench_serials.push_back(w->serial);
+    pw.id_task_valid = true;
+  }
+  Task& task = *pw.id_task;
+  for (std::size_t k = 0; k < g_wrenches.size(); ++k) task.wrench(static_cast<int>(k)) = g_wrenches[k]->value;
+  task.gravity = gravity.is_none() ? kDefaultGravity : vec3Arg("gravity", gravity);
+  return task;
+}
+
+// q̇ or τ: None means zeros.
+Eigen::Map<const Eigen::VectorXd> optionalVector(const char* name, py::handle value, Eigen::VectorXd& buffer,
+                                                 const Eigen::VectorXd& zeros) {
+  if (value.is_none()) return {zeros.data(), zeros.size()};
+  return vectorArg(name, value, buffer);
+}
+
+const FrictionOptions* frictionArg(py::handle friction) {
+  static const FrictionOptions defaults;
+  if (friction.is_none()) return nullptr;
+  if (py::isinstance<py::bool_>(friction)) return friction.cast<bool>() ? &defaults : nullptr;
+  if (py::isinstance<Friction>(friction)) return &friction.cast<Friction&>().options;
+  raise(PyExc_TypeError, "friction: expected zwang.Friction(...), True or None, got " +
+                             std::string(py::str(py::type::handle_of(friction).attr("__name__"))));
+}
+
+Eigen::VectorXd optionalOverride(const char* name, py::handle value) {
+  if (value.is_none()) return {};
+  Eigen::VectorXd buffer;
+  return vectorArg(name, value, buffer);
+}
+
+py::object overrideArray(const Eigen::VectorXd& v) { return v.size() ? py::object(vectorCopy(v)) : py::none(); }
+
+Vec6 frameAccelerationOf(const Result& r, int frame, Expressed e) {
+  if (r.data) return (e == Expressed::Local ? r.data->frame_acc_local : r.data->frame_acc_world).row(frame).transpose();
+  r.solution();  // stale check
+  return frameAcceleration(*r.model, *r.live->ws, frame, e);
+}
+
+std::string resultRepr(const Result& r) {
+  const Solution& s = r.solution();
+  std::string text = "<zwang.Result dof=" + std::to_string(s.qdd.size()) + " rows=" + std::to_string(s.coupling.rows);
+  if (r.with_friction) text += " friction" + std::string(r.friction().indeterminate ? " (indeterminate)" : "");
+  if (s.coupling.singular) text += " singular";
+  if (r.infeasible) text += " infeasible";
+  return text + (r.data ? " copy>" : ">");
+}
+
+}  // namespace
+
+PyWorkspace::PyWorkspace(std::shared_ptr<Model> model_in, int max_constraint_rows)
+    : model(std::move(model_in)) {
+  if (!model) raise(PyExc_TypeError, "model: expected a zwang.Model, got None");
+  if (max_constraint_rows < 0) raise(PyExc_ValueError, "max_constraint_rows must be >= 0");
+  ws = std::make_unique<Workspace>(*model, max_constraint_rows);
+  const int n = model->dof();
+  q_buf.setZero(n);
+  qd_buf.setZero(n);
+  tau_buf.setZero(n);
+  qdd_buf.setZero(n);
+  zeros.setZero(n);
+}
+
+void PyWorkspace::ensureCapacity(int rows) {
+  if (rows <= ws->constraintCapacity()) return;
+  retired.push_back(std::move(ws));
+  ws = std::make_unique<Workspace>(*model, rows);
+}
+
+const Solution& Result::solution() const {
+  if (data) return data->solution;
+  if (live->generation != generation)
+    raise(exceptions().stale_error,
+          "this Result is a view on a workspace that has been used again since (solve, kinematics or dynamics); "
+          "call res.copy() before the next call to keep it");
+  return live->ws->solution;
+}
+
+const FrictionResult& Result::friction() const {
+  solution();
+  return data ? data->friction : live->ws->friction;
+}
+
+py::handle Result::base() const { return data ? data_base : owner; }
+
+void bindSolve(py::module_& m) {
+  // ---- Workspace -----------------------------------------------------------
+  py::class_<PyWorkspace>(m, "Workspace",
+                          "Scratch memory of the solver for one model (zwang::Workspace) and the task built from the\n"
+                          "last constraints/wrenches lists. One per thread. Results of solve() are views on it.")
+      .def(py::init<std::shared_ptr<Model>, int>(), py::arg("model"), py::arg("max_constraint_rows") = 6,
+           "Room for up to max_constraint_rows constraint rows; solve() grows it once if a task needs more.")
+      .def_property_readonly("model", [](const PyWorkspace& pw) { return pw.model; })
+      .def_property_readonly("dof", [](const PyWorkspace& pw) { return pw.ws->dof(); })
+      .def_property_readonly("constraint_capacity", [](const PyWorkspace& pw) { return pw.ws->constraintCapacity(); })
+      .def("__repr__", [](const PyWorkspace& pw) {
+        return "<zwang.Workspace for '" + pw.model->name() + "', " + std::to_string(pw.ws->constraintCapacity()) +
+               " constraint rows>";
+      });
+
+  auto model_class = py::reinterpret_borrow<py::class_<Model, std::shared_ptr<Model>>>(m.attr("Model"));
+  model_class.def("workspace", [](std::shared_ptr<Model> model, int rows) {
+    return std::make_unique<PyWorkspace>(std::move(model), rows);
+  }, py::arg("max_constraint_rows") = 6, "zwang.Workspace(model, max_constraint_rows)");
+
+  // ---- Constraint ----------------------------------------------------------
+  py::class_<Constraint>(m, "Constraint",
+                         "Acceleration constraint A^T Xdd = b on a frame (classical, true accelerations of the frame\n"
+                         "origin; gravity not included). A is 6×m, its columns unit constraint forces, linear part\n"
+                         "first; a 6-vector is one column. frame, A and expressed are fixed; b may be changed\n"
+                         "between solves (c.b[:] = ... or c.b = ...) without rebuilding the task.")
+      .def(py::init([](const std::string& frame, py::handle A, py::handle b, const std::string& expressed) {
+             Constraint c{g_next_serial++, frame, expressedArg("expressed", expressed, true),
+                          constraintMatrixArg("A", A), {}};
+             c.b.setZero(c.A.cols());
+             if (!b.is_none()) {
+               Eigen::VectorXd buffer;
+               const auto v = vectorArg("b", b, buffer);
+               if (v.size() != c.A.cols())
+                 raise(PyExc_ValueError, "b: has " + std::to_string(v.size()) + " entries, A has " +
+                                             std::to_string(c.A.cols()) + " columns");
+               c.b = v;
+             }
+             return c;
+           }),
+           py::arg("frame"), py::arg("A"), py::arg("b") = py::none(), py::arg("expressed") = "local")
+      .def_property_readonly("frame", [](const Constraint& c) { return c.frame; })
+      .def_property_readonly("expressed", [](const Constraint& c) { return std::string(expressedName(c.expressed)); })
+      .def_property_readonly("A", [](const Constraint& c) { return matrixCopy(c.A); }, "6×m (a copy)")
+      .def_property_readonly("rows", [](const Constraint& c) { return c.A.cols(); })
+      .def_property("b", [](py::object self) { return vectorView(self.cast<Constraint&>().b, self, true); },
+                    [](Constraint& c, py::handle value) {
+                      Eigen::VectorXd buffer;
+                      const auto v = vectorArg("b", value, buffer);
+                      if (v.size() != c.b.size())
+                        raise(PyExc_ValueError, "b: has " + std::to_string(v.size()) + " entries, the constraint has " +
+                                                    std::to_string(c.b.size()) + " rows");
+                      c.b = v;
+                    }, "set points, one per column of A (a writable view)")
+      .def("__repr__", [](const Constraint& c) {
+        return "<zwang.Constraint on '" + c.frame + "', " + std::to_string(c.A.cols()) + " rows, " +
+               expressedName(c.expressed) + ">";
+      });
+
+  // ---- Wrench --------------------------------------------------------------
+  py::class_<Wrench>(m, "Wrench",
+                     "External wrench [force; torque] acting at a frame's origin, components in the frame's axes\n"
+                     "('local') or the world axes ('world'). The value may be changed between solves.")
+      .def(py::init([](const std::string& frame, py::handle value, py::handle force, py::handle torque,
+                       const std::string& expressed) {
+             Wrench w{g_next_serial++, frame, expressedArg("expressed", expressed, false), Vec6::Zero()};
+             if (!value.is_none()) {
+               if (!force.is_none() || !torque.is_none())
+                 raise(PyExc_TypeError, "Wrench: give either value or force/torque, not both");
+               w.value = vec6Arg("value", value);
+             }
+             if (!force.is_none()) w.value.head<3>() = vec3Arg("force", force);
+             if (!torque.is_none()) w.value.tail<3>() = vec3Arg("torque", torque);
+             return w;
+           }),
+           py::arg("frame"), py::arg("value") = py::none(), py::kw_only(), py::arg("force") = py::none(),
+           py::arg("torque") = py::none(), py::arg("expressed") = "local")
+      .def_property_readonly("frame", [](const Wrench& w) { return w.frame; })
+      .def_property_readonly("expressed", [](const Wrench& w) { return std::string(expressedName(w.expressed)); })
+      .def_property("value", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data(), 6, self, true); },
+                    [](Wrench& w, py::handle v) { w.value = vec6Arg("value", v); }, "[fx, fy, fz, nx, ny, nz] (a writable view)")
+      .def_property("force", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data(), 3, self, true); },
+                    [](Wrench& w, py::handle v) { w.value.head<3>() = vec3Arg("force", v); })
+      .def_property("torque", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data() + 3, 3, self, true); },
+                    [](Wrench& w, py::handle v) { w.value.tail<3>() = vec3Arg("torque", v); })
+      .def("__repr__", [](const Wrench& w) {
+        return "<zwang.Wrench on '" + w.frame + "', " + expressedName(w.expressed) + ">";
+      });
+
+  // ---- Friction ------------------------------------------------------------
+  py::class_<Friction>(m, "Friction",
+                       "Options of the friction-aware solve (zwang::FrictionOptions). margin: when mu* is not\n"
+                       "unique, the effort-minimising choice uses at most margin*f_j. breakaway/kinetic/damping:\n"
+                       "optional per-joint overrides of the model's values.")
+      .def(py::init([](double margin, double velocity_tolerance, double limit_tolerance, bool joint_limits,
+                       const std::string& method, int max_iterations, double kkt_tolerance, py::handle breakaway,
+                       py::handle kinetic, py::handle damping) {
+             Friction f;
+             f.options.margin = margin;
+             f.options.velocity_tolerance = velocity_tolerance;
+             f.options.limit_tolerance = limit_tolerance;
+             f.options.joint_limits = joint_limits;
+             if (method == "active_set")
+               f.options.method = FrictionMethod::ActiveSet;
+             else if (method == "projected_gradient")
+               f.options.method = FrictionMethod::ProjectedGradient;
+             else
+               raise(PyExc_ValueError, "method: unknown value '" + method + "' (expected 'active_set' or 'projected_gradient')");
+             f.options.max_iterations = max_iterations;
+             f.options.kkt_tolerance = kkt_tolerance;
+             f.options.breakaway = optionalOverride("breakaway", breakaway);
+             f.options.kinetic = optionalOverride("kinetic", kinetic);
+             f.options.damping = optionalOverride("damping", damping);
+             return f;
+           }),
+           py::kw_only(), py::arg("margin") = 1.0, py::arg("velocity_tolerance") = 1e-6,
+           py::arg("limit_tolerance") = 1e-9, py::arg("joint_limits") = true, py::arg("method") = "active_set",
+           py::arg("max_iterations") = 500, py::arg("kkt_tolerance") = 1e-12, py::arg("breakaway") = py::none(),
+           py::arg("kinetic") = py::none(), py::arg("damping") = py::none())
+      .def_property_readonly("margin", [](const Friction& f) { return f.options.margin; })
+      .def_property_readonly("velocity_tolerance", [](const Friction& f) { return f.options.velocity_tolerance; })
+      .def_property_readonly("limit_tolerance", [](const Friction& f) { return f.options.limit_tolerance; })
+      .def_property_readonly("joint_limits", [](const Friction& f) { return f.options.joint_limits; })
+      .def_property_readonly("method", [](const Friction& f) {
+        return std::string(f.options.method == FrictionMethod::ActiveSet ? "active_set" : "projected_gradient");
+      })
+      .def_property_readonly("max_iterations", [](const Friction& f) { return f.options.max_iterations; })
+      .def_property_readonly("kkt_tolerance", [](const Friction& f) { return f.options.kkt_tolerance; })
+      .def_property_readonly("breakaway", [](const Friction& f) { return overrideArray(f.options.breakaway); })
+      .def_property_readonly("kinetic", [](const Friction& f) { return overrideArray(f.options.kinetic); })
+      .def_property_readonly("damping", [](const Friction& f) { return overrideArray(f.options.damping); })
+      .def("__repr__", [](const Friction& f) {
+        return "<zwang.Friction margin=" + std::string(py::str(py::float_(f.options.margin))) + ">";
+      });
+
+  // ---- Result --------------------------------------------------------------
+  py::class_<Result>(m, "Result",
+                     "What solve() computed. Arrays are read-only NumPy views on the workspace (no copy), valid\n"
+                     "until the next call on that workspace; reading a Result after that raises\n"
+                     "StaleResultError, and arrays taken earlier then show the new values. Result.copy() keeps it.")
+      .def_property_readonly("qdd", [](const Result& r) { return vectorView(r.solution().qdd, r.base()); }, "q̈")
+      .def_property_readonly("tau_constraint", [](const Result& r) { return vectorView(r.solution().tau_constraint, r.base()); },
+                             "τ_c = Σ Jᵀ A ν, the joint torques of the constraint forces")
+      .def_property_readonly("tau_control", [](const Result& r) { return vectorView(r.solution().tau_control, r.base()); },
+                             "τ + τ_c, the command for the motors")
+      .def_property_readonly("nu", [](const Result& r) { return vectorCopy(r.solution().nu); },
+                             "ν, constraint magnitudes in constraint order (a copy: its length follows the task)")
+      .def_property_readonly("gauss", [](const Result& r) { return r.solution().gauss; }, "Z(q̈)")
+      .def_property_readonly("rows", [](const Result& r) { return r.solution().coupling.rows; })
+      .def_property_readonly("rank", [](const Result& r) { return r.solution().coupling.rank; })
+      .def_property_readonly("condition", [](const Result& r) { return r.solution().coupling.condition; })
+      .def_property_readonly("damping", [](const Result& r) { return r.solution().coupling.damping; })
+      .def_property_readonly("singular", [](const Result& r) { return r.solution().coupling.singular; })
+      .def_property_readonly("body_acc_local", [](const Result& r) { return rowsView(r.solution().body_acc_local, r.base()); },
+                             "(bodies, 6) true classical accelerations of the body frames, body axes")
+      .def_property_readonly("body_acc_world", [](const Result& r) { return rowsView(r.solution().body_acc_world, r.base()); },
+                             "(bodies, 6) the same in world axes")
+      .def("frame_acceleration", [](const Result& r, py::handle frame, const std::string& expressed) {
+        return vectorCopy(frameAccelerationOf(r, frameArg(*r.model, frame), expressedArg("expressed", expressed, true)));
+      }, py::arg("frame"), py::arg("expressed") = "world", "true classical acceleration [p̈; ω̇] of a frame's origin")
+      .def_property_readonly("infeasible", [](const Result& r) { return r.infeasible; })
+      .def_property_readonly("message", [](const Result& r) { return r.message; })
+      .def_property_readonly("with_friction", [](const Result& r) { return r.with_friction; })
+      .def_property_readonly("mu", [](const Result& r) -> py::object {
+        if (!r.with_friction) return py::none();
+        return vectorView(r.friction().mu, r.base());
+      }, "μ* per joint (0 for moving joints); μ > 0 opposes positive motion. None without friction")
+      .def_property_readonly("state", [](const Result& r) -> py::object {
+        if (!r.with_friction) return py::none();
+        py::list states;
+        for (const JointState s : r.friction().state) states.append(py::str(toString(s)));
+        return std::move(states);
+      }, "per joint: 'moving', 'stick', 'slip+', 'slip-', 'at-limit'. None without friction")
+      .def_property_readonly("tau_friction", [](const Result& r) -> py::object {
+        if (!r.with_friction) return py::none();
+        return vectorView(r.friction().tau_friction, r.base());
+      })
+      .def_property_readonly("dqdd_dmu", [](const Result& r) -> py::object {
+        if (!r.with_friction) return py::none();
+        return matrixView(r.friction().dqdd_dmu, r.base());
+      })
+      .def_property_readonly("stuck", [](const Result& r) -> py::object {
+        if (!r.with_friction) return py::none();
+        return py::cast(r.friction().stuck);
+      })
+      .def_property_readonly("gauss_dual", [](const Result& r) -> py::object {
+        if (!r.with_friction) return py::none();
+        return py::float_(r.friction().gauss_dual);
+      })
+      .def_property_readonly("iterations", [](const Result& r) { return r.with_friction ? r.friction().iterations : 0; })
+      .def_property_readonly("converged", [](const Result& r) { return r.with_friction ? r.friction().converged : true; })
+      .def_property_readonly("kkt_residual", [](const Result& r) { return r.with_friction ? r.friction().kkt_residual : 0.0; })
+      .def_property_readonly("indeterminate", [](const Result& r) { return r.with_friction && r.friction().indeterminate; })
+      .def_property_readonly("limit_impact", [](const Result& r) { return r.with_friction && r.friction().limit_impact; })
+      .def_property_readonly("impact_joint", [](const Result& r) { return r.with_friction ? r.friction().impact_joint : -1; })
+      .def_property_readonly("is_copy", [](const Result& r) { return static_cast<bool>(r.data); })
+      .def("copy", [](const Result& r) {
+        auto data = std::make_shared<ResultData>();
+        data->solution = r.solution();
+        data->friction = r.friction();
+        const auto frames = static_cast<Eigen::Index>(r.model->frames().size());
+        data->frame_acc_local.resize(frames, 6);
+        data->frame_acc_world.resize(frames, 6);
+        for (int f = 0; f < frames; ++f) {
+          data->frame_acc_local.row(f) = frameAccelerationOf(r, f, Expressed::Local).transpose();
+          data->frame_acc_world.row(f) = frameAccelerationOf(r, f, Expressed::World).transpose();
+        }
+        Result copy;
+        copy.model = r.model;
+        copy.with_friction = r.with_friction;
+        copy.infeasible = r.infeasible;
+        copy.message = r.message;
+        copy.data_base = py::capsule(new std::shared_ptr<ResultData>(data),
+                                     [](void* p) { delete static_cast<std::shared_ptr<ResultData>*>(p); });
+        copy.data = std::move(data);
+        return copy;
+      }, "a detached copy that later solves do not change")
+      .def("__repr__", &resultRepr);
+
+  // ---- solve ---------------------------------------------------------------
+  m.def("solve", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
+                    py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const FrictionOptions* options = frictionArg(friction);
+    Task& task = solveTask(pw, constraints, wrenches, gravity);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
+    const auto tauv = optionalVector("tau", tau, pw.tau_buf, pw.zeros);
+    ++pw.generation;
+    const Status status = options ? solveWithFriction(*model, task, qv, qdv, tauv, *pw.ws, *options)
+                                  : solveHybridDynamics(*model, task, qv, qdv, tauv, *pw.ws);
+    const bool infeasible = status.code == StatusCode::Infeasible;
+    if (!status && !infeasible) raiseStatus(status, "solve");
+    Result r;
+    r.model = std::move(model);
+    r.owner = std::move(ws_obj);
+    r.live = &pw;
+    r.generation = pw.generation;
+    r.with_friction = options != nullptr;
+    r.infeasible = infeasible;
+    if (infeasible) {
+      r.message = status.message;
+      raiseStatus(status, "solve", py::cast(std::move(r)));
+    }
+    return r;
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
+        py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
+        py::arg("friction") = py::none(), py::arg("gravity") = py::none(),
+        "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
+        "q, qd, tau: one entry per joint (qd, tau default to zeros); float64 arrays are read in place.\n"
+        "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
+        "gravity: 3-vector, default (0, 0, -9.81). The task is rebuilt only when the constraint or wrench\n"
+        "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
+        "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions).");
+
+  // ---- kinematics and dynamics ---------------------------------------------
+  m.def("forward_kinematics", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    ++pw.generation;
+    const Status s = qd.is_none() ? forwardKinematics(*model, *pw.ws, qv)
+                                  : forwardKinematics(*model, *pw.ws, qv, vectorArg("qd", qd, pw.qd_buf));
+    if (!s) raiseStatus(s, "forward_kinematics");
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
+        "Poses (and velocities with qd) of every body into ws; then frame_pose/frame_velocity with q=None.");
+  m.def("frame_pose", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const int f = frameArg(*model, frame);
+    if (!q.is_none()) {
+      const auto qv = vectorArg("q", q, pw.q_buf);
+      ++pw.generation;
+      if (const Status s = forwardKinematics(*model, *pw.ws, qv); !s) raiseStatus(s, "frame_pose");
+    }
+    return matrixCopy(framePose(*model, *pw.ws, f).matrix());
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), "4×4 pose of the frame in the world at q");
+  m.def("frame_velocity", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd,
+                             py::handle frame, const std::string& expressed) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const int f = frameArg(*model, frame);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    const auto qdv = vectorArg("qd", qd, pw.qd_buf);
+    ++pw.generation;
+    if (const Status s = forwardKinematics(*model, *pw.ws, qv, qdv); !s) raiseStatus(s, "frame_velocity");
+    return vectorCopy(frameVelocity(*model, *pw.ws, f, expressedArg("expressed", expressed, true)));
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd"), py::arg("frame"), py::arg("expressed") = "local",
+        "classical velocity [v; ω] of the frame origin");
+  m.def("frame_jacobian", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame,
+                             const std::string& expressed) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const int f = frameArg(*model, frame);
+    const Expressed e = expressedArg("expressed", expressed, true);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    Eigen::MatrixXd J(6, model->dof());
+    ++pw.generation;
+    if (const Status s = frameJacobian(*model, *pw.ws, qv, f, e, J); !s) raiseStatus(s, "frame_jacobian");
+    return matrixCopy(J);
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), py::arg("expressed") = "local",
+        "6×dof J with frame_velocity = J qd");
+  m.def("inverse_dynamics", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd,
+                               py::handle qdd, py::handle wrenches, py::handle gravity) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    Task& task = idTask(pw, wrenches, gravity);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
+    const auto qddv = optionalVector("qdd", qdd, pw.qdd_buf, pw.zeros);
+    ++pw.generation;
+    if (const Status s = inverseDynamics(*model, task, qv, qdv, qddv, *pw.ws); !s) raiseStatus(s, "inverse_dynamics");
+    return vectorCopy(pw.ws->tau);
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("qdd") = py::none(),
+        py::kw_only(), py::arg("wrenches") = py::none(), py::arg("gravity") = py::none(),
+        "RNEA: τ = H(q) q̈ + C(q, q̇) − Σ Jᵀ F_ext (rotor inertias included), a new array");
+  m.def("joint_space_inertia", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    ++pw.generation;
+    if (const Status s = jointSpaceInertia(*model, qv, *pw.ws); !s) raiseStatus(s, "joint_space_inertia");
+    return matrixCopy(pw.ws->H);
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), "CRBA: H(q), rotor inertias included, a new array");
+}
+
+}  // namespace zwang::python

@@ -1,0 +1,34 @@
+// libFuzzer target: URDF text → loadUrdfString. The only exception allowed out
+// of the loader is ModelError; a model that loads must then solve (zero state,
+// gravity) with finite outputs or a documented error status.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "fuzz_common.hpp"
+#include "zwang/zwang.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace zwang;
+  if (size > 1 << 16) return -1;  // the loader is not meant for megabytes; keeps the fuzzer fast
+  const std::string xml(reinterpret_cast<const char*>(data), size);
+  Model model;
+  try {
+    model = loadUrdfString(xml);
+  } catch (const ModelError& e) {
+    if (e.what()[0] == '\0') fuzz::failure("ModelError without a message", "loadUrdfString");
+    return 0;
+  }
+  if (model.dof() < 1 || model.dof() > 64) return 0;
+  Task task(model);
+  Workspace ws(model, task);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.dof());
+  const Status status = solveHybridDynamics(model, task, zero, zero, zero, ws);
+  if (status.ok()) {
+    fuzz::requireFinite(ws.solution.qdd, "qdd", "solveHybridDynamics on a loaded URDF");
+    fuzz::requireFinite(ws.solution.tau_control, "tau_control", "solveHybridDynamics on a loaded URDF");
+  } else if (status.code != StatusCode::Degenerate) {
+    fuzz::failure("unexpected status on a loaded model", status.message);
+  }
+  return 0;
+}

@@ -90,6 +90,7 @@ struct PyWorkspace {
   std::vector<std::uint64_t> constraint_serials, wrench_serials;
   std::vector<int> constraint_rows;  // first row of each constraint in b
   bool task_valid = false;
+  std::uint64_t task_builds = 0;  // how often the task was (re)built: tests and docs
   // Task for inverse_dynamics (gravity and wrenches only).
   std::unique_ptr<Task> id_task;
   std::vector<std::uint64_t> id_wrench_serials;

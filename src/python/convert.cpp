@@ -15,6 +15,9 @@ std::string shapeText(const py::array& a) {
   return s + ")";
 }
 
+// float64 in the machine's byte order (a '>f8' array is converted, not read in place).
+bool isNativeFloat64(const py::array& a) { return py::isinstance<py::array_t<double>>(a); }
+
 // Any input as a NumPy array with a real (int, unsigned, float) dtype.
 py::array realArray(const char* name, py::handle value) {
   if (value.is_none()) raise(PyExc_TypeError, std::string(name) + ": expected an array of real numbers, got None");
@@ -35,7 +38,7 @@ py::array realArray(const char* name, py::handle value) {
 // Copy a real 1-D array (any dtype, any stride) into out.
 void copyReal(const char* name, const py::array& a, double* out) {
   const py::ssize_t n = a.shape(0);
-  if (a.dtype().kind() == 'f' && a.itemsize() == 8) {
+  if (isNativeFloat64(a)) {
     const auto* base = static_cast<const char*>(a.data());
     const py::ssize_t stride = a.strides(0);
     for (py::ssize_t k = 0; k < n; ++k) std::memcpy(out + k, base + k * stride, sizeof(double));
@@ -73,7 +76,9 @@ Eigen::Matrix<double, N, 1> fixedArg(const char* name, py::handle value) {
 Eigen::Map<const Eigen::VectorXd> vectorArg(const char* name, py::handle value, Eigen::VectorXd& buffer) {
   const py::array a = vectorArray(name, value);
   const py::ssize_t n = a.shape(0);
-  if (a.dtype().kind() == 'f' && a.itemsize() == 8 && (a.strides(0) == 8 || n <= 1))
+  // In place only when `value` itself is the array: an array made here from a
+  // list dies with `a`, so its numbers are copied into the buffer.
+  if (a.ptr() == value.ptr() && isNativeFloat64(a) && (a.strides(0) == 8 || n <= 1))
     return {static_cast<const double*>(a.data()), n};  // in place, no copy
   if (buffer.size() != n) buffer.resize(n);
   copyReal(name, a, buffer.data());
@@ -88,6 +93,7 @@ ConstraintMatrix constraintMatrixArg(const char* name, py::handle value) {
   if (a.ndim() == 1 && a.shape(0) == 6) {
     ConstraintMatrix A(6, 1);
     copyReal(name, a, A.data());
+    if (!A.allFinite()) raise(PyExc_ValueError, std::string(name) + ": holds a non-finite value (NaN or Inf)");
     return A;
   }
   if (a.ndim() != 2 || a.shape(0) != 6 || a.shape(1) < 1)

@@ -125,6 +125,7 @@ Task& solveTask(PyWorkspace& pw, py::handle constraints, py::handle wrenches, py
     pw.wrench_serials.clear();
     for (const Wrench* w : g_wrenches) pw.wrench_serials.push_back(w->serial);
     pw.task_valid = true;
+    ++pw.task_builds;
   }
   Task& task = *pw.task;
   for (std::size_t k = 0; k < g_constraints.size(); ++k)
@@ -243,6 +244,8 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("model", [](const PyWorkspace& pw) { return pw.model; })
       .def_property_readonly("dof", [](const PyWorkspace& pw) { return pw.ws->dof(); })
       .def_property_readonly("constraint_capacity", [](const PyWorkspace& pw) { return pw.ws->constraintCapacity(); })
+      .def_property_readonly("task_builds", [](const PyWorkspace& pw) { return pw.task_builds; },
+                             "how many times solve() built a Task (only when the constraint/wrench objects change)")
       .def("__repr__", [](const PyWorkspace& pw) {
         return "<zwang.Workspace for '" + pw.model->name() + "', " + std::to_string(pw.ws->constraintCapacity()) +
                " constraint rows>";

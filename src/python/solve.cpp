@@ -2,6 +2,9 @@
 // kinematics / inverse-dynamics helpers.
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <chrono>
+
 #include "bindings.hpp"
 
 namespace zwang::python {
@@ -490,6 +493,31 @@ void bindSolve(py::module_& m) {
         "gravity: 3-vector, default (0, 0, -9.81). The task is rebuilt only when the constraint or wrench\n"
         "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
         "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions).");
+
+  // ---- the C++ cost of a solve, for measuring the Python-call overhead -----
+  m.def("_time_cpp_solve", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd,
+                              py::handle tau, py::handle constraints, py::handle wrenches, py::handle friction,
+                              py::handle gravity, int repeat) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const FrictionOptions* options = frictionArg(friction);
+    const Task& task = solveTask(pw, constraints, wrenches, gravity);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
+    const auto tauv = optionalVector("tau", tau, pw.tau_buf, pw.zeros);
+    ++pw.generation;
+    Status status;
+    const auto start = std::chrono::steady_clock::now();
+    for (int k = 0; k < repeat; ++k)
+      status = options ? solveWithFriction(*model, task, qv, qdv, tauv, *pw.ws, *options)
+                       : solveHybridDynamics(*model, task, qv, qdv, tauv, *pw.ws);
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    if (!status) raiseStatus(status, "_time_cpp_solve");
+    return elapsed.count() / std::max(repeat, 1);
+  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
+        py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
+        py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("repeat") = 1000,
+        "Seconds per call of the C++ solve alone (same arguments as solve), looped in C++: the baseline for\n"
+        "the Python-call overhead in docs/python.md. Not part of the API.");
 
   // ---- kinematics and dynamics ---------------------------------------------
   m.def("forward_kinematics", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd) {

@@ -47,38 +47,142 @@ void jacobiEigen(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::VectorXd> lamb
   lambda = A.diagonal();
 }
 
+namespace {
+
+// Lower Cholesky factor C of the lower triangle of A (C Cᵀ = A); false when a
+// pivot is not positive.
+bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C) {
+  const Eigen::Index m = A.rows();
+  for (Eigen::Index j = 0; j < m; ++j) {
+    double d = A(j, j);
+    for (Eigen::Index k = 0; k < j; ++k) d -= C(j, k) * C(j, k);
+    if (!(d > 0.0)) return false;
+    const double cjj = std::sqrt(d);
+    C(j, j) = cjj;
+    for (Eigen::Index i = j + 1; i < m; ++i) {
+      double s = A(i, j);
+      for (Eigen::Index k = 0; k < j; ++k) s -= C(i, k) * C(j, k);
+      C(i, j) = s / cjj;
+    }
+  }
+  return true;
+}
+
+// x ← (C Cᵀ)⁻¹ x, forward then backward substitution.
+void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::VectorXd> x) {
+  const Eigen::Index m = C.rows();
+  for (Eigen::Index i = 0; i < m; ++i) {
+    double s = x[i];
+    for (Eigen::Index k = 0; k < i; ++k) s -= C(i, k) * x[k];
+    x[i] = s / C(i, i);
+  }
+  for (Eigen::Index i = m - 1; i >= 0; --i) {
+    double s = x[i];
+    for (Eigen::Index k = i + 1; k < m; ++k) s -= C(k, i) * x[k];
+    x[i] = s / C(i, i);
+  }
+}
+
+// ‖A‖_F of a symmetric matrix from its lower triangle.
+double symmetricFrobenius(const Eigen::Ref<const Eigen::MatrixXd>& A) {
+  double s = 0.0;
+  for (Eigen::Index j = 0; j < A.cols(); ++j) {
+    s += A(j, j) * A(j, j);
+    for (Eigen::Index i = j + 1; i < A.rows(); ++i) s += 2.0 * A(i, j) * A(i, j);
+  }
+  return std::sqrt(s);
+}
+
+// ‖(C Cᵀ)⁻¹‖_F = ‖Wᵀ W‖_F with W = C⁻¹ (lower). W overwrites the strict upper
+// triangle of C transposed, so C itself stays usable: W(i, j) for i ≥ j is kept
+// in C(j, i) for i > j and in `diag`(i) for i = j.
+double inverseFrobenius(Eigen::Ref<Eigen::MatrixXd> C, Eigen::Ref<Eigen::VectorXd> diag) {
+  const Eigen::Index m = C.rows();
+  auto W = [&](Eigen::Index i, Eigen::Index j) -> double& { return i == j ? diag[i] : C(j, i); };
+  for (Eigen::Index j = 0; j < m; ++j) {
+    W(j, j) = 1.0 / C(j, j);
+    for (Eigen::Index i = j + 1; i < m; ++i) {  // row i of C W = e_i: Σ_k C(i,k) W(k,j) = 0
+      double s = 0.0;
+      for (Eigen::Index k = j; k < i; ++k) s += C(i, k) * W(k, j);
+      W(i, j) = -s / C(i, i);
+    }
+  }
+  double s = 0.0;  // (WᵀW)(a, b) = Σ_{k ≥ max(a,b)} W(k,a) W(k,b)
+  for (Eigen::Index a = 0; a < m; ++a)
+    for (Eigen::Index b = a; b < m; ++b) {
+      double p = 0.0;
+      for (Eigen::Index k = b; k < m; ++k) p += W(k, a) * W(k, b);
+      s += (a == b ? 1.0 : 2.0) * p * p;
+    }
+  return std::sqrt(s);
+}
+
+}  // namespace
+
 CouplingDiagnostics solveBalance(Eigen::Ref<Eigen::MatrixXd> L, const Eigen::Ref<const Eigen::VectorXd>& r,
-                                 Eigen::Ref<Eigen::VectorXd> nu, Eigen::Ref<Eigen::MatrixXd> V,
+                                 Eigen::Ref<Eigen::VectorXd> nu, Eigen::Ref<Eigen::MatrixXd> factor,
                                  Eigen::Ref<Eigen::VectorXd> lambda, Eigen::Ref<Eigen::VectorXd> tmp,
-                                 const BalanceOptions& options) {
+                                 const BalanceOptions& options, bool& by_eigen) {
   CouplingDiagnostics d;
   d.rows = static_cast<int>(L.rows());
+  by_eigen = false;
   if (d.rows == 0) return d;
 
-  jacobiEigen(L, lambda, V);
+  // Fast path: a Cholesky factor and a certificate that 𝓛 is regular. With
+  // κ_F = ‖𝓛‖_F‖𝓛⁻¹‖_F ≥ λ_max/λ_min, κ_F < 1/threshold means λ_min above
+  // threshold·λ_max: not singular, rank m, no damping, ν = 𝓛⁻¹ r exactly.
+  if (cholesky(L, factor)) {
+    const double kappa = symmetricFrobenius(L) * inverseFrobenius(factor, lambda);
+    if (std::isfinite(kappa) && kappa * options.singular_threshold < 1.0) {
+      d.rank = d.rows;
+      d.condition = kappa;
+      nu = r;
+      choleskySolveInPlace(factor, nu);
+      return d;
+    }
+  }
+
+  by_eigen = true;
+  for (Eigen::Index j = 0; j < L.cols(); ++j)  // the full symmetric matrix from its lower triangle
+    for (Eigen::Index i = j + 1; i < L.rows(); ++i) L(j, i) = L(i, j);
+  jacobiEigen(L, lambda, factor);
   const double lambda_max = std::max(0.0, lambda.maxCoeff());
   const double lambda_min = std::max(0.0, lambda.minCoeff());
   const double threshold = options.singular_threshold * lambda_max;
   d.rank = 0;
   for (Eigen::Index k = 0; k < lambda.size(); ++k)
     if (lambda_max > 0.0 && lambda[k] > threshold) ++d.rank;
-  d.condition = lambda_min > 0.0 ? lambda_max / lambda_min : std::numeric_limits<double>::infinity();
+  // The same κ_F as the fast path, from the eigenvalues.
+  d.condition = lambda_min > 0.0 ? std::sqrt(lambda.squaredNorm() * lambda.cwiseInverse().squaredNorm())
+                                 : std::numeric_limits<double>::infinity();
   d.singular = lambda_max <= 0.0 || lambda_min <= threshold;
   if (d.singular && lambda_max > 0.0) {
     const double x = threshold > 0.0 ? lambda_min / threshold : 0.0;
     d.damping = options.max_damping * lambda_max * std::sqrt(std::max(0.0, 1.0 - x * x));
   }
+  (void)tmp;
+  balanceApply(factor, lambda, true, d.damping, r, nu);
+  return d;
+}
 
-  // ν = Σ_k σ_k/(σ_k² + λ²) (e_kᵀ r) e_k; with λ = 0 this is exactly 𝓛⁻¹ r.
-  tmp.noalias() = V.transpose() * r;
-  const double damping2 = d.damping * d.damping;
-  for (Eigen::Index k = 0; k < tmp.size(); ++k) {
+void balanceApply(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::Ref<const Eigen::VectorXd>& lambda,
+                  bool by_eigen, double damping, const Eigen::Ref<const Eigen::VectorXd>& r,
+                  Eigen::Ref<Eigen::VectorXd> out) {
+  if (!by_eigen) {
+    out = r;
+    // The factor's strict upper triangle holds scratch (inverseFrobenius):
+    // choleskySolveInPlace reads the lower triangle and the diagonal only.
+    choleskySolveInPlace(factor, out);
+    return;
+  }
+  // out = Σ_k σ_k/(σ_k² + λ²) (e_kᵀ r) e_k; with λ = 0 this is exactly 𝓛⁻¹ r.
+  const double damping2 = damping * damping;
+  out.setZero();
+  for (Eigen::Index k = 0; k < lambda.size(); ++k) {
     const double s = std::max(0.0, lambda[k]);
     const double denominator = s * s + damping2;
-    tmp[k] = denominator > 0.0 ? tmp[k] * s / denominator : 0.0;
+    if (denominator > 0.0) out += factor.col(k) * (factor.col(k).dot(r) * s / denominator);
   }
-  nu.noalias() = V * tmp;
-  return d;
 }
 
 }  // namespace zwang::internal

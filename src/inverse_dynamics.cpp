@@ -16,18 +16,18 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
   const int N = model.dof();
   auto at = [](int i) { return static_cast<std::size_t>(i); };
 
-  internal::outwardKinematics(model, q, qd, ws);
-  ws.a[0] = internal::gravityShift(ws, 0, task.gravity);  // gravity as base acceleration
+  // In base coordinates (src/internal/sweeps.hpp): no transforms between bodies.
+  internal::outwardKinematics(model, q, qd, ws, true);
+  ws.a[0] = internal::gravityAcceleration(task.gravity);  // gravity as base acceleration
   for (int i = 1; i <= N; ++i) {
-    const RigidInertia& I = model.inertia(i);
-    ws.a[at(i)] = ws.Xup[at(i)].applyMotion(ws.a[at(i - 1)]) + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
-    ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], I * ws.v[at(i)]);
+    ws.a[at(i)] = ws.a[at(i - 1)] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
+    ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);
   }
   internal::applyExternalWrenches(model, task, ws);
-  for (int i = 1; i <= N; ++i) ws.f[at(i)] = model.inertia(i) * ws.a[at(i)] + ws.Fbias[at(i)];
+  for (int i = 1; i <= N; ++i) ws.f[at(i)] = ws.I[at(i)] * ws.a[at(i)] + ws.Fbias[at(i)];
   for (int i = N; i >= 1; --i) {
     ws.tau[i - 1] = ws.S[at(i)].dot(ws.f[at(i)]) + model.joint(i - 1).rotor_inertia * qdd[i - 1];
-    if (i > 1) ws.f[at(i - 1)] += ws.Xup[at(i)].inverseApplyForce(ws.f[at(i)]);
+    if (i > 1) ws.f[at(i - 1)] += ws.f[at(i)];
   }
   return {};
 }
@@ -39,16 +39,13 @@ Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::Vecto
   if (Status s = internal::checkVector("q", q, model.dof()); !s) return s;
   const int N = model.dof();
   auto at = [](int i) { return static_cast<std::size_t>(i); };
-  internal::outwardKinematics(model, q, Eigen::VectorXd(), ws);
-  for (int i = 1; i <= N; ++i) ws.Ic[at(i)] = model.inertia(i).matrix();
+  internal::outwardKinematics(model, q, Eigen::VectorXd(), ws, true);
+  for (int i = 1; i <= N; ++i) ws.Ic[at(i)] = ws.I[at(i)].matrix();
   for (int i = N; i >= 1; --i) {
-    if (i > 1) ws.Ic[at(i - 1)] += ws.Xup[at(i)].inverseApplyInertia(ws.Ic[at(i)]);
-    Vec6 F = ws.Ic[at(i)] * ws.S[at(i)];
+    if (i > 1) ws.Ic[at(i - 1)] += ws.Ic[at(i)];  // base coordinates: composite inertias add
+    const Vec6 F = ws.Ic[at(i)] * ws.S[at(i)];
     ws.H(i - 1, i - 1) = ws.S[at(i)].dot(F) + model.joint(i - 1).rotor_inertia;
-    for (int j = i; j > 1; --j) {
-      F = ws.Xup[at(j)].inverseApplyForce(F);
-      ws.H(i - 1, j - 2) = ws.H(j - 2, i - 1) = ws.S[at(j - 1)].dot(F);
-    }
+    for (int j = i - 1; j >= 1; --j) ws.H(i - 1, j - 1) = ws.H(j - 1, i - 1) = ws.S[at(j)].dot(F);
   }
   return {};
 }

@@ -15,9 +15,9 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   solution.body_acc_local.assign(bodies, Vec6::Zero());
   solution.body_acc_world.assign(bodies, Vec6::Zero());
 
-  Xup.assign(bodies, Transform{});
   Xworld.assign(bodies, Transform{});
   S.assign(bodies, Vec6::Zero());
+  I.assign(bodies, RigidInertia{});
   v.assign(bodies, Vec6::Zero());
   c.assign(bodies, Vec6::Zero());
   Fbias.assign(bodies, Vec6::Zero());
@@ -27,12 +27,12 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   D.assign(bodies, 0.0);
   u.assign(bodies, 0.0);
   SA.setZero(m, static_cast<Eigen::Index>(bodies));
-  Ahat.assign(bodies, ConstraintMatrix::Zero(6, m));
+  Ahat.setZero(6, m);
   U.setZero(m);
   L.setZero(m, m);
   A_body.setZero(6, m);
   b_body.setZero(m);
-  eigvec.setZero(m, m);
+  balance_factor.setZero(m, m);
   eigval.setZero(m);
   rhs.setZero(m);
   nu.setZero(m);

@@ -22,7 +22,10 @@ struct FrictionScratch;
 struct CouplingDiagnostics {
   int rows = 0;             // m, the number of constraint rows
   int rank = 0;             // eigenvalues of L above singular_threshold·λ_max
-  double condition = 1.0;   // λ_max / λ_min (infinite when λ_min ≤ 0)
+  // Frobenius condition number ‖L‖_F ‖L⁻¹‖_F (infinite when L is singular):
+  // at least λ_max/λ_min and at most m times it. Computed from the Cholesky
+  // factor in the usual case, from the eigenvalues near a singularity.
+  double condition = 1.0;
   double damping = 0.0;     // λ used in ν = (L² + λ²)⁻¹ L r; 0 when not singular
   bool singular = false;    // the task asked for more than the robot can do here
 };
@@ -59,39 +62,45 @@ class Workspace {
   Solution solution;
   FrictionResult friction;  // filled by solveWithFriction
 
+  // Every spatial quantity below is in BASE coordinates: world axes, referred
+  // to the world origin (docs/solver.md, "Coordinates"). Algorithm 1's
+  // transforms ⁱX_{i−1} between bodies are then identities.
+
   // --- outward sweep: poses, velocities, bias terms (Algorithm 1, lines 2–10)
-  std::vector<Transform> Xup;     // ⁱX_{i−1}(q_i)
-  std::vector<Transform> Xworld;  // ⁱX_0, world → body i
-  std::vector<Vec6> S;            // S_i, motion subspace in body i
-  std::vector<Vec6> v;            // Ẋ_i
-  std::vector<Vec6> c;            // Ẍ_bias,i = Ẋ_i × S_i q̇_i
-  std::vector<Vec6> Fbias;        // F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
+  std::vector<Transform> Xworld;     // ⁱX₀, world → body i
+  std::vector<Vec6> S;               // S_i, motion subspace
+  std::vector<RigidInertia> I;       // I_i, body inertia
+  std::vector<Vec6> v;               // Ẋ_i
+  std::vector<Vec6> c;               // Ẍ_bias,i = Ẋ_i × S_i q̇_i
+  std::vector<Vec6> Fbias;           // F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
 
   // --- inward sweep: articulated quantities (lines 11–22)
-  std::vector<Mat6> IA;                // I^A_i
-  std::vector<Vec6> FA;                // F^A_bias,i
-  std::vector<Vec6> IAS;               // I^A_i S_i
-  std::vector<double> D;               // D_i = d_i + S_iᵀ I^A_i S_i
-  std::vector<double> u;               // τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
-  Eigen::MatrixXd SA;                  // column i: (S_iᵀ A_i)ᵀ, capacity × bodies
-  std::vector<ConstraintMatrix> Ahat;  // A_i: unit constraint forces felt at body i (6 × capacity)
-  Eigen::VectorXd U;                   // U_0, acceleration energy of bias forces and torques
-  Eigen::MatrixXd L;                   // 𝓛_0, constraint coupling matrix (capacity²)
+  std::vector<Mat6> IA;              // I^A_i
+  std::vector<Vec6> FA;              // F^A_bias,i
+  std::vector<Vec6> IAS;             // I^A_i S_i
+  std::vector<double> D;             // D_i = d_i + S_iᵀ I^A_i S_i
+  std::vector<double> u;             // τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
+  Eigen::MatrixXd SA;                // column i: (S_iᵀ A_i)ᵀ, capacity × bodies
+  ConstraintMatrix Ahat;             // A_i (6 × capacity), updated in place from A_N down to A_0
+  Eigen::VectorXd U;                 // U_0, acceleration energy of bias forces and torques
+  Eigen::MatrixXd L;                 // 𝓛_0, constraint coupling matrix (capacity², lower triangle)
 
-  // --- the task in body form, solver column order (see Task::groups)
-  ConstraintMatrix A_body;  // columns of each constraint, as forces on its body, in body axes
-  Eigen::VectorXd b_body;   // set points as spatial accelerations of the gravity-shifted sweep
+  // --- the task in sweep form, solver column order (see Task::groups)
+  ConstraintMatrix A_body;  // columns of each constraint, as unit forces on its body
+  Eigen::VectorXd b_body;   // set points as the sweep's (gravity-shifted, spatial) accelerations
 
-  // --- balance (line 25)
-  Eigen::MatrixXd eigvec;   // eigenvectors of 𝓛
-  Eigen::VectorXd eigval;
+  // --- balance (line 25): 𝓛 = C Cᵀ (Cholesky, lower C) when certified regular,
+  // else its eigen-decomposition (src/coupling.cpp)
+  Eigen::MatrixXd balance_factor;  // C, or the eigenvectors of 𝓛 when balance_by_eigen
+  Eigen::VectorXd eigval;          // eigenvalues of 𝓛 when balance_by_eigen (else scratch)
+  bool balance_by_eigen = false;
   Eigen::VectorXd rhs;      // b − A_0ᵀẌ_0 − U_0
   Eigen::VectorXd nu;       // ν in solver order
   Eigen::VectorXd scratch;
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
-  std::vector<Vec6> a;      // Ẍ_i of the sweep (true acceleration + gravity shift)
-  std::vector<Vec6> f;      // accumulated forces for τ_c, RNEA
+  std::vector<Vec6> a;      // Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])
+  std::vector<Vec6> f;      // accumulated forces (RNEA)
 
   // --- other algorithms
   std::vector<Mat6> Ic;     // composite inertias (CRBA)

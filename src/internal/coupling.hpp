@@ -7,13 +7,25 @@
 namespace zwang::internal {
 
 // Solves 𝓛 ν = r for the symmetric positive semi-definite m×m matrix `L`
-// (overwritten) by a cyclic Jacobi eigen-decomposition into `V`, `lambda`;
-// uses `tmp` (m) as scratch. No allocation: all arguments are views of
+// (only its lower triangle is read; it is overwritten). Two ways, recorded in
+// `by_eigen` so that balanceApply can reuse the factorisation:
+//  * Cholesky 𝓛 = C Cᵀ (C lower, into `factor`) when 𝓛 is certified regular:
+//    its Frobenius condition number ‖𝓛‖_F‖𝓛⁻¹‖_F, an upper bound of
+//    λ_max/λ_min, is below 1/singular_threshold. The usual case, O(m³).
+//  * otherwise eigenpairs (σ_k, e_k) by cyclic Jacobi (eigenvectors into
+//    `factor`, eigenvalues into `lambda`) and the documented damping rule.
+// `tmp` (m) is scratch. No allocation: all arguments are views of
 // preallocated workspace memory.
 CouplingDiagnostics solveBalance(Eigen::Ref<Eigen::MatrixXd> L, const Eigen::Ref<const Eigen::VectorXd>& r,
-                                 Eigen::Ref<Eigen::VectorXd> nu, Eigen::Ref<Eigen::MatrixXd> V,
+                                 Eigen::Ref<Eigen::VectorXd> nu, Eigen::Ref<Eigen::MatrixXd> factor,
                                  Eigen::Ref<Eigen::VectorXd> lambda, Eigen::Ref<Eigen::VectorXd> tmp,
-                                 const BalanceOptions& options);
+                                 const BalanceOptions& options, bool& by_eigen);
+
+// out = 𝓛⁺_λ r with the factorisation and damping of the last solveBalance
+// (exactly 𝓛⁻¹ r when regular). `out` must not alias `r`.
+void balanceApply(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::Ref<const Eigen::VectorXd>& lambda,
+                  bool by_eigen, double damping, const Eigen::Ref<const Eigen::VectorXd>& r,
+                  Eigen::Ref<Eigen::VectorXd> out);
 
 // Symmetric eigen-decomposition A = V diag(λ) Vᵀ by cyclic Jacobi rotations
 // (accurate for small matrices, no allocation). A is overwritten.

@@ -22,13 +22,13 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 // Fails (Degenerate) when a joint has no inertia to move.
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws);
 
-// Line 25: ν = 𝓛⁻¹(b − A₀ᵀẌ₀ − U₀) into ws.nu (solver order), diagonalising 𝓛
-// (kept in ws.eigvec / ws.eigval for balanceSolve) and filling
-// ws.solution.coupling.
+// Line 25: ν = 𝓛⁻¹(b − A₀ᵀẌ₀ − U₀) into ws.nu (solver order), factoring 𝓛
+// (kept in ws.balance_factor for balanceSolve) and filling ws.solution.coupling.
 void balance(const Task& task, Workspace& ws);
 
 // ν for another right-hand side r with the factorisation and damping of the
-// last balance(): out = Σ σ_k/(σ_k² + λ²)(e_kᵀ r) e_k. `out` and `r` have m rows.
+// last balance() (𝓛⁻¹ r, or the damped Σ σ_k/(σ_k² + λ²)(e_kᵀ r) e_k when
+// singular). `out` and `r` have m rows and must not alias.
 void balanceSolve(const Workspace& ws, int m, const VectorRef& r, Eigen::Ref<Eigen::VectorXd> out);
 
 // Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.

@@ -1,42 +1,65 @@
 // Pieces shared by several algorithms (not installed).
+//
+// Every algorithm works in BASE coordinates: spatial vectors and inertias of
+// all bodies are expressed in the world axes and referred to the world origin
+// (Featherstone, RBDA §4; Pinocchio's "world" convention). The body-to-body
+// transforms ⁱX_{i−1} of the recursions are then identities: inertias and
+// forces are summed, not transformed, on the way in. Only each body's pose
+// ⁱX₀, its motion subspace S_i and its inertia I_i are mapped to the base once
+// per sweep.
 #pragma once
 
 #include "zwang/workspace.hpp"
 
 namespace zwang::internal {
 
-// Outward sweep of poses, velocities and velocity-product accelerations
-// (Algorithm 1, lines 3–6): Xup, Xworld, S, v, c. q̇ may be zero-length to skip
-// velocities.
+// Outward sweep (Algorithm 1, lines 3–6, in base coordinates): poses ⁱX₀,
+// motion subspaces S_i, velocities Ẋ_i = Ẋ_{i−1} + S_i q̇_i, velocity-product
+// accelerations Ẍ_bias,i = Ẋ_i × S_i q̇_i, and, when `with_inertia`, the body
+// inertias I_i. q̇ may be zero-length to skip velocities.
 void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
-                       const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws);
+                       const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia);
+
+// ᶠX₀ of a frame, after outwardKinematics.
+inline Transform framePlacementInBase(const Model& model, const Workspace& ws, int frame) {
+  const Frame& f = model.frame(frame);
+  return f.placement * ws.Xworld[static_cast<std::size_t>(f.body)];
+}
 
 // World-frame rotation ᵂR_f of a frame, after outwardKinematics.
 inline Mat3 frameRotation(const Model& model, const Workspace& ws, int frame) {
-  const Frame& f = model.frame(frame);
-  return (f.placement * ws.Xworld[static_cast<std::size_t>(f.body)]).E.transpose();
+  return framePlacementInBase(model, ws, frame).E.transpose();
 }
 
-// A spatial force given at a frame's origin (local or world axes) as a force
-// on the frame's body, in body coordinates.
-inline Vec6 wrenchOnBody(const Model& model, const Workspace& ws, int frame, Expressed expressed, const Vec6& w) {
-  const Frame& f = model.frame(frame);
-  Vec6 local = w;
-  if (expressed != Expressed::Local) {
-    const Mat3 Rt = frameRotation(model, ws, frame).transpose();
-    local << Rt * w.head<3>(), Rt * w.tail<3>();
-  }
-  return f.placement.inverseApplyForce(local);
+// A spatial force given at a frame's origin (local or world axes), in base
+// coordinates: [f; n + p × f] with p the frame origin, all in world axes.
+inline Vec6 wrenchInBase(const Model& model, const Workspace& ws, int frame, Expressed expressed, const Vec6& w) {
+  const Transform X = framePlacementInBase(model, ws, frame);
+  if (expressed == Expressed::Local) return X.inverseApplyForce(w);
+  Vec6 out = w;
+  out.tail<3>() += X.r.cross(w.head<3>());
+  return out;
 }
 
-// Subtract the task's external wrenches from Fbias (line 7: F_bias −= ⁱX₀* F_ext).
+// Subtract the task's external wrenches from Fbias (line 7: F_bias −= F_ext).
 void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws);
 
-// Gravity as the base acceleration Ẍ₀ = [−g; 0] (SPEC): its shift of body i's
-// sweep acceleration, ⁱX₀ Ẍ₀.
-inline Vec6 gravityShift(const Workspace& ws, int body, const Vec3& gravity) {
+// Gravity as the base acceleration Ẍ₀ = [−g; 0] (SPEC). In base coordinates it
+// is the same 6-vector for every body.
+inline Vec6 gravityAcceleration(const Vec3& gravity) {
   Vec6 out;
-  out << ws.Xworld[static_cast<std::size_t>(body)].E * (-gravity), Vec3::Zero();
+  out << -gravity, Vec3::Zero();
+  return out;
+}
+
+// Classical acceleration [linear of point p; angular], world axes, from a
+// true spatial acceleration `a` and velocity `v` in base coordinates:
+// a_p = a_lin + α × p + ω × (v_lin + ω × p).
+inline Vec6 classicalAtPoint(const Vec6& a, const Vec6& v, const Vec3& p) {
+  const Vec3 w = v.tail<3>();
+  const Vec3 vp = v.head<3>() + w.cross(p);
+  Vec6 out;
+  out << a.head<3>() + a.tail<3>().cross(p) + w.cross(vp), a.tail<3>();
   return out;
 }
 

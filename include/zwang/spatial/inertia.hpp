@@ -34,6 +34,14 @@ struct RigidInertia {
   RigidInertia operator+(const RigidInertia& o) const { return {mass + o.mass, h + o.h, Ibar + o.Ibar}; }
   RigidInertia& operator+=(const RigidInertia& o) { return *this = *this + o; }
 
+  // M += this inertia's 6×6 matrix.
+  void addTo(Mat6& M) const {
+    M.diagonal().head<3>().array() += mass;
+    M.topRightCorner<3, 3>() -= skew(h);
+    M.bottomLeftCorner<3, 3>() += skew(h);
+    M.bottomRightCorner<3, 3>() += Ibar;
+  }
+
   Mat6 matrix() const {
     Mat6 I;
     I.topLeftCorner<3, 3>() = mass * Mat3::Identity();

@@ -58,20 +58,48 @@ struct Transform {
     for (Eigen::Index k = 0; k < F.cols(); ++k) out.col(k) = inverseApplyForce(F.col(k));
   }
 
-  // Xᵀ I X: a 6×6 (articulated, symmetric) inertia given in B, expressed in A.
-  // Done with 3×3 blocks: X = blkdiag(E,E)·[1 −r×; 0 1].
+  // Xᵀ I X: a 6×6 symmetric (articulated) inertia given in B, expressed in A.
+  // With I = [M H; Hᵀ C] and X = blkdiag(E,E)·[1 −r×; 0 1]: rotate the blocks
+  // (M' = EᵀME, H' = EᵀHE, C' = EᵀCE), then shift:
+  //   Xᵀ I X = [M'  P; Pᵀ  C' + r×P − H'ᵀr×],  P = H' − M' r×.
+  // Only the lower triangle of I's diagonal blocks is read.
   Mat6 inverseApplyInertia(const Mat6& I) const {
-    const Mat3 Et = E.transpose();
-    const Mat3 M11 = Et * I.topLeftCorner<3, 3>() * E;
-    const Mat3 M12 = Et * I.topRightCorner<3, 3>() * E;
-    const Mat3 M22 = Et * I.bottomRightCorner<3, 3>() * E;
-    const Mat3 R = skew(r);
-    const Mat3 top_right = M12 - M11 * R;  // M11(−r×) + M12
+    const Mat3 M = rotateSymmetric(I.topLeftCorner<3, 3>());
+    const Mat3 C = rotateSymmetric(I.bottomRightCorner<3, 3>());
+    Mat3 H;
+    H.noalias() = E.transpose() * (I.topRightCorner<3, 3>() * E);
+    Mat3 P;  // H' − M' r×: row k of M'·r× is (m_k × r)ᵀ, M' symmetric so m_k = column k
+    for (int k = 0; k < 3; ++k) P.row(k) = H.row(k) - M.col(k).cross(r).transpose();
     Mat6 out;
-    out.topLeftCorner<3, 3>() = M11;
-    out.topRightCorner<3, 3>() = top_right;
-    out.bottomLeftCorner<3, 3>() = top_right.transpose();
-    out.bottomRightCorner<3, 3>() = R * top_right - M12.transpose() * R + M22;
+    out.topLeftCorner<3, 3>() = M;
+    out.topRightCorner<3, 3>() = P;
+    out.bottomLeftCorner<3, 3>() = P.transpose();
+    // r×P column j is r × p_j; row i of H'ᵀ r× is (h'_i × r)ᵀ with h'_i column i of H'.
+    Mat3 Q;
+    for (int j = 0; j < 3; ++j) Q.col(j) = r.cross(P.col(j));
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 w = H.col(i).cross(r);
+      for (int j = 0; j <= i; ++j) {
+        const double value = C(i, j) + Q(i, j) - w[j];
+        out(3 + i, 3 + j) = value;
+        out(3 + j, 3 + i) = value;
+      }
+    }
+    return out;
+  }
+
+  // Eᵀ S E for a symmetric 3×3 S (lower triangle read), symmetric result.
+  template <class Sym>
+  Mat3 rotateSymmetric(const Sym& S) const {
+    Mat3 full;
+    full << S(0, 0), S(1, 0), S(2, 0),  //
+        S(1, 0), S(1, 1), S(2, 1),      //
+        S(2, 0), S(2, 1), S(2, 2);
+    Mat3 SE;
+    SE.noalias() = full * E;
+    Mat3 out;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j <= i; ++j) out(i, j) = out(j, i) = E.col(i).dot(SE.col(j));
     return out;
   }
 

@@ -3,6 +3,8 @@
 // results stay finite, the coupling matrix says it is singular, and the
 // constraints hold in the least-squares sense (compared with the dense
 // reference's G q̈ = γ).
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <catch2/catch.hpp>
 
@@ -153,4 +155,44 @@ TEST_CASE("a constraint on the fixed base changes nothing and is reported singul
   CHECK(ws.solution.coupling.rank == 0);
   CHECK(ws.solution.nu.norm() == 0.0);
   CHECK((ws.solution.qdd - free_qdd).norm() < 1e-12);
+}
+
+TEST_CASE("coupling diagnostics: Frobenius condition number of 𝓛 against the dense G H⁻¹ Gᵀ") {
+  // 𝓛 is the dense G H⁻¹ Gᵀ up to a permutation of rows (solver order), so
+  // κ_F = ‖𝓛‖_F ‖𝓛⁻¹‖_F must match whichever way the solver factored it.
+  std::mt19937_64 rng(17);
+  RandomChainOptions chain_options;
+  chain_options.max_moving_joints = 8;
+  int tested = 0;
+  double worst = 0.0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const ChainSpec spec = randomChain(rng, chain_options);
+    RandomProblemOptions options;
+    options.max_constraint_rows = 6;
+    DynamicsInput in = randomProblem(rng, spec, options);
+    const int m = in.constraintRows();
+    if (m == 0 || m > spec.dof()) continue;
+    const DenseResult ref = denseDynamics(spec, in);
+    const Eigen::MatrixXd Ld = ref.G * ref.H.fullPivLu().solve(ref.G.transpose());
+    const Eigen::MatrixXd Ls = 0.5 * (Ld + Ld.transpose());
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Ls);
+    const double lmin = eig.eigenvalues().minCoeff(), lmax = eig.eigenvalues().maxCoeff();
+    if (!(lmin > 1e-7 * lmax)) continue;  // the dense reference itself loses digits beyond that
+    ++tested;
+    const double kappa_f = Ls.norm() * Ls.inverse().norm();
+    const Model model = modelFromSpec(spec);
+    const Task task = taskFromInput(model, in);
+    Workspace ws(model, task);
+    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    const CouplingDiagnostics& d = ws.solution.coupling;
+    CHECK_FALSE(d.singular);
+    CHECK(d.rank == m);
+    CHECK(d.damping == 0.0);
+    CHECK(d.condition >= lmax / lmin * (1.0 - 1e-6));
+    CHECK(d.condition <= m * lmax / lmin * (1.0 + 1e-6));
+    worst = std::max(worst, std::abs(d.condition - kappa_f) / kappa_f);
+  }
+  INFO("tested " << tested << ", worst relative difference " << worst);
+  CHECK(tested >= 60);
+  CHECK(worst < 1e-5);
 }

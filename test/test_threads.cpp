@@ -1,0 +1,132 @@
+// Thread safety (issue #6): one shared Model, one Task and one Workspace per
+// thread (docs/solver.md, "The hot path"), 8 threads × 10⁵ solves of the Panda:
+// friction with every joint stuck, friction under a 6-row tool constraint plus
+// an elbow row, and the plain constrained solver. Every thread must produce
+// bit-for-bit the outputs of a single-threaded run of the same sequence.
+//
+// Built twice: as an ordinary ctest test, and with ThreadSanitizer in .ci/run
+// (ZWANG_TSAN=ON builds only the library and this file, 10⁵ solves per
+// thread). The environment variable ZWANG_THREAD_SOLVES overrides the count.
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "zwang/zwang.hpp"
+
+using namespace zwang;
+
+namespace {
+
+constexpr int kThreads = 8;
+
+// The ThreadSanitizer build (top-level CMakeLists.txt) runs the full 10⁵ solves
+// per thread; the ordinary ctest run, also under ASan, 10⁴.
+#ifndef ZWANG_THREAD_SOLVES_DEFAULT
+#define ZWANG_THREAD_SOLVES_DEFAULT 10000
+#endif
+
+long solvesPerThread() {
+  const char* env = std::getenv("ZWANG_THREAD_SOLVES");
+  return env ? std::strtol(env, nullptr, 10) : ZWANG_THREAD_SOLVES_DEFAULT;
+}
+
+// FNV-1a over the bytes of the outputs: equal hashes ⇔ (with overwhelming
+// probability) bit-identical outputs.
+struct Hash {
+  std::uint64_t h = 1469598103934665603ull;
+  void add(const void* data, std::size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ p[k]) * 1099511628211ull;
+  }
+  void add(const Eigen::VectorXd& v) { add(v.data(), sizeof(double) * static_cast<std::size_t>(v.size())); }
+  void add(double x) { add(&x, sizeof x); }
+};
+
+struct Tasks {
+  Task free_task, constrained;
+  explicit Tasks(const Model& model) : free_task(model), constrained(model) {
+    constrained.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
+    ConstraintMatrix elbow = ConstraintMatrix::Zero(6, 1);
+    elbow(2, 0) = 1.0;
+    constrained.addConstraint("panda_link4", elbow, Expressed::World);
+    constrained.targets()[2] = 0.5;
+  }
+};
+
+struct Outcome {
+  std::uint64_t hash = 0;
+  long failures = 0;  // solves whose status was not Ok
+  char first_failure[240] = {};
+};
+
+// The same sequence of solves on every thread; inputs vary with the index.
+Outcome run(const Model& model, long solves) {
+  Tasks tasks(model);
+  Workspace ws(model, tasks.constrained);
+  Eigen::VectorXd q(7), qd(7), tau(7), home(7);
+  home << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  FrictionOptions options;
+  Hash hash;
+  Outcome out;
+  for (long i = 0; i < solves; ++i) {
+    for (int j = 0; j < 7; ++j) {
+      q[j] = home[j] + 0.3 * std::sin(0.001 * static_cast<double>(i) + j);  // inside the Panda's limits
+      tau[j] = 2.0 * std::cos(0.002 * static_cast<double>(i) * (j + 1));
+    }
+    Status status;
+    switch (i % 3) {
+      case 0:  // every joint stuck, gravity only
+        status = solveWithFriction(model, tasks.free_task, q, zero, tau, ws, options);
+        hash.add(ws.friction.mu);
+        break;
+      case 1:  // constrained, one joint moving, friction
+        qd = zero;
+        qd[3] = 0.2;
+        status = solveWithFriction(model, tasks.constrained, q, qd, tau, ws, options);
+        hash.add(ws.friction.mu);
+        break;
+      default:  // constrained, no friction
+        status = solveHybridDynamics(model, tasks.constrained, q, zero, tau, ws);
+        hash.add(ws.solution.nu);
+        break;
+    }
+    if (!status.ok() && out.failures++ == 0) std::snprintf(out.first_failure, sizeof out.first_failure, "solve %ld: %s", i, status.message);
+    hash.add(ws.solution.qdd);
+    hash.add(ws.solution.tau_control);
+    hash.add(ws.solution.gauss);
+  }
+  out.hash = hash.h;
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("8 threads share one model, each with its own workspace: results identical to one thread") {
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  const long solves = solvesPerThread();
+  REQUIRE(solves > 0);
+  const Outcome reference = run(model, solves);
+  INFO("first failure: " << reference.first_failure);
+  CHECK(reference.failures == 0);
+
+  std::vector<Outcome> outcomes(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&model, &outcomes, solves, t] { outcomes[static_cast<std::size_t>(t)] = run(model, solves); });
+  for (std::thread& thread : threads) thread.join();
+  for (int t = 0; t < kThreads; ++t) {
+    INFO("thread " << t);
+    CHECK(outcomes[static_cast<std::size_t>(t)].failures == 0);
+    CHECK(outcomes[static_cast<std::size_t>(t)].hash == reference.hash);
+  }
+  std::printf("threads: %d x %ld solves on one shared Panda model, every thread bit-identical to the single-thread run"
+              " (hash %016llx)\n",
+              kThreads, solves, static_cast<unsigned long long>(reference.hash));
+}

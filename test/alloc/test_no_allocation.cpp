@@ -109,3 +109,153 @@ TEST_CASE("the friction solve allocates nothing (all joints stuck, indeterminate
   CHECK(count == 0);
   CHECK(ws.friction.stuck.size() == 7);
 }
+
+// ---------------------------------------------------------------------------
+// Every entry point (issue #6): the remaining success paths, every error
+// return, and no exception out of any of them.
+
+namespace {
+Model oneDofArm() { return loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf"); }
+}  // namespace
+
+TEST_CASE("the solver entry points are declared noexcept") {
+  const Model model = panda();
+  Task task(model);
+  Workspace ws(model, task);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
+  // (Through Ref arguments: converting a VectorXd to a Ref is not itself noexcept.)
+  const Eigen::Ref<const Eigen::VectorXd> r(x);
+  const FrictionOptions options;
+  static_assert(noexcept(solveHybridDynamics(model, task, r, r, r, ws)));
+  static_assert(noexcept(solveWithFriction(model, task, r, r, r, ws, options)));
+  static_assert(noexcept(inverseDynamics(model, task, r, r, r, ws)));
+  static_assert(noexcept(jointSpaceInertia(model, r, ws)));
+  CHECK(solveHybridDynamics(model, task, r, r, r, ws).ok());  // (and they run)
+}
+
+TEST_CASE("friction at a joint limit, with overrides, a margin and an infeasible task allocates nothing") {
+  const Model model = panda();
+  Task task(model);
+  Workspace ws(model, task);
+  Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7);
+  q[3] = model.joint(3).lower;  // on its lower limit
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  FrictionOptions options;
+  options.breakaway = Eigen::VectorXd::Constant(7, 0.5);
+  options.margin = 0.5;
+  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws, options));  // warm
+  bool ok = false;
+  CHECK(allocationsDuring([&] { ok = solveWithFriction(model, task, q, zero, zero, ws, options).ok(); }) == 0);
+  CHECK(ok);
+
+  // The report's arm on its upper limit, asked to accelerate into it: Infeasible.
+  const Model arm = oneDofArm();
+  Task into(arm);
+  into.gravity.setZero();
+  ConstraintMatrix spin = ConstraintMatrix::Zero(6, 1);
+  spin(5, 0) = 1.0;
+  into.addConstraint("link1", spin);
+  into.targets()[0] = 5.0;
+  Workspace arm_ws(arm, into);
+  const Eigen::VectorXd at_upper = Eigen::VectorXd::Constant(1, arm.joint(0).upper), none = Eigen::VectorXd::Zero(1);
+  Status status;
+  solveWithFriction(arm, into, at_upper, none, none, arm_ws);  // warm
+  CHECK(allocationsDuring([&] { status = solveWithFriction(arm, into, at_upper, none, none, arm_ws); }) == 0);
+  CHECK(status.code == StatusCode::Infeasible);
+}
+
+TEST_CASE("frame accelerations and kinematics without velocities allocate nothing") {
+  const Model model = panda();
+  Task task(model);
+  Workspace ws(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), qd = Eigen::VectorXd::Constant(7, 0.3);
+  REQUIRE(solveHybridDynamics(model, task, q, qd, qd, ws));
+  const int tool = model.frameIndex("tool0");
+  bool ok = false;
+  double sink = 0.0;
+  const long count = allocationsDuring([&] {
+    sink = frameAcceleration(model, ws, tool, Expressed::World)[2] + frameAcceleration(model, ws, tool)[0];
+    ok = forwardKinematics(model, ws, q).ok();
+    sink += framePose(model, ws, tool).translation().z();
+  });
+  CHECK(ok);
+  CHECK(std::isfinite(sink));
+  CHECK(count == 0);
+}
+
+TEST_CASE("every error return of every entry point allocates nothing and throws nothing") {
+  const Model model = panda(), other = oneDofArm();
+  Task task(model);
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  task.addConstraint("panda_link4", ConstraintMatrix::Identity(6, 1));
+  Workspace ws(model, task), small(model, 3), foreign(other, 6);
+  const Task foreign_task(other);
+  const Eigen::VectorXd ok7 = Eigen::VectorXd::Constant(7, 0.1), short3 = Eigen::VectorXd::Zero(3);
+  Eigen::VectorXd nan7 = ok7;
+  nan7[4] = std::nan("");
+  FrictionOptions bad_margin, bad_override, bad_iterations, bad_tolerance, bad_speed;
+  bad_margin.margin = 2.0;
+  bad_override.breakaway = Eigen::VectorXd::Constant(7, -1.0);
+  bad_iterations.max_iterations = 0;
+  bad_tolerance.kkt_tolerance = 0.0;
+  bad_speed.velocity_tolerance = -1.0;
+  Eigen::MatrixXd J(6, 7), J_wrong(6, 3);
+
+  // Each call returns the expected code; collected first, checked after the counted region.
+  StatusCode codes[32];
+  int n = 0;
+  const long count = allocationsDuring([&] {
+    codes[n++] = solveHybridDynamics(model, task, short3, ok7, ok7, ws).code;        // SizeMismatch
+    codes[n++] = solveHybridDynamics(model, task, ok7, nan7, ok7, ws).code;          // NonFinite
+    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, small).code;        // WorkspaceTooSmall
+    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, foreign).code;      // ModelMismatch (workspace)
+    codes[n++] = solveHybridDynamics(model, foreign_task, ok7, ok7, ok7, ws).code;   // ModelMismatch (task)
+    codes[n++] = solveWithFriction(model, task, ok7, ok7, nan7, ws).code;            // NonFinite
+    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_margin).code;      // BadOption
+    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_override).code;    // BadOption
+    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_iterations).code;  // BadOption
+    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_tolerance).code;   // BadOption
+    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_speed).code;       // BadOption
+    codes[n++] = inverseDynamics(model, task, ok7, short3, ok7, ws).code;            // SizeMismatch
+    codes[n++] = inverseDynamics(model, task, ok7, ok7, ok7, foreign).code;          // ModelMismatch
+    codes[n++] = jointSpaceInertia(model, nan7, ws).code;                            // NonFinite
+    codes[n++] = jointSpaceInertia(model, ok7, foreign).code;                        // ModelMismatch
+    codes[n++] = forwardKinematics(model, ws, short3).code;                          // SizeMismatch
+    codes[n++] = forwardKinematics(model, ws, ok7, nan7).code;                       // NonFinite
+    codes[n++] = forwardKinematics(model, foreign, ok7).code;                        // ModelMismatch
+    codes[n++] = frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong).code;   // SizeMismatch
+    codes[n++] = frameJacobian(model, ws, nan7, 1, Expressed::World, J).code;        // NonFinite
+  });
+  CHECK(count == 0);
+  const StatusCode expected[] = {
+      StatusCode::SizeMismatch, StatusCode::NonFinite,    StatusCode::WorkspaceTooSmall, StatusCode::ModelMismatch,
+      StatusCode::ModelMismatch, StatusCode::NonFinite,   StatusCode::BadOption,         StatusCode::BadOption,
+      StatusCode::BadOption,     StatusCode::BadOption,   StatusCode::BadOption,         StatusCode::SizeMismatch,
+      StatusCode::ModelMismatch, StatusCode::NonFinite,   StatusCode::ModelMismatch,     StatusCode::SizeMismatch,
+      StatusCode::NonFinite,     StatusCode::ModelMismatch, StatusCode::SizeMismatch,    StatusCode::NonFinite};
+  REQUIRE(n == static_cast<int>(sizeof expected / sizeof expected[0]));
+  for (int k = 0; k < n; ++k) {
+    INFO("call " << k);
+    CHECK(codes[k] == expected[k]);
+  }
+  // The same calls again outside the counter: none throws (the noexcept ones
+  // would terminate; these check the ones that are not declared noexcept too).
+  CHECK_NOTHROW(forwardKinematics(model, ws, short3));
+  CHECK_NOTHROW(forwardKinematics(model, foreign, ok7));
+  CHECK_NOTHROW(frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong));
+}
+
+TEST_CASE("bug: frameJacobian with a frame index out of range throws instead of returning a Status", "[.][bug]") {
+  // docs/solver.md, "The hot path": no exceptions, a bad input returns a Status.
+  // frameJacobian checks J's size and q, but not `frame`: Model::frame() is
+  // vector::at(), which throws std::out_of_range.
+  const Model model = panda();
+  Task task(model);
+  Workspace ws(model, task);
+  Eigen::MatrixXd J(6, 7);
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);
+  Status status;
+  CHECK_NOTHROW(status = frameJacobian(model, ws, q, static_cast<int>(model.frames().size()), Expressed::World, J));
+  CHECK_NOTHROW(status = frameJacobian(model, ws, q, -1, Expressed::World, J));
+  CHECK_FALSE(status.ok());
+}

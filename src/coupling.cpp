@@ -117,6 +117,66 @@ double inverseFrobenius(Eigen::Ref<Eigen::MatrixXd> C, Eigen::Ref<Eigen::VectorX
   return std::sqrt(s);
 }
 
+// The fast path for a task of M ≤ 6 rows in fixed-size arithmetic: Cholesky,
+// the certificate κ_F·threshold < 1, ν = 𝓛⁻¹ r and the factor for later
+// right-hand sides. False (nothing written but `factor`) when not certified.
+template <int M>
+bool certifiedSolveFixed(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen::Ref<const Eigen::VectorXd>& r,
+                         Eigen::Ref<Eigen::VectorXd> nu, Eigen::Ref<Eigen::MatrixXd> factor, double threshold,
+                         double& kappa) {
+  using MatM = Eigen::Matrix<double, M, M>;
+  MatM C = MatM::Zero();  // 𝓛 = C Cᵀ
+  double norm2 = 0.0;     // ‖𝓛‖_F²
+  for (int j = 0; j < M; ++j) {
+    double d = L(j, j);
+    norm2 += d * d;
+    for (int k = 0; k < j; ++k) d -= C(j, k) * C(j, k);
+    if (!(d > 0.0)) return false;
+    C(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < M; ++i) {
+      double x = L(i, j);
+      norm2 += 2.0 * x * x;
+      for (int k = 0; k < j; ++k) x -= C(i, k) * C(j, k);
+      C(i, j) = x / C(j, j);
+    }
+  }
+  MatM W = MatM::Zero();  // C⁻¹, lower
+  for (int j = 0; j < M; ++j) {
+    W(j, j) = 1.0 / C(j, j);
+    for (int i = j + 1; i < M; ++i) {
+      double x = 0.0;
+      for (int k = j; k < i; ++k) x += C(i, k) * W(k, j);
+      W(i, j) = -x / C(i, i);
+    }
+  }
+  const MatM inverse = W.transpose() * W;  // 𝓛⁻¹
+  kappa = std::sqrt(norm2) * inverse.norm();
+  if (!(std::isfinite(kappa) && kappa * threshold < 1.0)) return false;
+  factor = C;
+  nu.noalias() = inverse * r;
+  return true;
+}
+
+bool certifiedSolveSmall(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen::Ref<const Eigen::VectorXd>& r,
+                         Eigen::Ref<Eigen::VectorXd> nu, Eigen::Ref<Eigen::MatrixXd> factor, double threshold,
+                         double& kappa) {
+  switch (L.rows()) {
+    case 1: {  // κ_F = 1: regular whenever positive
+      if (!(L(0, 0) > 0.0)) return false;
+      kappa = 1.0;
+      factor(0, 0) = std::sqrt(L(0, 0));
+      nu[0] = r[0] / L(0, 0);
+      return true;
+    }
+    case 2: return certifiedSolveFixed<2>(L, r, nu, factor, threshold, kappa);
+    case 3: return certifiedSolveFixed<3>(L, r, nu, factor, threshold, kappa);
+    case 4: return certifiedSolveFixed<4>(L, r, nu, factor, threshold, kappa);
+    case 5: return certifiedSolveFixed<5>(L, r, nu, factor, threshold, kappa);
+    case 6: return certifiedSolveFixed<6>(L, r, nu, factor, threshold, kappa);
+    default: return false;
+  }
+}
+
 }  // namespace
 
 CouplingDiagnostics solveBalance(Eigen::Ref<Eigen::MatrixXd> L, const Eigen::Ref<const Eigen::VectorXd>& r,
@@ -131,7 +191,14 @@ CouplingDiagnostics solveBalance(Eigen::Ref<Eigen::MatrixXd> L, const Eigen::Ref
   // Fast path: a Cholesky factor and a certificate that 𝓛 is regular. With
   // κ_F = ‖𝓛‖_F‖𝓛⁻¹‖_F ≥ λ_max/λ_min, κ_F < 1/threshold means λ_min above
   // threshold·λ_max: not singular, rank m, no damping, ν = 𝓛⁻¹ r exactly.
-  if (cholesky(L, factor)) {
+  if (d.rows <= 6) {
+    double kappa = 0.0;
+    if (certifiedSolveSmall(L, r, nu, factor, options.singular_threshold, kappa)) {
+      d.rank = d.rows;
+      d.condition = kappa;
+      return d;
+    }
+  } else if (cholesky(L, factor)) {
     const double kappa = symmetricFrobenius(L) * inverseFrobenius(factor, lambda);
     if (std::isfinite(kappa) && kappa * options.singular_threshold < 1.0) {
       d.rank = d.rows;

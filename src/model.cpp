@@ -45,11 +45,10 @@ bool finite(const Transform& X) { return X.E.allFinite() && X.r.allFinite(); }
 }  // namespace
 
 int Model::jointIndex(const std::string& name) const {
-  std::vector<std::string> names;
-  for (int j = 0; j < dof(); ++j) {
+  for (int j = 0; j < dof(); ++j)
     if (joints_[static_cast<std::size_t>(j)].name == name) return j;
-    names.push_back(joints_[static_cast<std::size_t>(j)].name);
-  }
+  std::vector<std::string> names;  // only on the error path: a lookup that succeeds allocates nothing
+  for (const Joint& joint : joints_) names.push_back(joint.name);
   throw ModelError("model '" + name_ + "' has no moving joint '" + name + "' (joints: " + knownNames(names) + ")");
 }
 
@@ -60,11 +59,10 @@ bool Model::hasFrame(const std::string& name) const {
 }
 
 int Model::frameIndex(const std::string& name) const {
-  std::vector<std::string> names;
-  for (std::size_t f = 0; f < frames_.size(); ++f) {
+  for (std::size_t f = 0; f < frames_.size(); ++f)
     if (frames_[f].name == name) return static_cast<int>(f);
-    names.push_back(frames_[f].name);
-  }
+  std::vector<std::string> names;  // only on the error path
+  for (const Frame& frame : frames_) names.push_back(frame.name);
   throw ModelError("model '" + name_ + "' has no frame '" + name + "' (frames: " + knownNames(names) + ")");
 }
 

@@ -59,9 +59,27 @@ inline RigidInertia transformInertia(const Transform& X, const RigidInertia& I) 
   return {I.mass, X.E * h_shift, X.E * Ibar_shift * X.E.transpose()};
 }
 
-// The inverse: given the inertia in B, express it in A.
+// The inverse: given the inertia in B, express it in A. With R = Eᵀ (B's axes
+// in A) and p = r (B's origin in A): h_A = m p + R h, and the rotational
+// inertia moves from B's origin to A's by the parallel-axis rule with a first
+// moment, Ī_A = R Ī Rᵀ + m(|p|²1 − p pᵀ) + 2(p·h_R)1 − p h_Rᵀ − h_R pᵀ,
+// h_R = R h.
 inline RigidInertia inverseTransformInertia(const Transform& X, const RigidInertia& I) {
-  return transformInertia(X.inverse(), I);
+  const Mat3 R = X.E.transpose();
+  const Vec3& p = X.r;
+  const Vec3 hR = R * I.h;
+  const Mat3 IR = I.Ibar * X.E;  // Ī Rᵀ
+  RigidInertia out;
+  out.mass = I.mass;
+  out.h = I.mass * p + hR;
+  const double diagonal = I.mass * p.squaredNorm() + 2.0 * p.dot(hR);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j <= i; ++j) {
+      double value = R.row(i).dot(IR.col(j)) - I.mass * p[i] * p[j] - p[i] * hR[j] - hR[i] * p[j];
+      if (i == j) value += diagonal;
+      out.Ibar(i, j) = out.Ibar(j, i) = value;
+    }
+  return out;
 }
 
 }  // namespace zwang::spatial

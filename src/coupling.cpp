@@ -47,8 +47,6 @@ void jacobiEigen(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::VectorXd> lamb
   lambda = A.diagonal();
 }
 
-namespace {
-
 // Lower Cholesky factor C of the lower triangle of A (C Cᵀ = A); false when a
 // pivot is not positive.
 bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C) {
@@ -82,6 +80,25 @@ void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref
     x[i] = s / C(i, i);
   }
 }
+
+bool certifiedCholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C,
+                       Eigen::Ref<Eigen::VectorXd> tmp, double floor) {
+  if (!cholesky(A, C)) return false;
+  // ‖C⁻¹‖_F² = trace(A⁻¹) = Σ 1/λ_k ≥ 1/λ_min, one column of C⁻¹ at a time.
+  const Eigen::Index m = A.rows();
+  double trace_inverse = 0.0;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    for (Eigen::Index i = j; i < m; ++i) {  // C w = e_j, w zero above j
+      double x = i == j ? 1.0 : 0.0;
+      for (Eigen::Index k = j; k < i; ++k) x -= C(i, k) * tmp[k];
+      tmp[i] = x / C(i, i);
+      trace_inverse += tmp[i] * tmp[i];
+    }
+  }
+  return std::isfinite(trace_inverse) && 1.0 > floor * trace_inverse;
+}
+
+namespace {
 
 // ‖A‖_F of a symmetric matrix from its lower triangle.
 double symmetricFrobenius(const Eigen::Ref<const Eigen::MatrixXd>& A) {

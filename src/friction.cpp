@@ -177,9 +177,13 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
       for (Eigen::Index a = 0; a < ns; ++a)
         for (Eigen::Index b = 0; b < ns; ++b) Pss(a, b) = P(fs.sub_index[a], fs.sub_index[b]);
       auto V = fs.V.topLeftCorner(ns, ns);
-      jacobiEigen(Pss, fs.eig.head(ns), V);
-      for (Eigen::Index e = 0; e < ns; ++e)
-        if (fs.eig[e] <= zero_curvature) fs.null_basis.col(nullity++).head(ns) = V.col(e);
+      // Certified positive definite (every curvature above zero_curvature):
+      // no null space, μ* is unique. Otherwise find the null space by eigen.
+      if (!certifiedCholesky(Pss, V, fs.eig.head(ns), zero_curvature)) {
+        jacobiEigen(Pss, fs.eig.head(ns), V);
+        for (Eigen::Index e = 0; e < ns; ++e)
+          if (fs.eig[e] <= zero_curvature) fs.null_basis.col(nullity++).head(ns) = V.col(e);
+      }
     }
     if (nullity > 0) {
       const auto N = fs.null_basis.topLeftCorner(ns, nullity);

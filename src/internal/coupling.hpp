@@ -27,6 +27,19 @@ void balanceApply(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::
                   bool by_eigen, double damping, const Eigen::Ref<const Eigen::VectorXd>& r,
                   Eigen::Ref<Eigen::VectorXd> out);
 
+// Lower Cholesky factor C (C Cᵀ = A) of the lower triangle of A; false when a
+// pivot is not positive. C may not alias A.
+bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C);
+
+// x ← (C Cᵀ)⁻¹ x with C from cholesky (its lower triangle is read).
+void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::VectorXd> x);
+
+// cholesky, plus a certificate that every eigenvalue of A is above `floor`:
+// λ_min ≥ 1/trace(A⁻¹) = 1/‖C⁻¹‖_F² > floor. False when either fails (C then
+// holds scratch). `tmp` (m) is scratch. O(m³/3).
+bool certifiedCholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C,
+                       Eigen::Ref<Eigen::VectorXd> tmp, double floor);
+
 // Symmetric eigen-decomposition A = V diag(λ) Vᵀ by cyclic Jacobi rotations
 // (accurate for small matrices, no allocation). A is overwritten.
 void jacobiEigen(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::VectorXd> lambda, Eigen::Ref<Eigen::MatrixXd> V);

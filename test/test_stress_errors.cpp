@@ -1,0 +1,269 @@
+// Every error message of the library, produced once (docs/errors.md lists them
+// with the test that produces each). Status messages of the solver entry
+// points, ModelError messages of ModelBuilder, Model lookups and Task; the URDF
+// loader's messages are produced by test_urdf (and the ones it does not reach,
+// here). Each check asserts the code and the words of the message.
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "zwang/zwang.hpp"
+
+using namespace zwang;
+using Catch::Contains;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+const double kInf = std::numeric_limits<double>::infinity();
+
+Model panda() { return loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf"); }
+
+std::string modelError(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "(no ModelError)";
+}
+
+RigidInertia box(double mass) { return RigidInertia::fromMassComInertia(mass, Vec3(0.1, 0, 0), Mat3::Identity() * 0.01); }
+
+Joint revolute(const std::string& name) {
+  Joint j;
+  j.name = name;
+  return j;
+}
+
+}  // namespace
+
+TEST_CASE("errors: solve statuses (sizes, non-finite inputs, workspace and task)", "[errors]") {
+  const Model model = panda();
+  const Model arm = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf");
+  Task task(model);
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6));
+  const int w = task.addWrench("panda_link5");
+  Workspace ws(model, task), small(model, 2), foreign(arm, 6);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(7), short3 = Eigen::VectorXd::Zero(3);
+  Eigen::VectorXd bad = x;
+  bad[2] = kNaN;
+
+  Status s = solveHybridDynamics(model, task, short3, x, x, ws);
+  CHECK(s.code == StatusCode::SizeMismatch);
+  CHECK_THAT(s.message, Contains("q has 3 entries, the model has 7 joints"));
+  s = solveHybridDynamics(model, task, x, bad, x, ws);
+  CHECK(s.code == StatusCode::NonFinite);
+  CHECK_THAT(s.message, Contains("qd[2] is nan (not finite)"));
+  task.gravity[1] = kInf;
+  s = solveHybridDynamics(model, task, x, x, x, ws);
+  CHECK(s.code == StatusCode::NonFinite);
+  CHECK_THAT(s.message, Contains("gravity holds a non-finite value (inf) at entry 1"));
+  task.gravity[1] = 0.0;
+  task.targets()[4] = kNaN;
+  s = solveHybridDynamics(model, task, x, x, x, ws);
+  CHECK_THAT(s.message, Contains("constraint targets b holds a non-finite value"));
+  task.targets()[4] = 0.0;
+  task.wrench(w)[0] = kNaN;
+  s = solveHybridDynamics(model, task, x, x, x, ws);
+  CHECK(s.code == StatusCode::NonFinite);
+  CHECK_THAT(s.message, Contains("wrench 0 (on frame 'panda_link5') is not finite"));
+  task.wrench(w)[0] = 0.0;
+  s = solveHybridDynamics(model, task, x, x, x, small);
+  CHECK(s.code == StatusCode::WorkspaceTooSmall);
+  CHECK_THAT(s.message, Contains("task has 6 constraint rows, the workspace was made for at most 2"));
+  s = solveHybridDynamics(model, task, x, x, x, foreign);
+  CHECK(s.code == StatusCode::ModelMismatch);
+  CHECK_THAT(s.message, Contains("workspace was made for 1 joints, the model has 7"));
+  const Task arm_task(arm);
+  s = solveHybridDynamics(model, arm_task, x, x, x, ws);
+  CHECK(s.code == StatusCode::ModelMismatch);
+  CHECK_THAT(s.message, Contains("task was made for another model (1 joints"));
+}
+
+TEST_CASE("errors: RNEA, CRBA, kinematics and Jacobian statuses", "[errors]") {
+  const Model model = panda();
+  const Model arm = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf");
+  const Task task(model), arm_task(arm);
+  Workspace ws(model, task), foreign(arm, arm_task);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
+  Status s = inverseDynamics(model, arm_task, x, x, x, ws);
+  CHECK(s.code == StatusCode::ModelMismatch);
+  CHECK_THAT(s.message, Contains("workspace or task was made for another model"));
+  s = jointSpaceInertia(model, x, foreign);
+  CHECK(s.code == StatusCode::ModelMismatch);
+  CHECK_THAT(s.message, Contains("workspace was made for 1 joints, the model has 7"));
+  s = forwardKinematics(model, foreign, x);
+  CHECK(s.code == StatusCode::ModelMismatch);
+  CHECK_THAT(s.message, Contains("workspace was made for 1 joints, the model has 7"));
+  Eigen::MatrixXd J(6, 5);
+  s = frameJacobian(model, ws, x, 1, Expressed::World, J);
+  CHECK(s.code == StatusCode::SizeMismatch);
+  CHECK_THAT(s.message, Contains("Jacobian output is 6x5, expected 6x7"));
+}
+
+TEST_CASE("errors: friction options and the infeasible task", "[errors]") {
+  const Model model = panda();
+  const Task task(model);
+  Workspace ws(model, task);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
+  const auto message = [&](const FrictionOptions& o) {
+    const Status s = solveWithFriction(model, task, x, x, x, ws, o);
+    CHECK(s.code == StatusCode::BadOption);
+    return std::string(s.message);
+  };
+  FrictionOptions o;
+  o.kinetic = Eigen::VectorXd::Zero(3);
+  CHECK_THAT(message(o), Contains("friction override 'kinetic' has 3 entries, the model has 7 joints"));
+  o = {};
+  o.damping = Eigen::VectorXd::Zero(7);
+  o.damping[1] = -2.0;
+  CHECK_THAT(message(o), Contains("friction override 'damping' for joint 'panda_joint2' is -2 (must be finite and >= 0)"));
+  o = {};
+  o.velocity_tolerance = kNaN;
+  CHECK_THAT(message(o), Contains("velocity_tolerance nan must be finite and >= 0"));
+  o = {};
+  o.limit_tolerance = -1.0;
+  CHECK_THAT(message(o), Contains("limit_tolerance -1 must be finite and >= 0"));
+  o = {};
+  o.margin = 1.5;
+  CHECK_THAT(message(o), Contains("margin 1.5 must be in [0, 1]"));
+  o = {};
+  o.max_iterations = 0;
+  CHECK_THAT(message(o), Contains("max_iterations must be at least 1"));
+  o = {};
+  o.kkt_tolerance = -1e-9;
+  CHECK_THAT(message(o), Contains("kkt_tolerance must be positive"));
+
+  // The report's arm on its upper limit, asked to accelerate into it.
+  const Model arm = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf");
+  Task into(arm);
+  into.gravity.setZero();
+  ConstraintMatrix spin = ConstraintMatrix::Zero(6, 1);
+  spin(5, 0) = 1.0;
+  into.addConstraint("link1", spin);
+  into.targets()[0] = 5.0;
+  Workspace arm_ws(arm, into);
+  const Status s = solveWithFriction(arm, into, Eigen::VectorXd::Constant(1, arm.joint(0).upper),
+                                     Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1), arm_ws);
+  CHECK(s.code == StatusCode::Infeasible);
+  CHECK_THAT(s.message, Contains("the task drives joint 'joint1' into its upper limit (3.14159)"));
+  CHECK(arm_ws.solution.qdd.allFinite());
+}
+
+TEST_CASE("errors: Degenerate, a joint with no inertia to move", "[errors]") {
+  // A massless body whose only load is a second joint about the same axis
+  // through the same point: the second joint absorbs every rotation of the
+  // first, so the first has D = 0 (no rotor inertia on either).
+  ModelBuilder builder("degenerate", "base");
+  builder.addJoint(revolute("first"), "link1", RigidInertia{});
+  builder.addJoint(revolute("second"), "link2",
+                   RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Mat3::Identity() * 0.01));
+  const Model model = builder.build();
+  const Task task(model);
+  Workspace ws(model, task);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
+  const Status s = solveHybridDynamics(model, task, x, x, x, ws);
+  CHECK(s.code == StatusCode::Degenerate);
+  CHECK_THAT(s.message, Contains("joint 'first' has no inertia to move here (D = "));
+}
+
+TEST_CASE("errors: ModelBuilder and model lookups", "[errors]") {
+  const Model model = panda();
+  CHECK_THAT(modelError([&] { model.jointIndex("elbow"); }),
+             Contains("model 'panda' has no moving joint 'elbow' (joints: ") && Contains("panda_joint1"));
+  CHECK_THAT(modelError([&] { model.frameIndex("hand"); }),
+             Contains("model 'panda' has no frame 'hand' (frames: ") && Contains("tool0"));
+
+  const auto addJoint = [](const Joint& j, const RigidInertia& inertia) {
+    return modelError([&] { ModelBuilder("m", "base").addJoint(j, "link1", inertia); });
+  };
+  Joint j = revolute("j1");
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(kNaN, Vec3::Zero(), Mat3::Identity())),
+             Contains("link 'link1': mass is not finite"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3(kInf, 0, 0), Mat3::Identity())),
+             Contains("centre of mass is not finite"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Mat3::Identity() * kNaN)),
+             Contains("inertia is not finite"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(-1.0, Vec3::Zero(), Mat3::Identity())),
+             Contains("mass -1.000000 is negative"));
+  Mat3 skew = Mat3::Identity();
+  skew(0, 1) = 0.5;
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), skew)),
+             Contains("inertia is not symmetric"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Vec3(1, 1, 0).asDiagonal())),
+             Contains("inertia is not positive definite (principal moments"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Vec3(1, 1, 3).asDiagonal())),
+             Contains("inertia violates the triangle inequality"));
+
+  CHECK_THAT(addJoint(revolute(""), box(1.0)), Contains("a moving joint needs a name"));
+  CHECK_THAT(modelError([] {
+               ModelBuilder b("m", "base");
+               b.addJoint(revolute("j1"), "link1", box(1.0)).addJoint(revolute("j1"), "link2", box(1.0));
+             }),
+             Contains("joint 'j1': a joint of that name exists already"));
+  CHECK_THAT(modelError([] { ModelBuilder("m", "base").addJoint(revolute("j1"), "base", box(1.0)); }),
+             Contains("joint 'j1': frame 'base' exists already"));
+  CHECK_THAT(modelError([] {
+               ModelBuilder b("m", "base");
+               b.addJoint(revolute("j1"), "link1", box(1.0)).addJoint(revolute("j2"), "link2", box(1.0), "base");
+             }),
+             Contains("joint 'j2': parent frame 'base' is not on the last body of the chain"));
+  j = revolute("j1");
+  j.axis = Vec3::Zero();
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': axis must be a finite non-zero vector"));
+  j = revolute("j1");
+  j.placement = Transform::translation(Vec3(kNaN, 0, 0));
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': origin is not finite"));
+  j = revolute("j1");
+  j.damping = kInf;
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': damping is not finite"));
+  j = revolute("j1");
+  j.rotor_inertia = -0.5;
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': rotor inertia -0.500000 is negative"));
+  j = revolute("j1");
+  j.lower = kNaN;
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': limit is NaN"));
+  j = revolute("j1");
+  j.lower = 1.0;
+  j.upper = -1.0;
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': lower limit exceeds upper limit"));
+  j = revolute("j1");
+  j.effort_limit = -1.0;
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': effort limit must be non-negative"));
+  j = revolute("j1");
+  j.velocity_limit = -1.0;
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': velocity limit must be non-negative"));
+
+  CHECK_THAT(modelError([] { ModelBuilder("m", "base").addFixedFrame("base", "base", Transform{}); }),
+             Contains("link 'base': a frame of that name exists already"));
+  CHECK_THAT(modelError([] {
+               ModelBuilder("m", "base").addFixedFrame("tool", "base", Transform::translation(Vec3(0, kInf, 0)));
+             }),
+             Contains("link 'tool': origin of its fixed joint is not finite"));
+  CHECK_THAT(modelError([&] { ModelBuilder(model).setRotorInertia("panda_joint1", -1.0); }),
+             Contains("joint 'panda_joint1': rotor inertia must be finite and non-negative"));
+  CHECK_THAT(modelError([&] { ModelBuilder(model).setFriction("panda_joint2", 1.0, kNaN, 0.0); }),
+             Contains("joint 'panda_joint2': friction and damping must be finite and non-negative"));
+  CHECK_THAT(modelError([] { ModelBuilder("m", "base").addJoint(revolute("j1"), "link1", RigidInertia{}).build(); }),
+             Contains("link 'link1': zero mass on a moving body with nothing beyond it (joint 'j1'"));
+}
+
+TEST_CASE("errors: Task construction", "[errors]") {
+  const Model model = panda();
+  Task task(model);
+  CHECK_THAT(modelError([&] { task.addConstraint("hand", ConstraintMatrix::Identity(6, 1)); }),
+             Contains("task: the model has no frame 'hand'"));
+  CHECK_THAT(modelError([&] { task.addConstraint(99, ConstraintMatrix::Identity(6, 1)); }),
+             Contains("task: frame index 99 out of range"));
+  CHECK_THAT(modelError([&] { task.addConstraint("tool0", ConstraintMatrix(6, 0)); }),
+             Contains("task: a constraint needs at least one column"));
+  ConstraintMatrix bad = ConstraintMatrix::Identity(6, 1);
+  bad(3, 0) = kNaN;
+  CHECK_THAT(modelError([&] { task.addConstraint("tool0", bad); }),
+             Contains("task: constraint matrix on frame 'tool0' is not finite"));
+  CHECK_THAT(modelError([&] { task.addWrench(-1); }), Contains("task: frame index -1 out of range"));
+}

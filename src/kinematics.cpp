@@ -87,6 +87,9 @@ Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const E
   if (J.rows() != 6 || J.cols() != model.dof())
     return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",
                          static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.dof());
+  if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
+    return Status::error(StatusCode::ModelMismatch, "frame index %d is not a frame of this model (it has %d frames)", frame,
+                         static_cast<int>(model.frames().size()));
   if (Status s = forwardKinematics(model, ws, q); !s) return s;
   // Column j: the frame-origin velocity of a unit rate of joint j, S_{j+1}
   // (base coordinates) seen at the frame origin p, for the joints that move it.

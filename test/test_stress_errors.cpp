@@ -267,3 +267,56 @@ TEST_CASE("errors: Task construction", "[errors]") {
              Contains("task: constraint matrix on frame 'tool0' is not finite"));
   CHECK_THAT(modelError([&] { task.addWrench(-1); }), Contains("task: frame index -1 out of range"));
 }
+
+namespace {
+// A two-joint URDF with `transmissions` appended inside <robot>.
+std::string urdfWith(const std::string& transmissions) {
+  return R"(<?xml version="1.0"?>
+<robot name="r" xmlns:drake="http://drake.mit.edu">
+  <link name="base"/>
+  <link name="l1"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="l2"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+  <joint name="j2" type="continuous"><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+)" + transmissions + "\n</robot>\n";
+}
+
+std::string transmission(const std::string& name, const std::string& joints, const std::string& actuators) {
+  return "<transmission name=\"" + name + "\">" + joints + actuators + "</transmission>";
+}
+
+std::string urdfError(const std::string& xml) { return modelError([&] { loadUrdfString(xml); }); }
+}  // namespace
+
+TEST_CASE("errors: URDF <transmission> rotor inertias (the messages test_urdf does not reach)", "[errors]") {
+  const std::string j1 = "<joint name=\"j1\"/>", j2 = "<joint name=\"j2\"/>";
+  const auto actuator = [](const std::string& name, const std::string& tags) {
+    return "<actuator name=\"" + name + "\">" + tags + "</actuator>";
+  };
+  REQUIRE(loadUrdfString(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia value=\"0.5\"/>"))))
+              .joint(0)
+              .rotor_inertia == 0.5);  // the template itself loads
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia/>")))),
+             Contains("<string>: transmission 't': <actuator> 'm'") && Contains("<drake:rotor_inertia> has no value attribute"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia value=\"heavy\"/>")))),
+             Contains("<drake:rotor_inertia> value \"heavy\" is not a number"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:gear_ratio value=\"1 2\"/>")))),
+             Contains("<drake:gear_ratio> value \"1 2\" is not a number"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia value=\"inf\"/>")))),
+             Contains("<drake:rotor_inertia> value \"inf\" is not finite"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia value=\"-2\"/>")))),
+             Contains("<drake:rotor_inertia> value -2 is negative"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1,
+                                             actuator("m1", "<drake:rotor_inertia value=\"1\"/>") +
+                                                 actuator("m2", "<drake:rotor_inertia value=\"1\"/>")))),
+             Contains("transmission 't': more than one <actuator> has a <drake:rotor_inertia>"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1 + j2, actuator("m", "<drake:rotor_inertia value=\"1\"/>")))),
+             Contains("transmission 't': a <drake:rotor_inertia> needs exactly one <joint name=") &&
+                 Contains("found 2"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", "<joint name=\"j7\"/>",
+                                             actuator("m", "<drake:rotor_inertia value=\"1\"/>")))),
+             Contains("transmission 't': <joint> 'j7' is not a joint of the URDF"));
+  CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia value=\"1\"/>")) +
+                                transmission("u", j1, actuator("n", "<drake:rotor_inertia value=\"2\"/>")))),
+             Contains("transmission 'u': joint 'j1' already has a rotor inertia from another transmission"));
+}

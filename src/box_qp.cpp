@@ -53,6 +53,18 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
     if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
     if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
   }
+  // Warm start: when P is certified positive definite, the unconstrained
+  // minimiser P⁻¹c clamped to the box (feasible, and usually close to the
+  // optimal active set, so few iterations follow even for many variables).
+  {
+    auto C = s.V.topLeftCorner(k, k);
+    if (certifiedCholesky(P, C, s.lambda.head(k), zero_curvature)) {
+      auto x_unc = s.p.head(k);
+      x_unc = c;
+      choleskySolveInPlace(C, x_unc);
+      for (Index j = 0; j < k; ++j) x[j] = std::min(hi[j], std::max(lo[j], x_unc[j]));
+    }
+  }
   // working[j] = 1: x_j held at a bound. Start with the variables whose box is
   // a point, and those already on a bound.
   auto on_bound = [&](Index j) { return x[j] <= lo[j] || x[j] >= hi[j]; };

@@ -265,7 +265,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
       state = JointState::Stick;
   }
   // g(μ*) = Z₀(q̈*) + μ*ᵀ W q̈* = Z with the joint torques τ − kinetic − Wᵀμ (eq. 5.7).
-  fr.gauss_dual = gaussAndBodyAccelerations(model, task, out.qdd, fs.tau_total, ws);
+  fr.gauss_dual = gaussFunction(model, task, out.qdd, fs.tau_total, ws);
   out.gauss = fr.gauss_dual - mu_dot_qdd;
   fr.kkt_residual = k > 0 ? boxQpKktResidual(P, fs.c.head(k), fs.lo.head(k), fs.hi.head(k), mu) : 0.0;
 

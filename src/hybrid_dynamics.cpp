@@ -19,7 +19,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(task.constraintRows()), out.tau_constraint);
   out.tau_control = tau + out.tau_constraint;
-  out.gauss = gaussAndBodyAccelerations(model, task, out.qdd, tau, ws);
+  out.gauss = gaussFunction(model, task, out.qdd, tau, ws);
   return {};
 }
 

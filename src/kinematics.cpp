@@ -13,7 +13,13 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
     const auto b = static_cast<std::size_t>(i);
     const Joint& joint = model.joint(i - 1);
     const Transform& X = ws.Xworld[b] = joint.transform(q[i - 1]) * ws.Xworld[b - 1];  // line 4: ⁱX₀
-    ws.S[b] = X.inverseApplyMotion(joint.motionSubspace());  // S_i in base coordinates
+    // S_i in base coordinates: [p × a; a] (revolute) or [a; 0] (prismatic),
+    // a = ᵂR_i axis, p the body origin.
+    const Vec3 a = X.E.transpose() * joint.axis;
+    if (joint.isRevolute())
+      ws.S[b] << X.r.cross(a), a;
+    else
+      ws.S[b] << a, Vec3::Zero();
     if (with_inertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
     if (with_velocity) {
       const Vec6 vJ = ws.S[b] * qd[i - 1];

@@ -16,22 +16,6 @@ const char* toString(JointType type) {
   return "unknown";
 }
 
-Transform Joint::transform(double q) const {
-  // X_J(q): the child frame is the joint frame rotated by q about (or shifted by
-  // q along) the axis; then ʲX_parent = X_J · X_T with X_T = placement.
-  if (!isRevolute()) return {placement.E, placement.r + placement.E.transpose() * (q * axis)};
-  // X_J = rotation(R), R = c·1 + s·[a]× + (1 − c)·a aᵀ (Rodrigues), so
-  // E = Rᵀ E_T = c·E_T − s·(a × E_T) + (1 − c)·a (aᵀ E_T), column by column.
-  const double s = std::sin(q), c = std::cos(q);
-  Transform X;
-  for (int j = 0; j < 3; ++j) {
-    const Vec3 e = placement.E.col(j);
-    X.E.col(j) = c * e - s * axis.cross(e) + ((1.0 - c) * axis.dot(e)) * axis;
-  }
-  X.r = placement.r;
-  return X;
-}
-
 namespace {
 
 std::string knownNames(const std::vector<std::string>& names) {

@@ -211,26 +211,27 @@ void constraintTorques(const Model& model, const Task& task, const Workspace& ws
   }
 }
 
-double gaussAndBodyAccelerations(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
-                                 Workspace& ws) {
+double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
+                     const Workspace& ws) {
   // Z with true accelerations and gravity as a force (the physical Gauss
   // function; the gravity-shifted sweep's version differs by a constant):
-  // Σ_i ½ aᵢᵀIᵢaᵢ + (F_bias,i − I_i[g; 0])ᵀaᵢ + Σ_j ½ d_j q̈_j² − τ_j q̈_j.
-  const Vec6 a0 = gravityAcceleration(task.gravity);  // [−g; 0]
+  // Σ_i ½ aᵢᵀIᵢaᵢ + (F_bias,i − I_i[g; 0])ᵀaᵢ + Σ_j ½ d_j q̈_j² − τ_j q̈_j,
+  // in 3-vector pieces: with y = ½a + [−g; 0] = [y_l; y_a] and a = [a_l; α],
+  // I y = [m y_l − h × y_a; h × y_l + Ī y_a].
+  const Vec3& g = task.gravity;
   double Z = 0.0;
   for (int i = 1; i <= model.dof(); ++i) {
     const RigidInertia& I = ws.I[at(i)];
-    const Vec6 a_true = ws.a[at(i)] - a0;
-    Z += a_true.dot(I * (0.5 * a_true + a0) + ws.Fbias[at(i)]);
+    const Vec6& a_sweep = ws.a[at(i)];
+    const Vec3 a_lin = a_sweep.head<3>() + g;  // true acceleration: sweep − [−g; 0]
+    const Vec3 alpha = a_sweep.tail<3>();
+    const Vec3 y_lin = 0.5 * a_lin - g;
+    const Vec3 y_ang = 0.5 * alpha;
+    const Vec6& F = ws.Fbias[at(i)];
+    Z += a_lin.dot(I.mass * y_lin - I.h.cross(y_ang) + F.head<3>()) +
+         alpha.dot(I.h.cross(y_lin) + I.Ibar * y_ang + F.tail<3>());
     const double qdd_i = qdd[i - 1];
     Z += (0.5 * model.joint(i - 1).rotor_inertia * qdd_i - tau[i - 1]) * qdd_i;
-
-    const Transform& X = ws.Xworld[at(i)];
-    Vec6& world = ws.solution.body_acc_world[at(i)];
-    world = classicalAtPoint(a_true, ws.v[at(i)], X.r);
-    Vec6& local = ws.solution.body_acc_local[at(i)];
-    local.head<3>().noalias() = X.E * world.head<3>();
-    local.tail<3>().noalias() = X.E * world.tail<3>();
   }
   return Z;
 }

@@ -12,8 +12,6 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   solution.nu.setZero(0);
   solution.tau_constraint.setZero(n);
   solution.tau_control.setZero(n);
-  solution.body_acc_local.assign(bodies, Vec6::Zero());
-  solution.body_acc_world.assign(bodies, Vec6::Zero());
 
   Xworld.assign(bodies, Transform{});
   S.assign(bodies, Vec6::Zero());

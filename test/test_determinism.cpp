@@ -54,7 +54,8 @@ std::uint64_t solveAll(const Model& model, const Task& task, const DynamicsInput
     hash.add(ws.solution.gauss);
     hash.add(ws.solution.coupling.condition);
     hash.add(ws.solution.coupling.damping);
-    for (const Vec6& a : ws.solution.body_acc_world) hash.add(a.data(), sizeof(double) * 6);
+    for (int f = 0; f < static_cast<int>(model.frames().size()); ++f)
+      hash.add(frameAcceleration(model, ws, f, Expressed::World).eval().data(), sizeof(double) * 6);
   };
   addSolution(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
   for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {

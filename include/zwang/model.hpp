@@ -7,6 +7,7 @@
 // but every link stays addressable as a Frame attached to a body.
 #pragma once
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -51,6 +52,22 @@ struct Joint {
   // ʲX_parent(q) = X_J(q) · X_T: the placement followed by the joint motion.
   Transform transform(double q) const;
 };
+
+inline Transform Joint::transform(double q) const {
+  // X_J(q): the child frame is the joint frame rotated by q about (or shifted by
+  // q along) the axis; then ʲX_parent = X_J · X_T with X_T = placement.
+  if (!isRevolute()) return {placement.E, placement.r + placement.E.transpose() * (q * axis)};
+  // X_J = rotation(R), R = c·1 + s·[a]× + (1 − c)·a aᵀ (Rodrigues), so
+  // E = Rᵀ E_T = c·E_T − s·(a × E_T) + (1 − c)·a (aᵀ E_T), column by column.
+  const double s = std::sin(q), c = std::cos(q);
+  Transform X;
+  for (int j = 0; j < 3; ++j) {
+    const Vec3 e = placement.E.col(j);
+    X.E.col(j) = c * e - s * axis.cross(e) + ((1.0 - c) * axis.dot(e)) * axis;
+  }
+  X.r = placement.r;
+  return X;
+}
 
 struct Frame {
   std::string name;

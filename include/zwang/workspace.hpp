@@ -40,10 +40,9 @@ struct Solution {
   Eigen::VectorXd tau_control;     // τ + τ_c, what is sent to the motors
   double gauss = 0.0;              // Z(q̈), the Gauss function (acceleration energy) at the solution
   CouplingDiagnostics coupling;
-  // True classical acceleration [linear of the origin; angular] of every body
-  // frame (index = body; 0 is the base), in the body's axes and in world axes.
-  std::vector<Vec6> body_acc_local;
-  std::vector<Vec6> body_acc_world;
+  // The true classical acceleration of any frame (a body's own frame:
+  // model.bodyFrame(b)) is computed on demand from the sweep by
+  // frameAcceleration() (kinematics.hpp), so a solve does not pay for it.
 };
 
 class Workspace {

@@ -46,10 +46,9 @@ void unitTorqueColumn(const Model& model, const Task& task, Workspace& ws, int j
 void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c);
 
-// Gauss function of the true accelerations ws.a − gravity shift, with joint
-// torques `tau`; also fills the solution's body accelerations.
-double gaussAndBodyAccelerations(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
-                                 Workspace& ws);
+// Gauss function of the true accelerations ws.a − [−g; 0], with joint torques `tau`.
+double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
+                     const Workspace& ws);
 
 // ws.nu (solver order) into the solution's ν (the task's row order).
 void publishNu(const Task& task, Workspace& ws);

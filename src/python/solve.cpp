@@ -191,6 +191,18 @@ Vec6 frameAccelerationOf(const Result& r, int frame, Expressed e) {
   return frameAcceleration(*r.model, *r.live->ws, frame, e);
 }
 
+// (bodies × 6) accelerations of every body's own frame, computed on demand.
+py::array bodyAccelerations(const Result& r, Expressed e) {
+  const int bodies = r.model->bodyCount();
+  py::array_t<double> out({bodies, 6});
+  auto view = out.mutable_unchecked<2>();
+  for (int b = 0; b < bodies; ++b) {
+    const Vec6 a = frameAccelerationOf(r, r.model->bodyFrame(b), e);
+    for (int k = 0; k < 6; ++k) view(b, k) = a[k];
+  }
+  return out;
+}
+
 std::string resultRepr(const Result& r) {
   const Solution& s = r.solution();
   std::string text = "<zwang.Result dof=" + std::to_string(s.qdd.size()) + " rows=" + std::to_string(s.coupling.rows);
@@ -392,10 +404,10 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("condition", [](const Result& r) { return r.solution().coupling.condition; })
       .def_property_readonly("damping", [](const Result& r) { return r.solution().coupling.damping; })
       .def_property_readonly("singular", [](const Result& r) { return r.solution().coupling.singular; })
-      .def_property_readonly("body_acc_local", [](const Result& r) { return rowsView(r.solution().body_acc_local, r.base()); },
-                             "(bodies, 6) true classical accelerations of the body frames, body axes")
-      .def_property_readonly("body_acc_world", [](const Result& r) { return rowsView(r.solution().body_acc_world, r.base()); },
-                             "(bodies, 6) the same in world axes")
+      .def_property_readonly("body_acc_local", [](const Result& r) { return bodyAccelerations(r, Expressed::Local); },
+                             "(bodies, 6) true classical accelerations of the body frames, body axes (a new array)")
+      .def_property_readonly("body_acc_world", [](const Result& r) { return bodyAccelerations(r, Expressed::World); },
+                             "(bodies, 6) the same in world axes (a new array)")
       .def("frame_acceleration", [](const Result& r, py::handle frame, const std::string& expressed) {
         return vectorCopy(frameAccelerationOf(r, frameArg(*r.model, frame), expressedArg("expressed", expressed, true)));
       }, py::arg("frame"), py::arg("expressed") = "world", "true classical acceleration [p̈; ω̇] of a frame's origin")

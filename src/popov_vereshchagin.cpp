@@ -11,6 +11,8 @@
 //    i..N, and each body adds its own columns as the inward sweep reaches it.
 #include "internal/popov_vereshchagin.hpp"
 
+#include <limits>
+
 #include "internal/checks.hpp"
 #include "internal/coupling.hpp"
 #include "internal/sweeps.hpp"
@@ -90,6 +92,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
   const int N = model.dof();
   const int m = task.constraintRows();
   ws.U.head(m).setZero();              // U_N = 0
+  ws.L_scale.head(m).setZero();
   ws.L.topLeftCorner(m, m).setZero();  // 𝓛_N = 0 (only the lower triangle is kept)
   ws.IA[at(N)] = ws.I[at(N)].matrix();  // line 9 for the last body
   ws.FA[at(N)] = ws.Fbias[at(N)];       // line 8
@@ -117,7 +120,11 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     // Lines 19–21, one constraint column at a time.
     const int k = task.activeColumns(i);
     double* sA = ws.SA.col(i).data();
-    for (int col = 0; col < k; ++col) sA[col] = S.dot(A.col(col));  // (Sᵀ A_i)ᵀ
+    const double SS_D = S.squaredNorm() / D;
+    for (int col = 0; col < k; ++col) {
+      sA[col] = S.dot(A.col(col));                          // (Sᵀ A_i)ᵀ
+      ws.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
+    }
     for (int col = 0; col < k; ++col) {
       const double sA_D = sA[col] / D;
       ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;               // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
@@ -140,6 +147,16 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
 
 void balance(const Task& task, Workspace& ws) {
   const int m = task.constraintRows();
+  // A row no joint can move (its row of G is zero: a constraint on the base,
+  // or a direction through every joint axis) has 𝓛_rr = Σ (Sᵀa)²/D = 0 up to
+  // the rounding of the Sᵀa products, ~ε²·L_scale. Make it exactly zero, so
+  // the balance sees the singularity and gives the row ν = 0 (docs/solver.md).
+  constexpr double kRounding = 1e4 * std::numeric_limits<double>::epsilon() * std::numeric_limits<double>::epsilon();
+  for (int r = 0; r < m; ++r)
+    if (ws.L(r, r) <= kRounding * ws.L_scale[r]) {
+      for (int col = 0; col <= r; ++col) ws.L(r, col) = 0.0;
+      for (int row = r; row < m; ++row) ws.L(row, r) = 0.0;
+    }
   ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);  // line 25 …
   ws.rhs.head(m).noalias() -= ws.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
   ws.solution.coupling = solveBalance(ws.L.topLeftCorner(m, m), ws.rhs.head(m), ws.nu.head(m),

@@ -28,6 +28,7 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   Ahat.setZero(6, m);
   U.setZero(m);
   L.setZero(m, m);
+  L_scale.setZero(m);
   A_body.setZero(6, m);
   b_body.setZero(m);
   balance_factor.setZero(m, m);

@@ -82,6 +82,7 @@ class Workspace {
   Eigen::MatrixXd SA;                // column i: (S_iᵀ A_i)ᵀ, capacity × bodies
   ConstraintMatrix Ahat;             // A_i (6 × capacity), updated in place from A_N down to A_0
   Eigen::VectorXd U;                 // U_0, acceleration energy of bias forces and torques
+  Eigen::VectorXd L_scale;           // Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
   Eigen::MatrixXd L;                 // 𝓛_0, constraint coupling matrix (capacity², lower triangle)
 
   // --- the task in sweep form, solver column order (see Task::groups)

@@ -184,11 +184,12 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
   auto clamp = [&](Eigen::Ref<Eigen::VectorXd> v) {
     for (Index j = 0; j < k; ++j) v[j] = std::min(hi[j], std::max(lo[j], v[j]));
   };
-  // Lipschitz constant of ∇φ: the largest eigenvalue of P.
-  auto M = s.M.topLeftCorner(k, k);
-  M = P;
-  jacobiEigen(M, s.lambda.head(k), s.V.topLeftCorner(k, k));
-  const double L = std::max(0.0, s.lambda.head(k).maxCoeff());
+  // Lipschitz constant of ∇φ: an upper bound of λ_max(P) in O(k²), the
+  // smaller of Gershgorin's (largest absolute row sum) and the trace (P is
+  // positive semi-definite), rather than an O(k³) eigen-decomposition.
+  double gershgorin = 0.0;
+  for (Index j = 0; j < k; ++j) gershgorin = std::max(gershgorin, P.row(j).cwiseAbs().sum());
+  const double L = std::max(0.0, std::min(gershgorin, P.diagonal().sum()));
   if (L <= 1e-12 * std::max(1.0, c.cwiseAbs().maxCoeff()) && L <= 1e-300 + 1e-12 * P.cwiseAbs().maxCoeff()) {
     // φ is linear: each variable goes to the bound its gradient points away from.
     for (Index j = 0; j < k; ++j) {

@@ -36,7 +36,8 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
                         double zero_curvature);
 
 // The same problem by accelerated projected gradient (FISTA with adaptive
-// restart), step 1/λ_max(P); a linear problem (P = 0) goes to its vertex.
+// restart), step 1/L with L ≥ λ_max(P) (Gershgorin or trace bound); a linear
+// problem (P = 0) goes to its vertex.
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                                 Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance);

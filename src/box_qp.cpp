@@ -282,11 +282,20 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
       for (Index u = 0; u < nw; ++u) s.t1[u] = s.C.row(s.working[u]).head(q).dot(a) - s.d[s.working[u]];
       auto V = s.V.topLeftCorner(nw, nw);
       auto ev = s.lambda.head(nw);
-      jacobiEigen(G, ev, V);
-      const double ev_tol = 1e-12 * std::max(1e-300, ev.maxCoeff());
-      s.t2.head(nw).noalias() = V.transpose() * s.t1.head(nw);
-      for (Index u = 0; u < nw; ++u) s.t2[u] = ev[u] > ev_tol ? s.t2[u] / ev[u] : 0.0;
-      lam.noalias() = V * s.t2.head(nw);
+      // Independent working rows (the usual case): Cholesky of the Gram
+      // matrix, certified well above rounding; otherwise the pseudo-inverse
+      // from its eigen-decomposition.
+      const double diagonal_scale = G.diagonal().maxCoeff();
+      if (certifiedCholesky(G, V, ev, 1e-12 * std::max(1e-300, diagonal_scale))) {
+        lam = s.t1.head(nw);
+        choleskySolveInPlace(V, lam);
+      } else {
+        jacobiEigen(G, ev, V);
+        const double ev_tol = 1e-12 * std::max(1e-300, ev.maxCoeff());
+        s.t2.head(nw).noalias() = V.transpose() * s.t1.head(nw);
+        for (Index u = 0; u < nw; ++u) s.t2[u] = ev[u] > ev_tol ? s.t2[u] / ev[u] : 0.0;
+        lam.noalias() = V * s.t2.head(nw);
+      }
     }
     // Candidate z' and the step towards it.
     auto target = s.g.head(q);

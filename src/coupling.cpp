@@ -1,12 +1,30 @@
 #include "internal/coupling.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 
 namespace zwang::internal {
 
+namespace {
+constexpr int kSmallEigen = 8;  // up to this size jacobiEigen uses a fixed-capacity QR solver
+}  // namespace
+
 void jacobiEigen(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::VectorXd> lambda, Eigen::Ref<Eigen::MatrixXd> V) {
   const Eigen::Index m = A.rows();
+  if (m <= kSmallEigen) {
+    // Small matrices (a task's rows, a few stuck joints): Householder
+    // tridiagonalisation and implicit QR in fixed-capacity storage, several
+    // times cheaper than Jacobi sweeps here and still allocation-free.
+    using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kSmallEigen, kSmallEigen>;
+    const Small symmetric = A.selfadjointView<Eigen::Lower>();
+    const Eigen::SelfAdjointEigenSolver<Small> solver(symmetric);
+    lambda = solver.eigenvalues();
+    V = solver.eigenvectors();
+    A.setZero();
+    A.diagonal() = lambda;
+    return;
+  }
   V.setIdentity();
   const double scale = A.cwiseAbs().maxCoeff();
   for (int sweep = 0; sweep < 64 && scale > 0.0; ++sweep) {

@@ -40,8 +40,9 @@ void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref
 bool certifiedCholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C,
                        Eigen::Ref<Eigen::VectorXd> tmp, double floor);
 
-// Symmetric eigen-decomposition A = V diag(λ) Vᵀ by cyclic Jacobi rotations
-// (accurate for small matrices, no allocation). A is overwritten.
+// Symmetric eigen-decomposition A = V diag(λ) Vᵀ, no allocation: up to 8×8 by
+// tridiagonalisation and QR in fixed-capacity storage, beyond by cyclic Jacobi
+// rotations. A is overwritten.
 void jacobiEigen(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::VectorXd> lambda, Eigen::Ref<Eigen::MatrixXd> V);
 
 }  // namespace zwang::internal

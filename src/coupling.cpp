@@ -184,11 +184,22 @@ bool certifiedSolveFixed(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen
       W(i, j) = -x / C(i, i);
     }
   }
-  const MatM inverse = W.transpose() * W;  // 𝓛⁻¹
+  const MatM inverse = W.transpose() * W;  // 𝓛⁻¹, for κ_F only
   kappa = std::sqrt(norm2) * inverse.norm();
   if (!(std::isfinite(kappa) && kappa * threshold < 1.0)) return false;
   factor = C;
-  nu.noalias() = inverse * r;
+  // ν by forward and backward substitution with C (more accurate than the
+  // explicit inverse when 𝓛 is ill-conditioned).
+  Eigen::Matrix<double, M, 1> x = r;
+  for (int i = 0; i < M; ++i) {
+    for (int k = 0; k < i; ++k) x[i] -= C(i, k) * x[k];
+    x[i] /= C(i, i);
+  }
+  for (int i = M - 1; i >= 0; --i) {
+    for (int k = i + 1; k < M; ++k) x[i] -= C(k, i) * x[k];
+    x[i] /= C(i, i);
+  }
+  nu = x;
   return true;
 }
 

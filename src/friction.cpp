@@ -142,10 +142,16 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   }
   for (Eigen::Index a = 0; a < k; ++a)  // symmetric in exact arithmetic (K is)
     for (Eigen::Index b = 0; b < a; ++b) P(a, b) = P(b, a) = 0.5 * (P(a, b) + P(b, a));
-  // Scales: accelerations of q̈(0), inverse inertias 1/D of the sweep.
-  double inv_inertia = 0.0;
-  for (int i = 1; i <= n; ++i) inv_inertia = std::max(inv_inertia, 1.0 / ws.D[static_cast<std::size_t>(i)]);
-  const double acc_scale = 1.0 + fs.qdd0.cwiseAbs().maxCoeff();
+  // Scales, of the stuck joints only (a light, fast joint elsewhere in the
+  // chain must not set them): their accelerations q̈_Θ(0) and the inverse
+  // articulated inertias 1/D of their bodies.
+  double inv_inertia = 0.0, acc_max = 0.0;
+  for (Eigen::Index a = 0; a < k; ++a) {
+    const int j = fr.stuck[static_cast<std::size_t>(a)];
+    inv_inertia = std::max(inv_inertia, 1.0 / ws.D[static_cast<std::size_t>(j + 1)]);
+    acc_max = std::max(acc_max, std::abs(fs.qdd0[j]));
+  }
+  const double acc_scale = 1.0 + acc_max;
   const double tolerance = options.kkt_tolerance * acc_scale;
   const double zero_curvature = 1e-10 * inv_inertia;
   auto mu = fs.mu.head(k);

@@ -28,7 +28,10 @@ struct Status {
   static Status error(StatusCode code, const char* format, Args... args) {
     Status s;
     s.code = code;
-    std::snprintf(s.message, sizeof s.message, format, args...);
+    if constexpr (sizeof...(Args) == 0)
+      std::snprintf(s.message, sizeof s.message, "%s", format);  // a fixed message: no format to interpret
+    else
+      std::snprintf(s.message, sizeof s.message, format, args...);
     return s;
   }
 };

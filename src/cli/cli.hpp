@@ -5,6 +5,7 @@
 //   0 success, 1 error (input, model, solver), 2 usage, 3 infeasible task.
 #pragma once
 
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -62,9 +63,22 @@ std::string readFile(const std::string& path, std::size_t max_bytes);
 // Write text to path, or to stdout when path is empty.
 void writeOutput(const std::string& path, const std::string& text);
 
+// Where the model files are: --models DIR, else the source tree's models/ when it
+// holds `file`, else the installed share/zwang/models.
+std::string modelsDirectory(const Arguments& args, const std::string& file);
+
+// Print rows as a fixed-width table: the first `left` columns left-aligned, the
+// others right-aligned; trailing blanks trimmed.
+void printColumns(const std::vector<std::vector<std::string>>& rows, std::size_t left = 1);
+
+// Run `gnuplot SCRIPT` in `dir`. When gnuplot is missing or fails, says so on
+// stderr in one line (naming `command`) and returns false.
+bool plotWithGnuplot(const std::string& command, const std::filesystem::path& dir, const std::string& script);
+
 // The commands; each returns the exit code.
 int commandSolve(int argc, char** argv);
 int commandInfo(int argc, char** argv);
 int commandScenarios(int argc, char** argv);
+int commandEnergy(int argc, char** argv);
 
 }  // namespace zwang::cli

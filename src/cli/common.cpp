@@ -1,6 +1,12 @@
-// Argument parsing, usage texts and file helpers of the zwang tool.
+// Argument parsing, usage texts, file, table and gnuplot helpers of the zwang tool.
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -46,12 +52,26 @@ const char* usageText(const std::string& command) {
            "  --no-plots    write the CSVs only (no gnuplot script, no PNG)\n"
            "\n"
            "Exit code 1 when a result disagrees with the report's.\n";
+  if (command == "energy")
+    return "usage: zwang energy [--out DIR] [--models DIR] [--no-plots]\n"
+           "\n"
+           "The Panda holding still against gravity in six poses: the motor torques of the\n"
+           "plain solver and of the friction-aware solver (margins 0.5 and 1), with the\n"
+           "URDF's breakaway friction. Prints the tables and writes DIR/panda_energy.csv\n"
+           "and, with gnuplot, DIR/panda_energy.png and DIR/panda_energy_joints.png.\n"
+           "\n"
+           "  --out DIR     output directory (default: ./energy; created if missing)\n"
+           "  --models DIR  where panda.urdf is (default: the source tree's models/)\n"
+           "  --no-plots    write the CSV only (no gnuplot script, no PNG)\n"
+           "\n"
+           "Exit code 1 when a result disagrees with the closed form.\n";
   return "usage: zwang <command> [options]\n"
          "\n"
          "commands:\n"
          "  solve PROBLEM.json [-o FILE] [--pretty]        solve a JSON problem, print the solution as JSON\n"
          "  info MODEL.urdf [--root L] [--tip L] [--json]  joints, frames and mass of a URDF chain\n"
          "  scenarios [--out DIR] [--models DIR]           the report's chapter 6 and Fig. 5.5, with plots\n"
+         "  energy [--out DIR] [--models DIR]              Panda holding poses: motor effort with/without friction\n"
          "\n"
          "  zwang <command> --help   a command's options\n"
          "  zwang --version          the version\n"
@@ -171,6 +191,87 @@ void writeOutput(const std::string& path, const std::string& text) {
   out << text;
   out.close();
   if (!out) throw CliError(kExitError, path + ": cannot write the file");
+}
+
+std::string modelsDirectory(const Arguments& args, const std::string& file) {
+  if (args.has("--models")) return args.value("--models");
+  for (const char* dir : {ZWANG_MODELS_DIR, ZWANG_INSTALLED_MODELS_DIR}) {
+    std::error_code ec;
+    if (std::filesystem::exists(std::filesystem::path(dir) / file, ec)) return dir;
+  }
+  return ZWANG_MODELS_DIR;
+}
+
+void printColumns(const std::vector<std::vector<std::string>>& rows, std::size_t left) {
+  // Display width of UTF-8 text: count the bytes that start a character.
+  auto columns = [](const std::string& s) {
+    std::size_t n = 0;
+    for (const char c : s) n += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+    return n;
+  };
+  std::vector<std::size_t> width;
+  for (const auto& row : rows) {
+    if (width.size() < row.size()) width.resize(row.size(), 0);
+    for (std::size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], columns(row[c]));
+  }
+  for (const auto& row : rows) {
+    std::string line;
+    for (std::size_t c = 0; c < row.size(); ++c)
+      line += (c == 0 ? "" : "  ") + (c < left ? row[c] + std::string(width[c] - columns(row[c]), ' ')
+                                               : std::string(width[c] - columns(row[c]), ' ') + row[c]);
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    std::printf("%s\n", line.c_str());
+  }
+}
+
+namespace {
+
+bool onPath(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  if (!path) return false;
+  std::stringstream dirs(path);
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    if (dir.empty()) dir = ".";
+    const std::string candidate = dir + "/" + program;
+    struct stat st {};
+    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0) return true;
+  }
+  return false;
+}
+
+// Run `gnuplot SCRIPT` in `dir`; the exit status (-1 when it could not start).
+int runGnuplot(const std::filesystem::path& dir, const std::string& script) {
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = ::fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(126);
+    char* const argv[] = {const_cast<char*>("gnuplot"), const_cast<char*>(script.c_str()), nullptr};
+    ::execvp("gnuplot", argv);
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+bool plotWithGnuplot(const std::string& command, const std::filesystem::path& dir, const std::string& script) {
+  if (!onPath("gnuplot")) {
+    std::fprintf(stderr, "zwang: %s: gnuplot is not on PATH: no PNG plots (the CSVs are written; "
+                         "install gnuplot, e.g. Debian's gnuplot-nox, and run `gnuplot %s` in %s)\n",
+                 command.c_str(), script.c_str(), dir.string().c_str());
+    return false;
+  }
+  if (const int rc = runGnuplot(dir, script); rc != 0) {
+    std::fprintf(stderr, "zwang: %s: gnuplot failed (exit %d): no PNG plots (the CSVs are written)\n", command.c_str(), rc);
+    return false;
+  }
+  return true;
 }
 
 }  // namespace zwang::cli

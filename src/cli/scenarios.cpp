@@ -12,10 +12,6 @@
 //   tau_control(μ)= τ₀ + τ_c(μ), the motor command (τ_c the constraint torque);
 //   tau_net(μ)    = H q̈(μ) + C, the net joint torque that accelerates the arm
 //                   (the report's "resulting torque", Figs. 6.4 and 6.7).
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -63,15 +59,6 @@ struct Result {
   bool ok = false;
   std::vector<double> mu_grid, g_grid, qdd_grid, tau_grid, net_grid;
 };
-
-std::string modelsDirectory(const Arguments& args) {
-  if (args.has("--models")) return args.value("--models");
-  for (const char* dir : {ZWANG_MODELS_DIR, ZWANG_INSTALLED_MODELS_DIR}) {
-    std::error_code ec;
-    if (std::filesystem::exists(std::filesystem::path(dir) / "one_dof_arm.urdf", ec)) return dir;
-  }
-  return ZWANG_MODELS_DIR;
-}
 
 Result run(const Model& model, const Scenario& sc) {
   Task task(model);
@@ -202,38 +189,6 @@ std::string plotScript(const std::vector<Result>& results, double f) {
   return s.str();
 }
 
-bool onPath(const std::string& program) {
-  const char* path = std::getenv("PATH");
-  if (!path) return false;
-  std::stringstream dirs(path);
-  std::string dir;
-  while (std::getline(dirs, dir, ':')) {
-    if (dir.empty()) dir = ".";
-    const std::string candidate = dir + "/" + program;
-    struct stat st {};
-    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0) return true;
-  }
-  return false;
-}
-
-// Run `gnuplot SCRIPT` in `dir`; the exit status (-1 when it could not start).
-int runGnuplot(const std::filesystem::path& dir, const std::string& script) {
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const pid_t pid = ::fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(126);
-    char* const argv[] = {const_cast<char*>("gnuplot"), const_cast<char*>(script.c_str()), nullptr};
-    ::execvp("gnuplot", argv);
-    ::_exit(127);
-  }
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 }  // namespace
 
 int commandScenarios(int argc, char** argv) {
@@ -244,7 +199,7 @@ int commandScenarios(int argc, char** argv) {
   }
   if (!args.positional.empty()) throw UsageError("scenarios", "unexpected argument '" + printable(args.positional[0], 60) + "'");
   const std::filesystem::path out = args.value("--out", "scenarios");
-  const std::filesystem::path urdf = std::filesystem::path(modelsDirectory(args)) / "one_dof_arm.urdf";
+  const std::filesystem::path urdf = std::filesystem::path(modelsDirectory(args, "one_dof_arm.urdf")) / "one_dof_arm.urdf";
   Model model;
   try {
     model = loadUrdfFile(urdf.string());
@@ -282,22 +237,7 @@ int commandScenarios(int argc, char** argv) {
     rows.push_back({kScenarios[k].name, fmt(r.mu), fmt(r.qdd), fmt(r.tau_control), fmt(r.tau_net), r.state, fmt(r.g),
                     fmt(r.grid_argmax), r.ok ? "ok" : "MISMATCH"});
   }
-  // A small fixed-width table (UTF-8 aware enough for the headers above).
-  auto columns = [](const std::string& s) {
-    std::size_t n = 0;
-    for (const char c : s) n += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
-    return n;
-  };
-  std::vector<std::size_t> width(rows[0].size(), 0);
-  for (const auto& row : rows)
-    for (std::size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], columns(row[c]));
-  for (const auto& row : rows) {
-    std::string line;
-    for (std::size_t c = 0; c < row.size(); ++c)
-      line += c == 0 ? row[c] + std::string(width[c] - columns(row[c]), ' ')
-                     : "  " + std::string(width[c] - columns(row[c]), ' ') + row[c];
-    std::printf("%s\n", line.c_str());
-  }
+  printColumns(rows);
   std::printf("\nThe report's results:\n");
   for (const Scenario& sc : kScenarios) std::printf("  %-9s  %s\n", sc.name, sc.report);
   std::printf("\ngrid argmax: the best of the %d samples of g (the report's sampling method); mu* is exact.\n", kSamples);
@@ -306,15 +246,8 @@ int commandScenarios(int argc, char** argv) {
 
   if (!args.has("--no-plots")) {
     writeOutput((out / "plots.gp").string(), plotScript(results, f));
-    if (!onPath("gnuplot")) {
-      std::fprintf(stderr, "zwang: scenarios: gnuplot is not on PATH: no PNG plots (the CSVs are written; "
-                           "install gnuplot, e.g. Debian's gnuplot-nox, and run `gnuplot plots.gp` in %s)\n",
-                   out.string().c_str());
-    } else if (const int rc = runGnuplot(out, "plots.gp"); rc != 0) {
-      std::fprintf(stderr, "zwang: scenarios: gnuplot failed (exit %d): no PNG plots (the CSVs are written)\n", rc);
-    } else {
+    if (plotWithGnuplot("scenarios", out, "plots.gp"))
       std::printf("wrote %s/<scenario>_{g,qdd,tau}.png (gnuplot, script plots.gp)\n", out.string().c_str());
-    }
   }
   if (!all_ok) {
     std::fprintf(stderr, "zwang: scenarios: a result disagrees with the report's (see the check column)\n");

@@ -2,7 +2,7 @@
 // binary and check exit codes, stderr and the JSON/CSV it writes. Numbers are
 // compared numerically, never as strings.
 //
-// Tags (one ctest test each): [golden] [errors] [robustness] [usage] [info] [scenarios]
+// Tags (one ctest test each): [golden] [errors] [robustness] [usage] [info] [scenarios] [energy]
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -471,7 +471,7 @@ TEST_CASE("Usage: help, unknown commands and options", "[usage]") {
     CHECK(contains(r.err, "zwang: unknown command 'frobnicate'"));
     CHECK(contains(r.err, "usage: zwang <command>"));
   }
-  for (const std::string command : {"solve", "info", "scenarios"}) {
+  for (const std::string command : {"solve", "info", "scenarios", "energy"}) {
     SECTION(command + " --help") {
       const Run r = run({command, "--help"});
       CHECK(r.exit_code == 0);
@@ -634,4 +634,126 @@ TEST_CASE("scenarios without gnuplot keeps the CSVs and says so", "[scenarios]")
   const Run quiet = run({"scenarios", "--out", out + "-csv", "--no-plots"}, {{"PATH", empty_bin}});
   CHECK(quiet.exit_code == 0);
   CHECK(quiet.err.empty());
+}
+
+// ---------------------------------------------------------------------------
+// energy: the committed docs/energy/panda_energy.csv is what the tool computes,
+// and it is what the physics says (q̈ = 0 holds G(q); friction takes
+// min(|G_j|, margin·f_j) off each joint).
+
+namespace {
+
+struct EnergyRow {
+  std::string pose, variant;
+  std::vector<double> values;  // q1-7, tau1-7, mu1-7, tau_norm, tau_sq, tau_abs_sum
+};
+
+std::vector<EnergyRow> readEnergyCsv(const std::string& path, std::string& header) {
+  std::istringstream in(cli_test::readText(path));
+  std::getline(in, header);
+  std::vector<EnergyRow> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    EnergyRow row;
+    std::istringstream cells(line);
+    std::getline(cells, row.pose, ',');
+    std::getline(cells, row.variant, ',');
+    std::string cell;
+    while (std::getline(cells, cell, ',')) row.values.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("energy regenerates the committed CSV within 1e-12", "[energy]") {
+  const std::string out = cli_test::scratchDir() + "/energy";
+  const Run r = run({"energy", "--out", out});
+  INFO("stdout: " << r.out << "\nstderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK_FALSE(contains(r.out, "MISMATCH"));
+  std::string header_new, header_old;
+  const auto fresh = readEnergyCsv(out + "/panda_energy.csv", header_new);
+  const auto committed = readEnergyCsv(std::string(ZWANG_ENERGY_DIR) + "/panda_energy.csv", header_old);
+  CHECK(header_new.rfind("pose,variant,q1,", 0) == 0);
+  CHECK(header_new == header_old);
+  REQUIRE(fresh.size() == 18);  // 6 poses × 3 variants
+  REQUIRE(committed.size() == fresh.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    CHECK(fresh[i].pose == committed[i].pose);
+    CHECK(fresh[i].variant == committed[i].variant);
+    REQUIRE(fresh[i].values.size() == 24);
+    REQUIRE(committed[i].values.size() == 24);
+    // 1e-12 absolute, relative for the few entries above 1 in magnitude (‖τ‖² reaches 2446)
+    for (std::size_t k = 0; k < 24; ++k)
+      worst = std::max(worst, std::abs(fresh[i].values[k] - committed[i].values[k]) /
+                                  std::max(1.0, std::abs(committed[i].values[k])));
+  }
+  CHECK(worst <= 1e-12);
+  if (cli_test::fileExists("/usr/bin/gnuplot") || cli_test::fileExists("/usr/local/bin/gnuplot")) {
+    CHECK(cli_test::fileExists(out + "/panda_energy.png"));
+    CHECK(cli_test::fileExists(out + "/panda_energy_joints.png"));
+  }
+
+  // Independently of the tool: G(q) by RNEA, and the effort-minimising friction.
+  const zwang::Model model = zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  zwang::Task free_task(model);
+  zwang::Workspace ws(model, 0);
+  for (std::size_t i = 0; i < fresh.size(); i += 3) {
+    INFO(fresh[i].pose);
+    const std::vector<double>& v = fresh[i].values;
+    const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(v.data(), 7), zero = Eigen::VectorXd::Zero(7);
+    REQUIRE(zwang::inverseDynamics(model, free_task, q, zero, zero, ws));
+    const Eigen::VectorXd gravity = ws.tau;
+    const double margins[3] = {0.0, 0.5, 1.0};
+    for (int variant = 0; variant < 3; ++variant) {
+      const std::vector<double>& w = fresh[i + variant].values;
+      double sq = 0.0;
+      for (int j = 0; j < 7; ++j) {
+        const double f = margins[variant] * model.joint(j).breakaway_friction;
+        const double expected = std::copysign(std::max(0.0, std::abs(gravity[j]) - f), gravity[j]);
+        CHECK(w[7 + j] == Approx(expected).margin(1e-9));
+        // the joint feels τ_control − μ = G(q): friction carries the rest
+        CHECK(w[7 + j] - w[14 + j] == Approx(gravity[j]).margin(1e-9));
+        CHECK(std::abs(w[14 + j]) <= f + 1e-12);
+        sq += w[7 + j] * w[7 + j];
+      }
+      CHECK(w[22] == Approx(sq).epsilon(1e-12));
+      CHECK(w[21] == Approx(std::sqrt(sq)).epsilon(1e-12));
+    }
+    CHECK(fresh[i + 2].values[22] < fresh[i + 1].values[22]);
+    CHECK(fresh[i + 1].values[22] < fresh[i].values[22]);
+  }
+}
+
+TEST_CASE("energy without gnuplot keeps the CSV and says so", "[energy]") {
+  const std::string out = cli_test::scratchDir() + "/energy-nognuplot";
+  const std::string empty_bin = cli_test::scratchDir() + "/empty-bin-energy";
+  std::filesystem::create_directories(empty_bin);
+  const Run r = run({"energy", "--out", out}, {{"PATH", empty_bin}});
+  CHECK(r.exit_code == 0);
+  CHECK(contains(r.err, "zwang: energy: gnuplot is not on PATH"));
+  CHECK(r.err.find('\n') == r.err.size() - 1);
+  CHECK(cli_test::fileExists(out + "/panda_energy.csv"));
+  CHECK(cli_test::fileExists(out + "/energy.gp"));
+  CHECK_FALSE(cli_test::fileExists(out + "/panda_energy.png"));
+  const Run quiet = run({"energy", "--out", out + "-csv", "--no-plots"}, {{"PATH", empty_bin}});
+  CHECK(quiet.exit_code == 0);
+  CHECK(quiet.err.empty());
+  CHECK_FALSE(cli_test::fileExists(out + "-csv/energy.gp"));
+}
+
+TEST_CASE("energy: usage and a missing model", "[energy]") {
+  const Run extra = run({"energy", "extra"});
+  CHECK(extra.exit_code == 2);
+  CHECK(contains(extra.err, "unexpected argument 'extra'"));
+  const Run none = run({"energy", "--models", cli_test::scratchDir() + "/nothing", "--out", cli_test::scratchDir() + "/en-none"});
+  checkOneLineError(none, 1);
+  CHECK(contains(none.err, "zwang: energy: "));
+  CHECK(contains(none.err, "panda.urdf"));
+  CHECK(contains(none.err, "(use --models DIR)"));
 }

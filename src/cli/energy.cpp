@@ -1,0 +1,329 @@
+// `zwang energy [--out DIR] [--models DIR] [--no-plots]`: the energy result of
+// docs/evaluation.md. The Franka Panda (models/panda.urdf) at rest in several
+// poses, holding still against gravity; the actuator effort with and without
+// friction awareness.
+//
+// The task holds everything still: six world-axis rows on tool0 (the tool's
+// classical acceleration is zero) and one row that locks the redundant
+// elbow's self-motion (panda_link1's angular acceleration about its own z,
+// which is q̈₁). Seven independent rows on seven joints fix q̈ = 0, so
+//   plain solver  (solveHybridDynamics): τ_control = G(q), the gravity torques;
+//   friction-aware (solveWithFriction, all joints stuck): μ* is not unique
+//     (g is flat on the whole box), and the library picks the maximiser with
+//     the least ‖τ_control‖² using at most margin·f_j of each breakaway torque:
+//     |τ_control,j| = max(0, |G_j| − margin·f_j).
+// Both are checked (against RNEA and the closed form) before anything is written.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "zwang/zwang.hpp"
+
+namespace zwang::cli {
+
+namespace {
+
+constexpr int kJoints = 7;
+
+struct Pose {
+  const char* name;
+  const char* what;
+  double q[kJoints];
+};
+
+// Inside the Panda's position limits, none on a limit; radians.
+const Pose kPoses[] = {
+    {"ready", "the usual start pose: elbow bent, tool down", {0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785}},
+    {"reach_forward", "arm stretched forward and low", {0.0, 0.6, 0.0, -1.4, 0.0, 2.0, 0.785}},
+    {"reach_up", "arm raised, tool high", {0.0, -0.3, 0.0, -0.9, 0.0, 0.6, 0.785}},
+    {"side_low", "turned to the side, reaching down", {1.2, 0.9, 0.4, -1.2, -0.3, 2.3, 0.0}},
+    {"elbow_out", "elbow swung out, wrist turned", {-0.8, 0.3, -1.2, -2.4, 0.9, 1.4, -0.6}},
+    {"folded", "folded in close to the base", {0.0, -1.3, 0.0, -2.9, 0.0, 1.7, 0.785}},
+};
+
+// The variants compared, in table order. margin < 0: the plain solver.
+struct Variant {
+  const char* name;
+  double margin;
+};
+const Variant kVariants[] = {{"plain", -1.0}, {"friction_margin_0.5", 0.5}, {"friction_margin_1", 1.0}};
+constexpr int kVariantCount = 3;
+
+struct Effort {
+  Eigen::VectorXd tau, mu;
+  std::vector<std::string> state;
+  bool indeterminate = false;
+  double norm = 0, sq = 0, abs_sum = 0;
+};
+
+struct PoseResult {
+  Eigen::VectorXd q, gravity;  // G(q) from RNEA
+  Eigen::Vector3d tool;        // tool0's position [m], world
+  Effort variant[kVariantCount];
+  int rank = 0;
+  double worst_qdd = 0, worst_check = 0;
+  bool ok = false;
+};
+
+std::string fmt(double x, const char* format = "%.4g") {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, format, std::abs(x) < 1e-12 ? 0.0 : x);
+  return buffer;
+}
+
+PoseResult run(const Model& model, const Pose& pose) {
+  const int n = model.dof();
+  Task task(model);  // gravity (0, 0, −9.81)
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  ConstraintMatrix lock = ConstraintMatrix::Zero(6, 1);
+  lock(5, 0) = 1.0;  // angular z of panda_link1, its own axes: q̈₁
+  task.addConstraint("panda_link1", lock, Expressed::Local);
+  Workspace ws(model, task);
+
+  PoseResult r;
+  r.q = Eigen::Map<const Eigen::VectorXd>(pose.q, n);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  const std::string where = std::string("energy: pose ") + pose.name + ": ";
+
+  Task free_task(model);
+  if (const Status s = inverseDynamics(model, free_task, r.q, zero, zero, ws); !s)
+    throw CliError(kExitError, where + "RNEA: " + s.message);
+  r.gravity = ws.tau;
+  if (const Status s = forwardKinematics(model, ws, r.q); !s) throw CliError(kExitError, where + s.message);
+  r.tool = framePose(model, ws, model.frameIndex("tool0")).translation();
+
+  for (int v = 0; v < kVariantCount; ++v) {
+    const Variant& variant = kVariants[v];
+    Status status;
+    if (variant.margin < 0) {
+      status = solveHybridDynamics(model, task, r.q, zero, zero, ws);
+    } else {
+      FrictionOptions options;
+      options.margin = variant.margin;
+      status = solveWithFriction(model, task, r.q, zero, zero, ws, options);
+    }
+    if (!status) throw CliError(kExitError, where + variant.name + ": " + status.message);
+    Effort& e = r.variant[v];
+    e.tau = ws.solution.tau_control;
+    e.mu = variant.margin < 0 ? zero : Eigen::VectorXd(ws.friction.mu);
+    for (int j = 0; j < n; ++j) e.state.push_back(variant.margin < 0 ? "-" : toString(ws.friction.state[j]));
+    e.indeterminate = variant.margin >= 0 && ws.friction.indeterminate;
+    e.sq = e.tau.squaredNorm();
+    e.norm = std::sqrt(e.sq);
+    e.abs_sum = e.tau.cwiseAbs().sum();
+    r.rank = ws.solution.coupling.rank;
+    r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
+    if (ws.solution.coupling.singular) throw CliError(kExitError, where + "the hold-still task is singular here");
+    // The closed form: τ_control = G(q) + μ with the effort-minimising μ.
+    for (int j = 0; j < n; ++j) {
+      const double f = variant.margin < 0 ? 0.0 : variant.margin * model.joint(j).breakaway_friction;
+      const double expected = std::copysign(std::max(0.0, std::abs(r.gravity[j]) - f), r.gravity[j]);
+      r.worst_check = std::max(r.worst_check, std::abs(e.tau[j] - expected));
+    }
+  }
+  r.ok = r.rank == 7 && r.worst_qdd < 1e-9 && r.worst_check < 1e-9;
+  return r;
+}
+
+std::string csvText(const std::vector<PoseResult>& results) {
+  std::ostringstream out;
+  out << "pose,variant";
+  for (const char* column : {"q", "tau", "mu"})
+    for (int j = 1; j <= kJoints; ++j) out << "," << column << j;
+  out << ",tau_norm,tau_sq,tau_abs_sum\n";
+  char cell[40];
+  auto number = [&](double x) {
+    std::snprintf(cell, sizeof cell, ",%.17g", x);
+    out << cell;
+  };
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    const PoseResult& r = results[p];
+    for (int v = 0; v < kVariantCount; ++v) {
+      const Effort& e = r.variant[v];
+      out << kPoses[p].name << "," << kVariants[v].name;
+      for (int j = 0; j < kJoints; ++j) number(r.q[j]);
+      for (int j = 0; j < kJoints; ++j) number(e.tau[j]);
+      for (int j = 0; j < kJoints; ++j) number(e.mu[j]);
+      number(e.norm);
+      number(e.sq);
+      number(e.abs_sum);
+      out << "\n";
+    }
+  }
+  return out.str();
+}
+
+// Two bar charts: ‖τ_control‖ per pose and variant; |τ_control,j| per joint
+// and pose with the breakaway torques. The data are inline (17 digits), the
+// same numbers as the CSV.
+std::string plotScript(const Model& model, const std::vector<PoseResult>& results) {
+  std::ostringstream s;
+  char cell[40];
+  auto number = [&](double x) {
+    std::snprintf(cell, sizeof cell, " %.17g", std::abs(x) < 1e-12 ? 0.0 : x);
+    return std::string(cell);
+  };
+  s << "# Generated by `zwang energy`; run it in this directory: gnuplot energy.gp\n"
+       "set encoding utf8\n"
+       "set datafile separator whitespace\n"
+       "# columns: pose, |tau_control| plain, margin 0.5, margin 1 [N·m]\n"
+       "$norms << EOD\n";
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    s << kPoses[p].name;
+    for (int v = 0; v < kVariantCount; ++v) s << number(results[p].variant[v].norm);
+    s << "\n";
+  }
+  s << "EOD\n";
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    s << "# columns: joint, |tau_control,j| plain, margin 0.5, margin 1, breakaway f_j [N·m]\n"
+      << "$joints_" << kPoses[p].name << " << EOD\n";
+    for (int j = 0; j < kJoints; ++j) {
+      s << j + 1;
+      for (int v = 0; v < kVariantCount; ++v) s << number(std::abs(results[p].variant[v].tau[j]));
+      s << number(model.joint(j).breakaway_friction) << "\n";
+    }
+    s << "EOD\n";
+  }
+  s << "set style data histograms\n"
+       "set style histogram clustered gap 1\n"
+       "set style fill solid 0.85 border -1\n"
+       "set boxwidth 0.9\n"
+       "set grid ytics\n"
+       "set key outside bottom center horizontal box maxrows 1 width -2\n"
+       "set yrange [0:*]\n"
+       "set xrange [-0.6:" << results.size() - 0.4 << "]\n"
+       "\n"
+       "set terminal pngcairo size 900,520 font \"DejaVu Sans,11\"\n"
+       "set output \"panda_energy.png\"\n"
+       "set title \"Panda holding still against gravity: motor effort ‖τ_{control}‖\"\n"
+       "set ylabel \"‖τ_{control}‖ [N·m]\"\n"
+       "set xtics noenhanced\n"
+       "plot $norms using 2:xtic(1) title \"plain (friction-unaware)\" linecolor rgb \"#a0a0a0\", \\\n"
+       "  '' using 3 title \"friction-aware, margin 0.5\" linecolor rgb \"#70a0e0\", \\\n"
+       "  '' using 4 title \"friction-aware, margin 1\" linecolor rgb \"#0050b0\"\n"
+       "\n"
+       "set terminal pngcairo size 1200,760 font \"DejaVu Sans,10\"\n"
+       "set output \"panda_energy_joints.png\"\n"
+       "set multiplot layout 2,3 title \"Panda holding still: |τ_{control,j}| per joint (bars) and breakaway friction f_j (red)\"\n"
+       "set key inside top right vertical maxrows auto width 0 box opaque font \",8\"\n"
+       "set offsets 0, 0, graph 0.05, 0\n"
+       "set xrange [-0.6:" << kJoints - 0.4 << "]\n"
+       "set xlabel \"joint\"\n"
+       "set ylabel \"|τ| [N·m]\"\n"
+       "set yrange [0:*]\n";
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    const std::string data = std::string("$joints_") + kPoses[p].name;
+    s << "set title \"" << kPoses[p].name << "\" noenhanced\n"
+      << (p == 0 ? "" : "unset key\n") << "plot " << data
+      << " using 2:xtic(1) title \"plain\" linecolor rgb \"#a0a0a0\", \\\n  '' using 3 title \"margin 0.5\" "
+         "linecolor rgb \"#70a0e0\", \\\n  '' using 4 title \"margin 1\" linecolor rgb \"#0050b0\", \\\n  '' using "
+         "($0):5 with points pointtype 5 pointsize 1.1 linecolor rgb \"#c00000\" title \"f_j\"\n";
+  }
+  s << "unset multiplot\nunset output\n";
+  return s.str();
+}
+
+}  // namespace
+
+int commandEnergy(int argc, char** argv) {
+  const Arguments args = parseArguments("energy", argc, argv, 2, {"--no-plots"}, {"--out", "--models"});
+  if (args.help) {
+    std::fputs(usageText("energy"), stdout);
+    return kExitOk;
+  }
+  if (!args.positional.empty()) throw UsageError("energy", "unexpected argument '" + printable(args.positional[0], 60) + "'");
+  const std::filesystem::path out = args.value("--out", "energy");
+  const std::filesystem::path urdf = std::filesystem::path(modelsDirectory(args, "panda.urdf")) / "panda.urdf";
+  Model model;
+  try {
+    model = loadUrdfFile(urdf.string());
+  } catch (const ModelError& e) {
+    throw CliError(kExitError, std::string("energy: ") + e.what() + " (use --models DIR)");
+  }
+  if (model.dof() != kJoints || !model.hasFrame("tool0") || !model.hasFrame("panda_link1"))
+    throw CliError(kExitError, "energy: " + urdf.string() + ": expected the 7-joint Panda with frames panda_link1 and tool0");
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (ec) throw CliError(kExitError, "energy: " + out.string() + ": cannot create the directory (" + ec.message() + ")");
+
+  std::vector<PoseResult> results;
+  bool all_ok = true;
+  for (const Pose& pose : kPoses) {
+    results.push_back(run(model, pose));
+    all_ok = all_ok && results.back().ok;
+  }
+
+  std::error_code path_ec;
+  const std::filesystem::path shown = std::filesystem::proximate(urdf, path_ec);
+  std::printf("zwang energy: %s holding still against gravity (0, 0, -9.81), at rest\n",
+              (path_ec ? urdf : shown).string().c_str());
+  std::printf("task: tool0 fixed (6 rows, world axes) + panda_link1 angular z (= qdd1) fixed: qdd = 0 exactly\n");
+  std::printf("breakaway friction f [N·m] (URDF <dynamics friction>):");
+  for (int j = 0; j < kJoints; ++j) std::printf(" %s", fmt(model.joint(j).breakaway_friction).c_str());
+  std::printf("\nplain: solveHybridDynamics (tau_control = gravity torques G(q)); friction-aware: solveWithFriction,\n"
+              "all joints stick, mu* indeterminate, the maximiser with the least |tau_control|^2 using at most\n"
+              "margin*f_j, so |tau_control,j| = max(0, |G_j| - margin*f_j).\n\n");
+
+  std::printf("poses: q [rad], tool0 position [m]\n");
+  std::vector<std::vector<std::string>> poses{{"pose", "what", "q1", "q2", "q3", "q4", "q5", "q6", "q7", "tool x", "y", "z"}};
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    std::vector<std::string> row{kPoses[p].name, kPoses[p].what};
+    for (const double x : kPoses[p].q) row.push_back(fmt(x));
+    for (int k = 0; k < 3; ++k) row.push_back(fmt(std::abs(results[p].tool[k]) < 5e-4 ? 0.0 : results[p].tool[k], "%.3f"));
+    poses.push_back(row);
+  }
+  printColumns(poses, 2);
+
+  std::printf("\ntau_control per joint [N·m]\n");
+  std::vector<std::vector<std::string>> joints{{"pose", "variant", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6", "tau7"}};
+  for (std::size_t p = 0; p < results.size(); ++p)
+    for (int v = 0; v < kVariantCount; ++v) {
+      std::vector<std::string> row{v == 0 ? kPoses[p].name : "", kVariants[v].name};
+      for (int j = 0; j < kJoints; ++j) row.push_back(fmt(results[p].variant[v].tau[j]));
+      joints.push_back(row);
+    }
+  printColumns(joints, 2);
+
+  std::printf("\nactuator effort: |tau| = 2-norm of tau_control [N·m], sum|tau| [N·m], |tau|^2 [N²m²];\n"
+              "m = margin of the friction-aware solve; saved = how much less |tau|^2 with m=1 than plain\n");
+  std::vector<std::vector<std::string>> table{{"pose", "|tau| plain", "|tau| m=0.5", "|tau| m=1", "sum|tau| plain",
+                                               "sum|tau| m=0.5", "sum|tau| m=1", "|tau|^2 plain", "|tau|^2 m=0.5",
+                                               "|tau|^2 m=1", "saved m=1", "check"}};
+  double total[kVariantCount] = {0, 0, 0};
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    const PoseResult& r = results[p];
+    std::vector<std::string> row{kPoses[p].name};
+    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].norm));
+    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].abs_sum));
+    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].sq));
+    for (int v = 0; v < kVariantCount; ++v) total[v] += r.variant[v].sq;
+    row.push_back(fmt(100.0 * (1.0 - r.variant[2].sq / r.variant[0].sq), "%.1f") + " %");
+    row.push_back(r.ok ? "ok" : "MISMATCH");
+    table.push_back(row);
+  }
+  printColumns(table);
+  std::printf("\nall poses: |tau|^2 summed %s (plain), %s (margin 0.5), %s (margin 1): %s %% and %s %% less\n",
+              fmt(total[0]).c_str(), fmt(total[1]).c_str(), fmt(total[2]).c_str(),
+              fmt(100.0 * (1.0 - total[1] / total[0]), "%.1f").c_str(), fmt(100.0 * (1.0 - total[2] / total[0]), "%.1f").c_str());
+  std::printf("check: rank 7, |qdd| < 1e-9 and tau_control = the closed form within 1e-9 (G from RNEA)\n");
+
+  writeOutput((out / "panda_energy.csv").string(), csvText(results));
+  std::printf("wrote %s/panda_energy.csv (pose, variant, q1-7, tau1-7 = tau_control, mu1-7, tau_norm, tau_sq, tau_abs_sum)\n",
+              out.string().c_str());
+  if (!args.has("--no-plots")) {
+    writeOutput((out / "energy.gp").string(), plotScript(model, results));
+    if (plotWithGnuplot("energy", out, "energy.gp"))
+      std::printf("wrote %s/panda_energy.png, panda_energy_joints.png (gnuplot, script energy.gp)\n", out.string().c_str());
+  }
+  if (!all_ok) {
+    std::fprintf(stderr, "zwang: energy: a result disagrees with the closed form (see the check column)\n");
+    return kExitError;
+  }
+  return kExitOk;
+}
+
+}  // namespace zwang::cli

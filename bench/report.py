@@ -299,6 +299,19 @@ def main():
     w("")
 
     # ---- Friction versus the report's methods, at every size
+    worst = [(name, counters[name]) for name in sorted(counters) if name.startswith("worst_")]
+    if worst:
+        w("## Worst case over 10⁶ calls")
+        w("")
+        w("Each friction solve timed on its own (steady_clock, its ~20 ns overhead included), Panda with all 7")
+        w("joints stuck; the same workspace throughout (median of the repetitions for each statistic).")
+        w("")
+        w("| benchmark | calls | median [ns] | 99 % [ns] | 99.99 % [ns] | max [ns] |")
+        w("|---|---|---|---|---|---|")
+        for name, c in worst:
+            w(f"| `{name}` | {c.get('calls', 0):,.0f} | {fmt_ns(c.get('median_ns'))} | {fmt_ns(c.get('p99_ns'))} | "
+              f"{fmt_ns(c.get('p99.99_ns'))} | {fmt_ns(c.get('max_ns'))} |")
+        w("")
     w("## Friction solve versus the report's methods")
     w("")
     w("Time of the method divided by the time of `solveWithFriction` (active set) on the same problem.")

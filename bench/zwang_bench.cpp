@@ -26,6 +26,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -356,6 +357,37 @@ void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int
 }
 
 // ---------------------------------------------------------------------------
+// Worst case, not median: 10⁶ timed friction solves (issue 6, real-time
+// guarantees). Each call is timed on its own with steady_clock (its overhead,
+// some 20 ns, is included); counters give the maximum and the tail.
+
+void benchWorstCase(benchmark::State& state, const Problem* p, TaskKind kind, int calls) {
+  const std::vector<int> stuck = stuckSet(p->n, p->n);
+  const Eigen::VectorXd qd = stuckVelocities(*p, stuck);
+  const Task task = taskFromInput(p->model, makeInput(*p, kind, qd));
+  Workspace ws(p->model, task);
+  std::vector<double> ns(static_cast<std::size_t>(calls));
+  for (auto _ : state) {
+    for (int c = 0; c < calls; ++c) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const Status s = solveWithFriction(p->model, task, p->q, qd, p->tau, ws);
+      const auto t1 = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(s.code);
+      benchmark::DoNotOptimize(ws.solution.qdd.data());
+      ns[static_cast<std::size_t>(c)] = std::chrono::duration<double, std::nano>(t1 - t0).count();
+    }
+  }
+  std::sort(ns.begin(), ns.end());
+  auto quantile = [&](double q) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * ns.size()))]; };
+  setCounters(state, *p, task.constraintRows(), p->n);
+  state.counters["calls"] = calls;
+  state.counters["median_ns"] = quantile(0.5);
+  state.counters["p99_ns"] = quantile(0.99);
+  state.counters["p99.99_ns"] = quantile(0.9999);
+  state.counters["max_ns"] = ns.back();
+}
+
+// ---------------------------------------------------------------------------
 // Static friction: the report's method and a naive gradient method, both
 // calling the full solver (solveHybridDynamics) for every evaluation of g.
 //
@@ -607,6 +639,15 @@ int main(int argc, char** argv) {
         reg(std::string("naivepg_") + task_name + "_k" + std::to_string(k), *p,
             [q = p.get(), kind = kind, k](benchmark::State& s) { benchNaiveGradient(s, q, kind, k); });
       }
+
+  // Worst case over 10⁶ calls, Panda with every joint stuck (plain and 6 rows).
+  for (const auto& p : problems)
+    if (p->label == "panda")
+      for (const auto& [kind, task_name] : fric_tasks)
+        benchmark::RegisterBenchmark((std::string("worst_as_") + task_name + "_kall/" + p->label).c_str(),
+                                     [q = p.get(), kind = kind](benchmark::State& s) { benchWorstCase(s, q, kind, 1000000); })
+            ->Iterations(1)
+            ->Unit(benchmark::kMillisecond);
 
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

@@ -2,7 +2,7 @@
 // binary and check exit codes, stderr and the JSON/CSV it writes. Numbers are
 // compared numerically, never as strings.
 //
-// Tags (one ctest test each): [golden] [errors] [robustness] [usage] [info] [scenarios] [energy]
+// Tags (one ctest test each): [golden] [errors] [robustness] [usage] [info] [scenarios] [energy] [docs]
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -756,4 +756,45 @@ TEST_CASE("energy: usage and a missing model", "[energy]") {
   CHECK(contains(none.err, "zwang: energy: "));
   CHECK(contains(none.err, "panda.urdf"));
   CHECK(contains(none.err, "(use --models DIR)"));
+}
+
+// ---------------------------------------------------------------------------
+// docs: what the pages quote is what is compiled and committed.
+
+TEST_CASE("getting-started.md quotes the example that ctest compiles and runs", "[docs]") {
+  const std::string docs = ZWANG_DOCS_DIR;
+  std::string example = cli_test::readText(docs + "/examples/getting_started.cpp");
+  while (!example.empty() && example.back() == '\n') example.pop_back();
+  const std::string page = cli_test::readText(docs + "/getting-started.md");
+  CHECK(contains(page, "```cpp\n" + example + "\n```\n"));
+  const std::string problem_text = cli_test::readText(kProblems + "/arm_stick.json");
+  CHECK(contains(page, problem_text.substr(0, problem_text.find_last_not_of('\n') + 1)));
+}
+
+TEST_CASE("the docs link only to files that exist", "[docs]") {
+  const std::string docs = ZWANG_DOCS_DIR;
+  for (const char* name : {"getting-started.md", "conventions.md", "theory.md", "evaluation.md", "cli.md"}) {
+    INFO(name);
+    REQUIRE(cli_test::fileExists(docs + "/" + name));
+    // The page without its fenced code blocks (code may contain "](").
+    std::string page;
+    {
+      std::istringstream lines(cli_test::readText(docs + "/" + name));
+      bool fenced = false;
+      for (std::string line; std::getline(lines, line);) {
+        if (line.rfind("```", 0) == 0) fenced = !fenced;
+        else if (!fenced) page += line + "\n";
+      }
+    }
+    // Markdown links and images: ](target) with a relative target.
+    for (std::size_t at = page.find("]("); at != std::string::npos; at = page.find("](", at + 2)) {
+      const std::size_t end = page.find(')', at);
+      REQUIRE(end != std::string::npos);
+      std::string target = page.substr(at + 2, end - at - 2);
+      if (target.rfind("http", 0) == 0 || target.empty() || target[0] == '#') continue;
+      target = target.substr(0, target.find('#'));
+      INFO(target);
+      CHECK(std::filesystem::exists(std::filesystem::path(docs) / target));
+    }
+  }
 }

@@ -269,7 +269,9 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
       s.d[rows++] = x0[j] - lo[j];
     }
   }
-  const double scale = 1.0 + a.cwiseAbs().maxCoeff() + s.d.head(rows).cwiseAbs().maxCoeff();
+  // (No rows at all when every bound is infinite: nothing limits z.)
+  const double scale = 1.0 + (q > 0 ? a.cwiseAbs().maxCoeff() : 0.0) +
+                       (rows > 0 ? s.d.head(rows).cwiseAbs().maxCoeff() : 0.0);
   const double tol = 1e-12 * scale;
   Index nw = 0;  // working set: indices into the rows, s.working[0..nw)
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {

@@ -42,27 +42,30 @@ void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws) 
 
 }  // namespace internal
 
-Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
-                         const Eigen::Ref<const Eigen::VectorXd>& qd) {
+namespace {
+
+// The checks every kinematics entry point shares (no allocation, no exception).
+Status checkWorkspace(const Model& model, const Workspace& ws) noexcept {
   if (ws.dof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
                          model.dof());
-  if (Status s = internal::checkVector("q", q, model.dof()); !s) return s;
-  if (qd.size() != 0)
-    if (Status s = internal::checkVector("qd", qd, model.dof()); !s) return s;
-  internal::outwardKinematics(model, q, qd, ws, false);
   return {};
 }
 
-Eigen::Isometry3d framePose(const Model& model, const Workspace& ws, int frame) {
-  const Transform X = internal::framePlacementInBase(model, ws, frame);  // ᶠX_0
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = X.E.transpose();
-  T.translation() = X.r;
-  return T;
+Status checkFrame(const Model& model, int frame) noexcept {
+  const int frames = static_cast<int>(model.frames().size());
+  if (frame < 0 || frame >= frames)
+    return Status::error(StatusCode::ModelMismatch, "frame index %d is not a frame of this model (it has %d frames)", frame,
+                         frames);
+  return {};
 }
 
-namespace {
+// Both, for the accessors that read a workspace after forwardKinematics or a solve.
+Status checkFrameAndWorkspace(const Model& model, const Workspace& ws, int frame) noexcept {
+  if (Status s = checkFrame(model, frame); !s) return s;
+  return checkWorkspace(model, ws);
+}
+
 // A classical [linear of the frame origin; angular] 6-vector in world axes,
 // re-expressed as asked.
 Vec6 express(const Transform& Xf0, Expressed expressed, const Vec6& world) {
@@ -71,31 +74,54 @@ Vec6 express(const Transform& Xf0, Expressed expressed, const Vec6& world) {
   out << Xf0.E * world.head<3>(), Xf0.E * world.tail<3>();
   return out;
 }
+
 }  // namespace
 
-Vec6 frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed) {
+Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                         const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
+  if (Status s = checkWorkspace(model, ws); !s) return s;
+  if (Status s = internal::checkVector("q", q, model.dof()); !s) return s;
+  if (qd.size() != 0)
+    if (Status s = internal::checkVector("qd", qd, model.dof()); !s) return s;
+  internal::outwardKinematics(model, q, qd, ws, false);
+  return {};
+}
+
+Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isometry3d& pose) noexcept {
+  if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
+  const Transform X = internal::framePlacementInBase(model, ws, frame);  // ᶠX_0
+  pose.setIdentity();
+  pose.linear() = X.E.transpose();
+  pose.translation() = X.r;
+  return {};
+}
+
+Status frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed, Vec6& velocity) noexcept {
+  if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   const Vec6& v = ws.v[static_cast<std::size_t>(model.frame(frame).body)];
   Vec6 world;
   world << v.head<3>() + v.tail<3>().cross(X.r), v.tail<3>();  // velocity of the frame origin p
-  return express(X, expressed, world);
+  velocity = express(X, expressed, world);
+  return {};
 }
 
-Vec6 frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed) {
+Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed,
+                         Vec6& acceleration) noexcept {
+  if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
   // ws.a holds the sweep's accelerations, true + [−g; 0] (= ws.a[0]).
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   const auto b = static_cast<std::size_t>(model.frame(frame).body);
-  return express(X, expressed, internal::classicalAtPoint(ws.a[b] - ws.a[0], ws.v[b], X.r));
+  acceleration = express(X, expressed, internal::classicalAtPoint(ws.a[b] - ws.a[0], ws.v[b], X.r));
+  return {};
 }
 
 Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q, int frame,
-                     Expressed expressed, Eigen::Ref<Eigen::MatrixXd> J) {
+                     Expressed expressed, Eigen::Ref<Eigen::MatrixXd> J) noexcept {
   if (J.rows() != 6 || J.cols() != model.dof())
     return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",
                          static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.dof());
-  if (frame < 0 || frame >= static_cast<int>(model.frames().size()))
-    return Status::error(StatusCode::ModelMismatch, "frame index %d is not a frame of this model (it has %d frames)", frame,
-                         static_cast<int>(model.frames().size()));
+  if (Status s = checkFrame(model, frame); !s) return s;
   if (Status s = forwardKinematics(model, ws, q); !s) return s;
   // Column j: the frame-origin velocity of a unit rate of joint j, S_{j+1}
   // (base coordinates) seen at the frame origin p, for the joints that move it.

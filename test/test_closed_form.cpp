@@ -3,9 +3,11 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "support/frame_values.hpp"
 #include "zwang/zwang.hpp"
 
 using namespace zwang;
+using zwang::testing::accelerationOf;
 
 namespace {
 
@@ -98,14 +100,14 @@ TEST_CASE("1-DOF arm: constraints and accelerations are classical (ω×v include
   REQUIRE(solveHybridDynamics(model, task, vec({0.4}), vec({omega}), vec({0.0}), ws));
   CHECK(ws.solution.qdd[0] == Approx(2.0).epsilon(1e-14));
   // The tip moves on a unit circle: centripetal −ω² along local x, α along y.
-  const Vec6 a_tip = frameAcceleration(model, ws, model.frameIndex("tip"), Expressed::Local);
+  const Vec6 a_tip = accelerationOf(model, ws, model.frameIndex("tip"), Expressed::Local);
   CHECK(a_tip[0] == Approx(-omega * omega).epsilon(1e-13));
   CHECK(a_tip[1] == Approx(2.0).epsilon(1e-13));
   CHECK(a_tip[5] == Approx(2.0).epsilon(1e-13));
   // The body frame sits on the axis: no linear acceleration.
-  CHECK(frameAcceleration(model, ws, model.bodyFrame(1), Expressed::Local).head<3>().norm() < 1e-13);
+  CHECK(accelerationOf(model, ws, model.bodyFrame(1), Expressed::Local).head<3>().norm() < 1e-13);
   // In world axes, at q = 0.4 the local x axis is (cos, sin, 0).
-  const Vec6 a_world = frameAcceleration(model, ws, model.frameIndex("tip"), Expressed::World);
+  const Vec6 a_world = accelerationOf(model, ws, model.frameIndex("tip"), Expressed::World);
   const double c = std::cos(0.4), s = std::sin(0.4);
   CHECK(a_world[0] == Approx(-omega * omega * c - 2.0 * s).epsilon(1e-13));
   CHECK(a_world[1] == Approx(-omega * omega * s + 2.0 * c).epsilon(1e-13));

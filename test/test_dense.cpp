@@ -6,6 +6,7 @@
 #include <Eigen/SVD>
 #include <cstdio>
 
+#include "support/frame_values.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"
 
@@ -54,8 +55,8 @@ TEST_CASE("hybrid dynamics matches the dense KKT solution on 500+ random chains"
     gauss_err.add(std::abs(s.gauss - ref.gauss) / std::max(1.0, std::abs(ref.gauss)));
     for (std::size_t l = 0; l < spec.links.size(); ++l) {
       const int frame = model.frameIndex(spec.links[l].name);
-      acc_err.add(relativeError(frameAcceleration(model, ws, frame, Expressed::Local), ref.acc_local[l]));
-      acc_err.add(relativeError(frameAcceleration(model, ws, frame, Expressed::World), ref.acc_world[l]));
+      acc_err.add(relativeError(accelerationOf(model, ws, frame, Expressed::Local), ref.acc_local[l]));
+      acc_err.add(relativeError(accelerationOf(model, ws, frame, Expressed::World), ref.acc_world[l]));
     }
 
     // Closure (SPEC §1): the unconstrained arm driven by τ_ctrl and the same
@@ -108,7 +109,7 @@ TEST_CASE("RNEA, CRBA, Jacobians and poses match the dense reference") {
         const Eigen::MatrixXd Jref = linkJacobian(spec, in.q, spec.links[l].name, axes);
         jac_err.add((J - Jref).cwiseAbs().maxCoeff());
       }
-      const Eigen::Isometry3d T = framePose(model, ws, frame);
+      const Eigen::Isometry3d T = poseOf(model, ws, frame);
       pose_err.add((T.matrix() - kin.poses[l].matrix()).cwiseAbs().maxCoeff());
     }
   }

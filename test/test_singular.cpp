@@ -8,6 +8,7 @@
 #include <Eigen/SVD>
 #include <catch2/catch.hpp>
 
+#include "support/frame_values.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"
 
@@ -113,7 +114,7 @@ TEST_CASE("stretched-out arm: the along-arm tip acceleration is out of reach") {
   CHECK(s.coupling.singular);
   CHECK(s.coupling.rank == 1);
   // Across the arm the demand is met; along it, the arm does what it can (nothing).
-  const Vec6 a = frameAcceleration(model, ws, model.frameIndex("tip"), Expressed::Local);
+  const Vec6 a = accelerationOf(model, ws, model.frameIndex("tip"), Expressed::Local);
   CHECK(a[1] == Approx(0.7).epsilon(1e-6));
   CHECK(a[0] == Approx(0.0).margin(1e-9));
   const auto [ours, best] = residuals(denseDynamics(spec, in), s.qdd);

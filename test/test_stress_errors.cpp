@@ -103,6 +103,32 @@ TEST_CASE("errors: RNEA, CRBA, kinematics and Jacobian statuses", "[errors]") {
   s = frameJacobian(model, ws, x, 1, Expressed::World, J);
   CHECK(s.code == StatusCode::SizeMismatch);
   CHECK_THAT(s.message, Contains("Jacobian output is 6x5, expected 6x7"));
+
+  // A frame index out of range, and a workspace made for another model: the
+  // kinematics accessors (issue #6) and frameJacobian say the same.
+  REQUIRE(forwardKinematics(model, ws, x, x));
+  Eigen::Isometry3d pose;
+  Vec6 out;
+  J.resize(6, 7);
+  const int frames = static_cast<int>(model.frames().size());
+  const std::function<Status(const Workspace&, int)> accessors[] = {
+      [&](const Workspace& w, int f) { return framePose(model, w, f, pose); },
+      [&](const Workspace& w, int f) { return frameVelocity(model, w, f, Expressed::Local, out); },
+      [&](const Workspace& w, int f) { return frameAcceleration(model, w, f, Expressed::World, out); }};
+  for (const auto& accessor : accessors) {
+    s = accessor(ws, frames);
+    CHECK(s.code == StatusCode::ModelMismatch);
+    CHECK_THAT(s.message, Contains("frame index 10 is not a frame of this model (it has 10 frames)"));
+    s = accessor(ws, -1);
+    CHECK(s.code == StatusCode::ModelMismatch);
+    CHECK_THAT(s.message, Contains("frame index -1 is not a frame of this model (it has 10 frames)"));
+    s = accessor(foreign, 1);
+    CHECK(s.code == StatusCode::ModelMismatch);
+    CHECK_THAT(s.message, Contains("workspace was made for 1 joints, the model has 7"));
+  }
+  s = frameJacobian(model, ws, x, -1, Expressed::Local, J);
+  CHECK(s.code == StatusCode::ModelMismatch);
+  CHECK_THAT(s.message, Contains("frame index -1 is not a frame of this model (it has 10 frames)"));
 }
 
 TEST_CASE("errors: friction options and the infeasible task", "[errors]") {

@@ -93,8 +93,11 @@ PoseResult run(const Model& model, const Pose& pose) {
   if (const Status s = inverseDynamics(model, free_task, r.q, zero, zero, ws); !s)
     throw CliError(kExitError, where + "RNEA: " + s.message);
   r.gravity = ws.tau;
-  if (const Status s = forwardKinematics(model, ws, r.q); !s) throw CliError(kExitError, where + s.message);
-  r.tool = framePose(model, ws, model.frameIndex("tool0")).translation();
+  Eigen::Isometry3d tool;
+  Status s = forwardKinematics(model, ws, r.q);
+  if (s) s = framePose(model, ws, model.frameIndex("tool0"), tool);
+  if (!s) throw CliError(kExitError, where + s.message);
+  r.tool = tool.translation();
 
   for (int v = 0; v < kVariantCount; ++v) {
     const Variant& variant = kVariants[v];

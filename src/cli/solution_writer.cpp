@@ -1,6 +1,10 @@
 // Writing the solution of `zwang solve` as JSON.
 #include "solution_writer.hpp"
 
+#include <string>
+
+#include "cli.hpp"
+
 namespace zwang::cli {
 
 namespace {
@@ -77,8 +81,12 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
                    {"rank", s.coupling.rank},
                    {"infeasible", status.code == StatusCode::Infeasible}};
   Json frame_map = Json::object();
-  for (const int f : frames)
-    frame_map[model.frame(f).name] = {{"acceleration_world", array(frameAcceleration(model, ws, f, Expressed::World))}};
+  for (const int f : frames) {
+    Vec6 a;
+    if (const Status s = frameAcceleration(model, ws, f, Expressed::World, a); !s)
+      throw CliError(kExitError, std::string("solve: ") + s.message);
+    frame_map[model.frame(f).name] = {{"acceleration_world", array(a)}};
+  }
   out["frames"] = std::move(frame_map);
   return out;
 }

@@ -42,7 +42,16 @@ int main(int argc, char** argv) {
       return 1;
     }
     const zwang::Solution& s = ws.solution;
-    const Eigen::Vector3d p = zwang::framePose(model, ws, model.frameIndex(tool)).translation();
+    const int tool_frame = model.frameIndex(tool);
+    Eigen::Isometry3d pose;
+    zwang::Vec6 a_tool;
+    zwang::Status read = zwang::framePose(model, ws, tool_frame, pose);
+    if (read) read = zwang::frameAcceleration(model, ws, tool_frame, zwang::Expressed::World, a_tool);
+    if (!read) {
+      std::fprintf(stderr, "zwang_demo: %s\n", read.message);
+      return 1;
+    }
+    const Eigen::Vector3d p = pose.translation();
     std::printf("zwang demo: %s (%d joints), hold '%s' still under gravity\n", model.name().c_str(), n, tool.c_str());
     std::printf("  tool position [m]            %9.4f %9.4f %9.4f\n", p.x(), p.y(), p.z());
     printVector("q [rad]", q);
@@ -50,7 +59,6 @@ int main(int argc, char** argv) {
     printVector("nu (tool wrench, world)", s.nu);
     printVector("tau_constraint [Nm]", s.tau_constraint);
     printVector("tau_control [Nm]", s.tau_control);
-    const zwang::Vec6 a_tool = zwang::frameAcceleration(model, ws, model.frameIndex(tool), zwang::Expressed::World);
     std::printf("  tool acceleration (check 0)  %9.2e\n", a_tool.norm());
     std::printf("  Gauss function Z            %9.4f\n", s.gauss);
     std::printf("  coupling L: rows %d, rank %d, condition %.3g, damping %.3g, singular %s\n", s.coupling.rows,

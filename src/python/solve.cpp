@@ -188,7 +188,9 @@ py::object overrideArray(const Eigen::VectorXd& v) { return v.size() ? py::objec
 Vec6 frameAccelerationOf(const Result& r, int frame, Expressed e) {
   if (r.data) return (e == Expressed::Local ? r.data->frame_acc_local : r.data->frame_acc_world).row(frame).transpose();
   r.solution();  // stale check
-  return frameAcceleration(*r.model, *r.live->ws, frame, e);
+  Vec6 a;
+  if (const Status s = frameAcceleration(*r.model, *r.live->ws, frame, e, a); !s) raiseStatus(s, "frame_acceleration");
+  return a;
 }
 
 // (bodies × 6) accelerations of every body's own frame, computed on demand.
@@ -549,7 +551,9 @@ void bindSolve(py::module_& m) {
       ++pw.generation;
       if (const Status s = forwardKinematics(*model, *pw.ws, qv); !s) raiseStatus(s, "frame_pose");
     }
-    return matrixCopy(framePose(*model, *pw.ws, f).matrix());
+    Eigen::Isometry3d pose;
+    if (const Status s = framePose(*model, *pw.ws, f, pose); !s) raiseStatus(s, "frame_pose");
+    return matrixCopy(pose.matrix());
   }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), "4×4 pose of the frame in the world at q");
   m.def("frame_velocity", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd,
                              py::handle frame, const std::string& expressed) {
@@ -557,9 +561,13 @@ void bindSolve(py::module_& m) {
     const int f = frameArg(*model, frame);
     const auto qv = vectorArg("q", q, pw.q_buf);
     const auto qdv = vectorArg("qd", qd, pw.qd_buf);
+    const Expressed e = expressedArg("expressed", expressed, true);
     ++pw.generation;
-    if (const Status s = forwardKinematics(*model, *pw.ws, qv, qdv); !s) raiseStatus(s, "frame_velocity");
-    return vectorCopy(frameVelocity(*model, *pw.ws, f, expressedArg("expressed", expressed, true)));
+    Vec6 v;
+    Status s = forwardKinematics(*model, *pw.ws, qv, qdv);
+    if (s) s = frameVelocity(*model, *pw.ws, f, e, v);
+    if (!s) raiseStatus(s, "frame_velocity");
+    return vectorCopy(v);
   }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd"), py::arg("frame"), py::arg("expressed") = "local",
         "classical velocity [v; ω] of the frame origin");
   m.def("frame_jacobian", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame,

@@ -1,5 +1,6 @@
 // Once the workspace exists, the hot-path calls make no heap allocation.
 #include <catch2/catch.hpp>
+#include <type_traits>
 
 #include "counting_malloc.hpp"
 #include "zwang/zwang.hpp"
@@ -71,13 +72,18 @@ TEST_CASE("RNEA, CRBA, kinematics and Jacobians allocate nothing") {
   const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), qd = Eigen::VectorXd::Constant(7, 0.3);
   Eigen::MatrixXd J(6, 7);
   const int tool = model.frameIndex("tool0");
+  Eigen::Isometry3d pose;
+  Vec6 v_local, v_world;
   bool ok = false;
   double sink = 0.0;
   const long count = allocationsDuring([&] {
     ok = inverseDynamics(model, task, q, qd, qd, ws).ok();
     ok = jointSpaceInertia(model, q, ws).ok() && ok;
     ok = forwardKinematics(model, ws, q, qd).ok() && ok;
-    sink = framePose(model, ws, tool).translation().x() + frameVelocity(model, ws, tool)[0];
+    ok = framePose(model, ws, tool, pose).ok() && ok;
+    ok = frameVelocity(model, ws, tool, Expressed::Local, v_local).ok() && ok;
+    ok = frameVelocity(model, ws, tool, Expressed::World, v_world).ok() && ok;
+    sink = pose.translation().x() + v_local[0] + v_world[1];
     ok = frameJacobian(model, ws, q, tool, Expressed::World, J).ok() && ok;
   });
   CHECK(ok);
@@ -133,6 +139,28 @@ TEST_CASE("the solver entry points are declared noexcept") {
   CHECK(solveHybridDynamics(model, task, r, r, r, ws).ok());  // (and they run)
 }
 
+TEST_CASE("the kinematics entry points are declared noexcept") {
+  const Model model = panda();
+  Workspace ws(model, 0);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
+  const Eigen::Ref<const Eigen::VectorXd> r(x);
+  Eigen::Isometry3d pose;
+  Vec6 out;
+  // (qd given: the default argument builds a Ref, which is not noexcept itself.)
+  static_assert(noexcept(forwardKinematics(model, ws, r, r)));
+  static_assert(noexcept(framePose(model, ws, 0, pose)));
+  static_assert(noexcept(frameVelocity(model, ws, 0, Expressed::Local, out)));
+  static_assert(noexcept(frameAcceleration(model, ws, 0, Expressed::World, out)));
+  // frameJacobian takes its output Ref by value, and copying a Ref is not
+  // noexcept: assert the declaration itself (noexcept is part of the type).
+  static_assert(std::is_same_v<decltype(frameJacobian),
+                               Status(const Model&, Workspace&, const Eigen::Ref<const Eigen::VectorXd>&, int, Expressed,
+                                      Eigen::Ref<Eigen::MatrixXd>) noexcept>);
+  CHECK(forwardKinematics(model, ws, r, r).ok());  // (and they run)
+  CHECK(framePose(model, ws, 0, pose).ok());
+  CHECK(pose.isApprox(Eigen::Isometry3d::Identity()));  // frame 0 is the base
+}
+
 TEST_CASE("friction at a joint limit, with overrides, a margin and an infeasible task allocates nothing") {
   const Model model = panda();
   Task task(model);
@@ -171,12 +199,16 @@ TEST_CASE("frame accelerations and kinematics without velocities allocate nothin
   const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), qd = Eigen::VectorXd::Constant(7, 0.3);
   REQUIRE(solveHybridDynamics(model, task, q, qd, qd, ws));
   const int tool = model.frameIndex("tool0");
+  Vec6 a_world, a_local;
+  Eigen::Isometry3d pose;
   bool ok = false;
   double sink = 0.0;
   const long count = allocationsDuring([&] {
-    sink = frameAcceleration(model, ws, tool, Expressed::World)[2] + frameAcceleration(model, ws, tool)[0];
-    ok = forwardKinematics(model, ws, q).ok();
-    sink += framePose(model, ws, tool).translation().z();
+    ok = frameAcceleration(model, ws, tool, Expressed::World, a_world).ok();
+    ok = frameAcceleration(model, ws, tool, Expressed::Local, a_local).ok() && ok;
+    ok = forwardKinematics(model, ws, q).ok() && ok;
+    ok = framePose(model, ws, tool, pose).ok() && ok;
+    sink = a_world[2] + a_local[0] + pose.translation().z();
   });
   CHECK(ok);
   CHECK(std::isfinite(sink));
@@ -200,6 +232,9 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
   bad_tolerance.kkt_tolerance = 0.0;
   bad_speed.velocity_tolerance = -1.0;
   Eigen::MatrixXd J(6, 7), J_wrong(6, 3);
+  const int frames = static_cast<int>(model.frames().size());
+  Eigen::Isometry3d pose;
+  Vec6 out;
 
   // Each call returns the expected code; collected first, checked after the counted region.
   StatusCode codes[32];
@@ -225,6 +260,16 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
     codes[n++] = forwardKinematics(model, foreign, ok7).code;                        // ModelMismatch
     codes[n++] = frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong).code;   // SizeMismatch
     codes[n++] = frameJacobian(model, ws, nan7, 1, Expressed::World, J).code;        // NonFinite
+    codes[n++] = frameJacobian(model, ws, ok7, frames, Expressed::World, J).code;    // ModelMismatch (frame)
+    codes[n++] = framePose(model, ws, -1, pose).code;                                // ModelMismatch (frame)
+    codes[n++] = framePose(model, ws, frames, pose).code;                            // ModelMismatch (frame)
+    codes[n++] = framePose(model, foreign, 1, pose).code;                            // ModelMismatch (workspace)
+    codes[n++] = frameVelocity(model, ws, -1, Expressed::Local, out).code;           // ModelMismatch (frame)
+    codes[n++] = frameVelocity(model, ws, frames, Expressed::World, out).code;       // ModelMismatch (frame)
+    codes[n++] = frameVelocity(model, foreign, 1, Expressed::Local, out).code;       // ModelMismatch (workspace)
+    codes[n++] = frameAcceleration(model, ws, -1, Expressed::World, out).code;       // ModelMismatch (frame)
+    codes[n++] = frameAcceleration(model, ws, frames, Expressed::Local, out).code;   // ModelMismatch (frame)
+    codes[n++] = frameAcceleration(model, foreign, 1, Expressed::World, out).code;   // ModelMismatch (workspace)
   });
   CHECK(count == 0);
   const StatusCode expected[] = {
@@ -232,35 +277,55 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
       StatusCode::ModelMismatch, StatusCode::NonFinite,   StatusCode::BadOption,         StatusCode::BadOption,
       StatusCode::BadOption,     StatusCode::BadOption,   StatusCode::BadOption,         StatusCode::SizeMismatch,
       StatusCode::ModelMismatch, StatusCode::NonFinite,   StatusCode::ModelMismatch,     StatusCode::SizeMismatch,
-      StatusCode::NonFinite,     StatusCode::ModelMismatch, StatusCode::SizeMismatch,    StatusCode::NonFinite};
+      StatusCode::NonFinite,     StatusCode::ModelMismatch, StatusCode::SizeMismatch,    StatusCode::NonFinite,
+      StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,   StatusCode::ModelMismatch,
+      StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,   StatusCode::ModelMismatch,
+      StatusCode::ModelMismatch, StatusCode::ModelMismatch};
   REQUIRE(n == static_cast<int>(sizeof expected / sizeof expected[0]));
   for (int k = 0; k < n; ++k) {
     INFO("call " << k);
     CHECK(codes[k] == expected[k]);
   }
-  // The same calls again outside the counter: none throws (the noexcept ones
-  // would terminate; these check the ones that are not declared noexcept too).
-  CHECK_NOTHROW(forwardKinematics(model, ws, short3));
-  CHECK_NOTHROW(forwardKinematics(model, foreign, ok7));
-  CHECK_NOTHROW(frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong));
+  // Every entry point is declared noexcept (the static_asserts above): one
+  // that threw would have terminated this test binary.
 }
 
-TEST_CASE("frameJacobian with a frame index out of range returns a Status, allocates and throws nothing") {
-  // (Threw std::out_of_range from Model::frame() until 6daad16.)
+TEST_CASE("a frame index out of range: every kinematics accessor returns a Status, allocates and throws nothing") {
+  // (frameJacobian threw std::out_of_range from Model::frame() until 6daad16;
+  // framePose, frameVelocity and frameAcceleration until issue #6 made them
+  // return a Status.)
   const Model model = panda();
   Task task(model);
   Workspace ws(model, task);
   Eigen::MatrixXd J(6, 7);
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);
+  REQUIRE(solveHybridDynamics(model, task, q, q, q, ws));
   const int frames = static_cast<int>(model.frames().size());
-  Status past_end, negative;
-  long count = -1;
-  CHECK_NOTHROW(count = allocationsDuring([&] {
-                  past_end = frameJacobian(model, ws, q, frames, Expressed::World, J);
-                  negative = frameJacobian(model, ws, q, -1, Expressed::World, J);
-                }));
+  REQUIRE(frames == 10);
+  // Outputs hold a marker: an error leaves them unchanged.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << 7, 7, 7;
+  const Vec6 marker = Vec6::Constant(7.0);
+  Vec6 v = marker, a = marker;
+  Status results[8];
+  const long count = allocationsDuring([&] {
+    int k = 0;
+    for (const int bad : {-1, frames}) {
+      results[k++] = frameJacobian(model, ws, q, bad, Expressed::World, J);
+      results[k++] = framePose(model, ws, bad, pose);
+      results[k++] = frameVelocity(model, ws, bad, Expressed::Local, v);
+      results[k++] = frameAcceleration(model, ws, bad, Expressed::World, a);
+    }
+  });
   CHECK(count == 0);
-  CHECK(past_end.code == StatusCode::ModelMismatch);
-  CHECK(negative.code == StatusCode::ModelMismatch);
-  CHECK_THAT(std::string(past_end.message), Catch::Contains("frame index 10 is not a frame of this model"));
+  const char* expected[] = {"frame index -1 is not a frame of this model (it has 10 frames)",
+                            "frame index 10 is not a frame of this model (it has 10 frames)"};
+  for (int k = 0; k < 8; ++k) {
+    INFO("call " << k);
+    CHECK(results[k].code == StatusCode::ModelMismatch);
+    CHECK(std::string(results[k].message) == expected[k / 4]);
+  }
+  CHECK(pose.translation() == Eigen::Vector3d(7, 7, 7));
+  CHECK(v == marker);
+  CHECK(a == marker);
 }

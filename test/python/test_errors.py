@@ -90,6 +90,16 @@ def test_unknown_frames_and_joints(panda, ws):
         panda.joint("elbow")
     with pytest.raises(zwang.ModelError, match="out of range"):
         zwang.frame_pose(panda, ws, READY, 99)
+    # Every kinematics accessor: names and indices, past either end.
+    for frame in [-1, len(panda.frames), "hand"]:
+        with pytest.raises(zwang.ModelError):
+            zwang.frame_pose(panda, ws, READY, frame)
+        with pytest.raises(zwang.ModelError):
+            zwang.frame_velocity(panda, ws, READY, np.zeros(7), frame)
+        with pytest.raises(zwang.ModelError):
+            zwang.frame_jacobian(panda, ws, READY, frame)
+        with pytest.raises(zwang.ModelError):
+            solve(panda, ws).frame_acceleration(frame)
     # The workspace still works after the errors.
     assert solve(panda, ws).qdd.shape == (7,)
 

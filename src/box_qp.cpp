@@ -24,7 +24,8 @@ QpScratch::QpScratch(int n)
       d(2 * n),
       free_index(n),
       working(2 * n),
-      side(2 * n) {}
+      side(2 * n),
+      factor(n) {}
 
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
@@ -36,140 +37,6 @@ double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
     r = std::max(r, std::abs(x[j] - projected));
   }
   return r;
-}
-
-QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
-                        const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
-                        double zero_curvature) {
-  QpReport report;
-  const Index k = x.size();
-  if (k == 0) {
-    report.converged = true;
-    return report;
-  }
-  double x_scale = 1.0;
-  for (Index j = 0; j < k; ++j) {
-    if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
-    if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
-  }
-  // Warm start: when P is certified positive definite, the unconstrained
-  // minimiser P⁻¹c clamped to the box (feasible, and usually close to the
-  // optimal active set, so few iterations follow even for many variables).
-  {
-    auto C = s.V.topLeftCorner(k, k);
-    if (certifiedCholesky(P, C, s.lambda.head(k), zero_curvature)) {
-      auto x_unc = s.p.head(k);
-      x_unc = c;
-      choleskySolveInPlace(C, x_unc);
-      for (Index j = 0; j < k; ++j) x[j] = std::min(hi[j], std::max(lo[j], x_unc[j]));
-    }
-  }
-  // working[j] = 1: x_j held at a bound. Start with the variables whose box is
-  // a point, and those already on a bound.
-  auto on_bound = [&](Index j) { return x[j] <= lo[j] || x[j] >= hi[j]; };
-  for (Index j = 0; j < k; ++j) s.working[j] = on_bound(j) ? 1 : 0;
-
-  for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
-    s.g.head(k).noalias() = P * x;
-    s.g.head(k) -= c;  // ∇φ = P x − c
-    Index nf = 0;
-    for (Index j = 0; j < k; ++j)
-      if (!s.working[j]) s.free_index[nf++] = static_cast<int>(j);
-
-    // The step on the free variables: minimise ½ pᵀ P_FF p + g_Fᵀ p. None
-    // when the free gradient already vanishes (to the tolerance).
-    double free_gradient = 0.0;
-    for (Index a = 0; a < nf; ++a) free_gradient = std::max(free_gradient, std::abs(s.g[s.free_index[a]]));
-    bool moved = false;
-    if (nf > 0 && free_gradient > tolerance) {
-      auto M = s.M.topLeftCorner(nf, nf);
-      for (Index a = 0; a < nf; ++a)
-        for (Index b = 0; b < nf; ++b) M(a, b) = P(s.free_index[a], s.free_index[b]);
-      auto V = s.V.topLeftCorner(nf, nf);
-      auto lam = s.lambda.head(nf);
-      auto step = s.p.head(nf);
-      bool linear = false;
-      if (certifiedCholesky(M, V, lam, zero_curvature)) {
-        // Every curvature of P_FF is above zero_curvature: the Newton step
-        // −P_FF⁻¹ g_F from the Cholesky factor (the usual case, O(nf³/3)).
-        for (Index a = 0; a < nf; ++a) step[a] = -s.g[s.free_index[a]];
-        choleskySolveInPlace(V, step);
-      } else {
-        jacobiEigen(M, lam, V);
-        auto rho = s.t1.head(nf);
-        for (Index a = 0; a < nf; ++a) s.t2[a] = -s.g[s.free_index[a]];
-        rho.noalias() = V.transpose() * s.t2.head(nf);  // −g_F in the eigenbasis
-        // Zero-curvature descent component: φ falls linearly along it.
-        step.setZero();
-        for (Index e = 0; e < nf; ++e)
-          if (lam[e] <= zero_curvature && std::abs(rho[e]) > tolerance) {
-            step += rho[e] * V.col(e);
-            linear = true;
-          }
-        if (!linear)
-          for (Index e = 0; e < nf; ++e)
-            if (lam[e] > zero_curvature) step += (rho[e] / lam[e]) * V.col(e);  // Newton step
-      }
-      // Components at rounding level are zero: a 1e-39 cross term must not
-      // turn an unbounded direction into a huge finite step.
-      const double step_size = step.cwiseAbs().maxCoeff();
-      for (Index a = 0; a < nf; ++a)
-        if (std::abs(step[a]) <= 1e-12 * step_size) step[a] = 0.0;
-
-      if (step.cwiseAbs().maxCoeff() > 1e-15 * x_scale) {
-        // Longest feasible step along `step` (capped at 1 for a Newton step).
-        double alpha = linear ? kInf : 1.0;
-        Index blocking = -1;
-        for (Index a = 0; a < nf; ++a) {
-          const Index j = s.free_index[a];
-          const double room = step[a] > 0 ? hi[j] - x[j] : step[a] < 0 ? lo[j] - x[j] : kInf;
-          const double t = step[a] != 0.0 ? room / step[a] : kInf;
-          if (t < alpha) {
-            alpha = t;
-            blocking = j;
-          }
-        }
-        if (!std::isfinite(alpha)) {  // a linear descent with no bound ahead
-          report.unbounded = true;
-          Index worst = 0;
-          for (Index a = 1; a < nf; ++a)
-            if (std::abs(step[a]) > std::abs(step[worst])) worst = a;
-          report.unbounded_index = s.free_index[worst];
-          break;
-        }
-        for (Index a = 0; a < nf; ++a) x[s.free_index[a]] += alpha * step[a];
-        if (blocking >= 0) {
-          // Snap the blocking variable exactly onto its bound.
-          for (Index a = 0; a < nf; ++a)
-            if (s.free_index[a] == blocking) x[blocking] = step[a] > 0 ? hi[blocking] : lo[blocking];
-          s.working[blocking] = 1;
-        }
-        moved = true;
-      }
-    }
-    if (moved) continue;
-
-    // Stationary on the free set: release the bound whose multiplier has the
-    // wrong sign (at the upper bound ∇φ_j must be ≤ 0, at the lower ≥ 0).
-    Index release = -1;
-    double worst = tolerance;
-    for (Index j = 0; j < k; ++j) {
-      if (!s.working[j] || lo[j] == hi[j]) continue;
-      const double wrong = x[j] >= hi[j] ? s.g[j] : -s.g[j];
-      if (wrong > worst) {
-        worst = wrong;
-        release = j;
-      }
-    }
-    if (release < 0) {
-      report.converged = true;
-      break;
-    }
-    s.working[release] = 0;
-  }
-  report.kkt_residual = boxQpKktResidual(P, c, lo, hi, x);
-  return report;
 }
 
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,

@@ -12,6 +12,7 @@
 #include "internal/checks.hpp"
 #include "internal/coupling.hpp"
 #include "internal/friction_scratch.hpp"
+#include "internal/growing_cholesky.hpp"
 #include "internal/popov_vereshchagin.hpp"
 
 namespace zwang {
@@ -142,25 +143,19 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   }
   for (Eigen::Index a = 0; a < k; ++a)  // symmetric in exact arithmetic (K is)
     for (Eigen::Index b = 0; b < a; ++b) P(a, b) = P(b, a) = 0.5 * (P(a, b) + P(b, a));
-  // Scales, of the stuck joints only (a light, fast joint elsewhere in the
-  // chain must not set them): their accelerations q̈_Θ(0) and the inverse
-  // articulated inertias 1/D of their bodies.
-  double inv_inertia = 0.0, acc_max = 0.0;
-  for (Eigen::Index a = 0; a < k; ++a) {
-    const int j = fr.stuck[static_cast<std::size_t>(a)];
-    inv_inertia = std::max(inv_inertia, 1.0 / ws.D[static_cast<std::size_t>(j + 1)]);
-    acc_max = std::max(acc_max, std::abs(fs.qdd0[j]));
-  }
+  // The acceleration scale, of the stuck joints only (a light, fast joint
+  // elsewhere in the chain must not set it): their accelerations q̈_Θ(0).
+  double acc_max = 0.0;
+  for (Eigen::Index a = 0; a < k; ++a) acc_max = std::max(acc_max, std::abs(fs.qdd0[fr.stuck[static_cast<std::size_t>(a)]]));
   const double acc_scale = 1.0 + acc_max;
   const double tolerance = options.kkt_tolerance * acc_scale;
-  const double zero_curvature = 1e-10 * inv_inertia;
   auto mu = fs.mu.head(k);
   mu.setZero();  // feasible: 0 ∈ Λ
   QpReport report;
   if (k > 0) {
     report = options.method == FrictionMethod::ActiveSet
                  ? boxQpActiveSet(P, fs.c.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp, options.max_iterations,
-                                  tolerance, zero_curvature)
+                                  tolerance)
                  : boxQpProjectedGradient(P, fs.c.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp,
                                           options.max_iterations, tolerance);
   }
@@ -177,19 +172,24 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
     Eigen::Index ns = 0;
     for (Eigen::Index a = 0; a < k; ++a)
       if (std::abs(fs.c[a] - P.row(a).dot(mu)) <= acc_tol) fs.sub_index[ns++] = static_cast<int>(a);
+    // Directions along which g is flat to within the acceleration tolerance
+    // over the whole box: a curvature λ moves q̈ by at most λ·W across a box
+    // of width W. (None when every stuck joint slips: μ* is then unique.)
     Eigen::Index nullity = 0;
-    if (ns > 0) {  // (none when every stuck joint slips: μ* is then unique)
-      auto Pss = fs.null_basis.topLeftCorner(ns, ns);
+    if (ns > 0) {
+      double width = 0.0;
+      for (Eigen::Index a = 0; a < ns; ++a) {
+        const Eigen::Index t = fs.sub_index[a];
+        width = std::max(width, std::abs(mu[t]));
+        if (std::isfinite(fs.lo[t])) width = std::max(width, std::abs(fs.lo[t]));
+        if (std::isfinite(fs.hi[t])) width = std::max(width, std::abs(fs.hi[t]));
+      }
+      width *= 2.0;
+      auto Pss = fs.V.topLeftCorner(ns, ns);
       for (Eigen::Index a = 0; a < ns; ++a)
         for (Eigen::Index b = 0; b < ns; ++b) Pss(a, b) = P(fs.sub_index[a], fs.sub_index[b]);
-      auto V = fs.V.topLeftCorner(ns, ns);
-      // Certified positive definite (every curvature above zero_curvature):
-      // no null space, μ* is unique. Otherwise find the null space by eigen.
-      if (!certifiedCholesky(Pss, V, fs.eig.head(ns), zero_curvature)) {
-        jacobiEigen(Pss, fs.eig.head(ns), V);
-        for (Eigen::Index e = 0; e < ns; ++e)
-          if (fs.eig[e] <= zero_curvature) fs.null_basis.col(nullity++).head(ns) = V.col(e);
-      }
+      const double floor = width > 0.0 ? acc_tol / (static_cast<double>(ns) * width) : 0.0;
+      nullity = nearNullSpace(Pss, floor, fs.null_basis.topLeftCorner(ns, ns), fs.perm.head(ns));
     }
     if (nullity > 0) {
       const auto N = fs.null_basis.topLeftCorner(ns, nullity);

@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 
+#include "internal/growing_cholesky.hpp"
+
 namespace zwang::internal {
 
 struct QpScratch {
@@ -13,6 +15,7 @@ struct QpScratch {
   Eigen::MatrixXd C;                          // 2n × n, constraint rows (least-distance QP)
   Eigen::VectorXd d;                          // 2n
   Eigen::VectorXi free_index, working, side;  // n, 2n, 2n
+  GrowingCholesky factor;                     // of P_FF, F the free variables (active set)
 };
 
 struct QpReport {
@@ -25,15 +28,16 @@ struct QpReport {
 
 // min φ(x) = ½ xᵀ P x − cᵀ x  over lo ≤ x ≤ hi (entries may be ±∞, lo ≤ 0 ≤ hi),
 // P symmetric positive SEMI-definite (k × k). x is the start (feasible) and the
-// result. Primal active-set method: Newton steps on the free variables
-// (eigen-decomposed, so a singular P_FF is fine), and along a zero-curvature
-// descent direction straight to the next bound — never a division by zero
-// curvature. Finite; `tolerance` is on the projected gradient; eigenvalues of
-// P_FF at or below `zero_curvature` count as zero.
+// result. Primal active-set method whose free set F always keeps P_FF
+// positive definite, with its Cholesky factor updated by one index per
+// iteration (O(k²)): Newton steps on F; a variable whose Schur pivot is at
+// rounding level (zero curvature relative to P_jj) is not added but moved,
+// with F, along the zero-curvature direction straight to the next bound.
+// `tolerance` is on the projected gradient (plus the rounding of ∇φ).
+// Invariant under diagonal scaling of the variables: badly scaled P is fine.
 QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
-                        double zero_curvature);
+                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance);
 
 // The same problem by accelerated projected gradient (FISTA with adaptive
 // restart), step 1/L with L ≥ λ_max(P) (Gershgorin or trace bound); a linear

@@ -9,8 +9,8 @@ namespace zwang::internal {
 struct FrictionScratch {
   FrictionScratch(int dof, int bodies, int capacity)
       : f(dof), fc(dof), b(dof), tau_eff(dof), qdd0(dof), lo(dof), hi(dof), lo_margin(dof), hi_margin(dof),
-        c(dof), mu(dof), mu_alt(dof), h(dof), z(dof), za(dof), eig(dof), tau_total(dof), sub_mu(dof),
-        sub_lo(dof), sub_hi(dof), sub_index(dof), u0(bodies),
+        c(dof), mu(dof), mu_alt(dof), h(dof), z(dof), za(dof), tau_total(dof), sub_mu(dof),
+        sub_lo(dof), sub_hi(dof), sub_index(dof), perm(dof), u0(bodies),
         nu0(capacity), dU(capacity), rhs(capacity), du(bodies, dof), dnu(capacity, dof), P(dof, dof),
         null_basis(dof, dof), V(dof, dof), qp(dof) {}
   Eigen::VectorXd f, fc, b;         // breakaway, kinetic, viscous per joint
@@ -19,16 +19,17 @@ struct FrictionScratch {
   Eigen::VectorXd lo, hi;           // Λ on Θ₀ (k entries)
   Eigen::VectorXd lo_margin, hi_margin;
   Eigen::VectorXd c;                // q̈_Θ(0)
-  Eigen::VectorXd mu, mu_alt, h, z, za, eig, tau_total;
+  Eigen::VectorXd mu, mu_alt, h, z, za, tau_total;
   Eigen::VectorXd sub_mu, sub_lo, sub_hi;  // restricted to the sticking joints
   Eigen::VectorXi sub_index;               // positions in Θ₀ of the sticking joints
+  Eigen::VectorXi perm;                    // pivot order (near null space)
   Eigen::VectorXd u0;               // u_i of the μ = 0 pass
   Eigen::VectorXd nu0;              // ν of the μ = 0 pass (solver order)
   Eigen::VectorXd dU, rhs;          // per-column δU₀ and balance right-hand side
   Eigen::MatrixXd du;               // bodies × k: δu_i per unit torque at each stuck joint
   Eigen::MatrixXd dnu;              // capacity × k: δν per unit torque
   Eigen::MatrixXd P;                // K_ΘΘ
-  Eigen::MatrixXd null_basis, V;    // eigenvectors of K_ΘΘ
+  Eigen::MatrixXd null_basis, V;    // near null space of K_ΣΣ, and its working copy
   QpScratch qp;
 };
 

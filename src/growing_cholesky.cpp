@@ -1,0 +1,115 @@
+#include "internal/growing_cholesky.hpp"
+
+#include <cmath>
+#include <utility>
+
+namespace zwang::internal {
+
+GrowingCholesky::GrowingCholesky(int capacity) : L_(capacity, capacity), index_(capacity), w_(capacity) {}
+
+int GrowingCholesky::positionOf(int j) const {
+  for (int a = 0; a < size_; ++a)
+    if (index_[a] == j) return a;
+  return -1;
+}
+
+double GrowingCholesky::schurPivot(const Eigen::Ref<const Eigen::MatrixXd>& P, int j) {
+  double s = P(j, j);
+  for (int a = 0; a < size_; ++a) {  // w = L⁻¹ P_Fj, forward substitution
+    double x = P(index_[a], j);
+    for (int b = 0; b < a; ++b) x -= L_(a, b) * w_[b];
+    w_[a] = x / L_(a, a);
+    s -= w_[a] * w_[a];
+  }
+  return s;
+}
+
+void GrowingCholesky::append(int j, double pivot) {
+  for (int b = 0; b < size_; ++b) L_(size_, b) = w_[b];
+  L_(size_, size_) = std::sqrt(pivot);
+  index_[size_++] = j;
+}
+
+void GrowingCholesky::nullDirection(Eigen::Ref<Eigen::VectorXd> d_F) const {
+  for (int a = size_ - 1; a >= 0; --a) {  // Lᵀ d = −w, backward substitution
+    double x = -w_[a];
+    for (int b = a + 1; b < size_; ++b) x -= L_(b, a) * d_F[b];
+    d_F[a] = x / L_(a, a);
+  }
+}
+
+void GrowingCholesky::remove(int position) {
+  // Drop the row; the rows below then stick out one column to the right of
+  // the diagonal, which one Givens rotation per row folds back in.
+  for (int r = position; r + 1 < size_; ++r) {
+    for (int b = 0; b <= r + 1; ++b) L_(r, b) = L_(r + 1, b);
+    index_[r] = index_[r + 1];
+  }
+  --size_;
+  for (int t = position; t < size_; ++t) {
+    const double a = L_(t, t), b = L_(t, t + 1);
+    const double r = std::hypot(a, b);
+    const double c = a / r, s = b / r;
+    for (int row = t; row < size_; ++row) {  // rotate columns t and t + 1
+      const double x = L_(row, t), y = L_(row, t + 1);
+      L_(row, t) = c * x + s * y;
+      L_(row, t + 1) = -s * x + c * y;
+    }
+    L_(t, t + 1) = 0.0;
+  }
+}
+
+void GrowingCholesky::solveInPlace(Eigen::Ref<Eigen::VectorXd> x) const {
+  for (int a = 0; a < size_; ++a) {
+    double s = x[a];
+    for (int b = 0; b < a; ++b) s -= L_(a, b) * x[b];
+    x[a] = s / L_(a, a);
+  }
+  for (int a = size_ - 1; a >= 0; --a) {
+    double s = x[a];
+    for (int b = a + 1; b < size_; ++b) s -= L_(b, a) * x[b];
+    x[a] = s / L_(a, a);
+  }
+}
+
+Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::Ref<Eigen::MatrixXd> N,
+                           Eigen::Ref<Eigen::VectorXi> perm) {
+  const Eigen::Index n = A.rows();
+  for (Eigen::Index i = 0; i < n; ++i) perm[i] = static_cast<int>(i);
+  Eigen::Index r = 0;
+  for (; r < n; ++r) {
+    Eigen::Index p = r;  // the largest remaining Schur diagonal leads
+    for (Eigen::Index i = r + 1; i < n; ++i)
+      if (A(i, i) > A(p, p)) p = i;
+    if (!(A(p, p) > floor)) break;
+    if (p != r) {
+      A.row(r).swap(A.row(p));
+      A.col(r).swap(A.col(p));
+      std::swap(perm[r], perm[p]);
+    }
+    const double l = std::sqrt(A(r, r));
+    A(r, r) = l;
+    for (Eigen::Index i = r + 1; i < n; ++i) A(i, r) /= l;
+    for (Eigen::Index j = r + 1; j < n; ++j)  // Schur complement, both triangles
+      for (Eigen::Index i = r + 1; i < n; ++i) A(i, j) -= A(i, r) * A(j, r);
+  }
+  // In pivoted order the directions are [−L₁₁⁻ᵀ L₂₁ᵀ; I]: column e leaves the
+  // factored part's gradient unchanged while moving the remaining index r + e.
+  const Eigen::Index nullity = n - r;
+  for (Eigen::Index e = 0; e < nullity; ++e) {
+    auto d = N.col(e).head(n);
+    d.setZero();
+    d[perm[r + e]] = 1.0;
+    for (Eigen::Index a = r - 1; a >= 0; --a) {  // L₁₁ᵀ y = −L₂₁ᵀ e
+      double x = -A(r + e, a);
+      for (Eigen::Index b = a + 1; b < r; ++b) x -= A(b, a) * d[perm[b]];
+      d[perm[a]] = x / A(a, a);
+    }
+    for (int pass = 0; pass < 2; ++pass)  // modified Gram–Schmidt, twice (enough for orthogonality)
+      for (Eigen::Index f = 0; f < e; ++f) d -= N.col(f).head(n).dot(d) * N.col(f).head(n);
+    d /= d.norm();
+  }
+  return nullity;
+}
+
+}  // namespace zwang::internal

@@ -31,20 +31,15 @@ constexpr double kRounding = 64.0 * DBL_EPSILON;
 // computed as a tiny number), not physics.
 constexpr double kReach = 1e12;
 
-// g = P x − c, and each entry's rounding bound (P symmetric: column access).
+// g = P x − c (P symmetric), and a bound on each entry's rounding from the
+// absolute row sums of P (computed once).
 void gradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
-              const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Ref<Eigen::VectorXd> g,
-              Eigen::Ref<Eigen::VectorXd> noise) {
-  for (Eigen::Index j = 0; j < x.size(); ++j) {
-    double sum = -c[j], magnitude = std::abs(c[j]);
-    for (Eigen::Index l = 0; l < x.size(); ++l) {
-      const double t = P(l, j) * x[l];
-      sum += t;
-      magnitude += std::abs(t);
-    }
-    g[j] = sum;
-    noise[j] = kRounding * magnitude;
-  }
+              const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& row_sums,
+              Eigen::Ref<Eigen::VectorXd> g, Eigen::Ref<Eigen::VectorXd> noise) {
+  g.noalias() = P * x;
+  g -= c;
+  const double x_max = x.cwiseAbs().maxCoeff();
+  for (Eigen::Index j = 0; j < x.size(); ++j) noise[j] = kRounding * (row_sums[j] * x_max + std::abs(c[j]));
 }
 
 // Room for x_j along the sign of `rate` (per unit of step), +∞ when unbounded.
@@ -69,6 +64,8 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   auto g = s.g.head(k);
   auto noise = s.lambda.head(k);
   auto fixed = s.working.head(k);
+  auto row_sums = s.t2.head(k);
+  for (int j = 0; j < k; ++j) row_sums[j] = P.col(j).cwiseAbs().sum();
   const auto independent = [&](double pivot, int j) { return pivot > kDependent * P(j, j); };
   const auto clampTo = [&](int j, double v) { x[j] = std::min(hi[j], std::max(lo[j], v)); };
   double x_scale = 1.0;
@@ -106,7 +103,7 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   for (int j = 0; j < k; ++j) fixed[j] = lo[j] < hi[j] ? 0 : 1;  // a point box never moves
   growFree();
   if (F.size() > 0) {
-    gradient(P, c, x, g, noise);
+    gradient(P, c, x, row_sums, g, noise);
     auto step = s.p.head(F.size());
     for (int a = 0; a < F.size(); ++a) step[a] = -g[F.index(a)];
     F.solveInPlace(step);
@@ -126,9 +123,29 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
     if (clamped) growFree();
   }
 
+  // A Newton step p on F cut at α < 1 lowers φ by g_Fᵀp (α − α²/2)
+  // (P_FF p = −g_F). Is the projected full step clamp(x + p) lower still?
+  // φ(x + Δ) − φ(x) = gᵀΔ + ½ ΔᵀPΔ, Δ zero off F.
+  const auto projectedStepIsBetter = [&](double alpha) {
+    const int nf = F.size();
+    auto step = s.p.head(nf);
+    auto delta = s.t1.head(k);
+    delta.setZero();
+    double gp = 0.0;
+    for (int a = 0; a < nf; ++a) {
+      const int j = F.index(a);
+      gp += g[j] * step[a];
+      delta[j] = std::min(hi[j], std::max(lo[j], x[j] + step[a])) - x[j];
+    }
+    const double cut = gp * (alpha - 0.5 * alpha * alpha);
+    auto Pdelta = s.lambda.head(k);  // (noise is recomputed with the next gradient)
+    Pdelta.noalias() = P * delta;
+    return g.dot(delta) + 0.5 * delta.dot(Pdelta) < cut;
+  };
+
   int newton_in_a_row = 0;
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
-    gradient(P, c, x, g, noise);
+    gradient(P, c, x, row_sums, g, noise);
     const int nf = F.size();
 
     // ---- Newton step on F, unless F is stationary (to the tolerance; at
@@ -148,6 +165,20 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
           alpha = std::max(0.0, t);
           blocking = a;
         }
+      }
+      if (blocking >= 0 && projectedStepIsBetter(alpha)) {
+        // Bertsekas' projected Newton step: all of F's bounds met at once
+        // (several variables fixed in one iteration instead of one each).
+        for (int a = nf - 1; a >= 0; --a) {
+          const int j = F.index(a);
+          clampTo(j, x[j] + step[a]);
+          if (x[j] <= lo[j] || x[j] >= hi[j]) {
+            F.remove(a);
+            fixed[j] = 1;
+          }
+        }
+        newton_in_a_row = 0;
+        continue;
       }
       for (int a = 0; a < nf; ++a) clampTo(F.index(a), x[F.index(a)] + alpha * step[a]);
       if (blocking >= 0) {
@@ -188,6 +219,18 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
     if (independent(pivot, j)) {  // a real curvature: the next Newton step moves it
       F.append(j, pivot);
       fixed[j] = 0;
+      // Release the others whose gradient points into their room with it
+      // (the Newton step on the larger F still descends): one iteration
+      // instead of one each, when the warm start fixed too many.
+      for (int i = 0; i < k; ++i) {
+        if (!fixed[i] || lo[i] == hi[i]) continue;
+        const double into_room = x[i] >= hi[i] ? g[i] : x[i] <= lo[i] ? -g[i] : std::abs(g[i]);
+        if (into_room - noise[i] <= tolerance) continue;
+        const double pivot_i = F.schurPivot(P, i);
+        if (!independent(pivot_i, i)) continue;
+        F.append(i, pivot_i);
+        fixed[i] = 0;
+      }
       continue;
     }
     // Zero curvature: d_j = ±1 downhill, d_F = −P_FF⁻¹ P_Fj d_j keeps F

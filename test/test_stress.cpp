@@ -202,6 +202,22 @@ Residuals residuals(const Model& model, const Task& task, const DynamicsInput& i
   return r;
 }
 
+// Asserts the residuals of one solve (plain or with friction) and records the
+// worst: closure and τ_c always; the constraint residual of a regular task only
+// (and, outside the strict run, only when its coupling condition is at most 1e6).
+void checkResiduals(const Residuals& r, bool singular, double condition, bool strict, Worst& worst) {
+  const double closure_tolerance = singular ? kSingularClosureTolerance : kClosureTolerance;
+  CHECK(r.closure <= closure_tolerance);
+  CHECK(r.tau_c <= kTauConstraintTolerance);
+  if (r.closure > closure_tolerance || r.tau_c > kTauConstraintTolerance) ++worst.singular_residual_failures;
+  if (!singular && (strict || condition <= 1e6)) CHECK(r.constraint <= kConstraintTolerance);
+  if (!singular && r.constraint > kConstraintTolerance) ++worst.constraint_failures;
+  double& closure = singular ? worst.closure_singular : worst.closure;
+  closure = std::max(closure, std::max(r.closure, r.tau_c));
+  worst.tau_c = std::max(worst.tau_c, singular ? 0.0 : r.tau_c);
+  if (!singular) worst.constraint = std::max(worst.constraint, r.constraint);
+}
+
 // strict: also require maximum dissipation, |μ| ≤ f to 1e-12, a converged
 // active set, agreement of the maximisers, and the constraint residual of
 // regular tasks whose coupling condition exceeds 1e6. Until the bugs behind
@@ -251,17 +267,8 @@ void runStress(bool strict) {
         ++worst.regular_constrained;
       }
       const Eigen::VectorXd no_friction = Eigen::VectorXd::Zero(n);
-      Residuals r = residuals(model, task, in, dense, ws.solution, no_friction, scratch);
-      const double closure_tolerance = singular ? kSingularClosureTolerance : kClosureTolerance;
-      CHECK(r.closure <= closure_tolerance);
-      CHECK(r.tau_c <= kTauConstraintTolerance);
-      if (r.closure > closure_tolerance || r.tau_c > kTauConstraintTolerance) ++worst.singular_residual_failures;
-      if (!singular && (strict || condition <= 1e6)) CHECK(r.constraint <= kConstraintTolerance);
-      if (!singular && r.constraint > kConstraintTolerance) ++worst.constraint_failures;
-      (singular ? worst.closure_singular : worst.closure) =
-          std::max(singular ? worst.closure_singular : worst.closure, std::max(r.closure, r.tau_c));
-      worst.tau_c = std::max(worst.tau_c, singular ? 0.0 : r.tau_c);
-      if (!singular) worst.constraint = std::max(worst.constraint, r.constraint);
+      checkResiduals(residuals(model, task, in, dense, ws.solution, no_friction, scratch), singular, condition, strict,
+                     worst);
 
       // --- static friction, both maximisers
       Eigen::VectorXd qdd_active;
@@ -292,17 +299,8 @@ void runStress(bool strict) {
           worst.gradient_iterations_max = std::max(worst.gradient_iterations_max, fr.iterations);
           if (!fr.converged) ++worst.gradient_not_converged;
         }
-        r = residuals(model, task, in, dense, ws.solution, fr.tau_friction, scratch);
-        const double closure_tolerance = singular ? kSingularClosureTolerance : kClosureTolerance;
-        CHECK(r.closure <= closure_tolerance);
-        CHECK(r.tau_c <= kTauConstraintTolerance);
-        if (r.closure > closure_tolerance || r.tau_c > kTauConstraintTolerance) ++worst.singular_residual_failures;
-        if (!singular && (strict || condition <= 1e6)) CHECK(r.constraint <= kConstraintTolerance);
-      if (!singular && r.constraint > kConstraintTolerance) ++worst.constraint_failures;
-        (singular ? worst.closure_singular : worst.closure) =
-            std::max(singular ? worst.closure_singular : worst.closure, std::max(r.closure, r.tau_c));
-        worst.tau_c = std::max(worst.tau_c, singular ? 0.0 : r.tau_c);
-        if (!singular) worst.constraint = std::max(worst.constraint, r.constraint);
+        checkResiduals(residuals(model, task, in, dense, ws.solution, fr.tau_friction, scratch), singular, condition,
+                       strict, worst);
 
         // Maximum dissipation on Θ₀, with q̈(0) = q̈* − (∂q̈/∂μ) μ*.
         const Eigen::VectorXd& qdd = ws.solution.qdd;

@@ -10,17 +10,19 @@
 
 #include <catch2/catch.hpp>
 
+#include "support/bad_inputs.hpp"
 #include "zwang/zwang.hpp"
 
 using namespace zwang;
 using Catch::Contains;
+using zwang::testing::oneDofArmModel;
 
 namespace {
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 const double kInf = std::numeric_limits<double>::infinity();
 
-Model panda() { return loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf"); }
+Model panda() { return zwang::testing::pandaModel(); }
 
 std::string modelError(const std::function<void()>& f) {
   try {
@@ -43,7 +45,7 @@ Joint revolute(const std::string& name) {
 
 TEST_CASE("errors: solve statuses (sizes, non-finite inputs, workspace and task)", "[errors]") {
   const Model model = panda();
-  const Model arm = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf");
+  const Model arm = oneDofArmModel();
   Task task(model);
   task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6));
   const int w = task.addWrench("panda_link5");
@@ -86,7 +88,7 @@ TEST_CASE("errors: solve statuses (sizes, non-finite inputs, workspace and task)
 
 TEST_CASE("errors: RNEA, CRBA, kinematics and Jacobian statuses", "[errors]") {
   const Model model = panda();
-  const Model arm = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf");
+  const Model arm = oneDofArmModel();
   const Task task(model), arm_task(arm);
   Workspace ws(model, task), foreign(arm, arm_task);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
@@ -136,48 +138,18 @@ TEST_CASE("errors: friction options and the infeasible task", "[errors]") {
   const Task task(model);
   Workspace ws(model, task);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
-  const auto message = [&](const FrictionOptions& o) {
-    const Status s = solveWithFriction(model, task, x, x, x, ws, o);
+  for (const zwang::testing::BadFrictionOption& bad : zwang::testing::badFrictionOptions()) {
+    const Status s = solveWithFriction(model, task, x, x, x, ws, bad.options);
     CHECK(s.code == StatusCode::BadOption);
-    return std::string(s.message);
-  };
-  FrictionOptions o;
-  o.kinetic = Eigen::VectorXd::Zero(3);
-  CHECK_THAT(message(o), Contains("friction override 'kinetic' has 3 entries, the model has 7 joints"));
-  o = {};
-  o.damping = Eigen::VectorXd::Zero(7);
-  o.damping[1] = -2.0;
-  CHECK_THAT(message(o), Contains("friction override 'damping' for joint 'panda_joint2' is -2 (must be finite and >= 0)"));
-  o = {};
-  o.velocity_tolerance = kNaN;
-  CHECK_THAT(message(o), Contains("velocity_tolerance nan must be finite and >= 0"));
-  o = {};
-  o.limit_tolerance = -1.0;
-  CHECK_THAT(message(o), Contains("limit_tolerance -1 must be finite and >= 0"));
-  o = {};
-  o.margin = 1.5;
-  CHECK_THAT(message(o), Contains("margin 1.5 must be in [0, 1]"));
-  o = {};
-  o.max_iterations = 0;
-  CHECK_THAT(message(o), Contains("max_iterations must be at least 1"));
-  o = {};
-  o.kkt_tolerance = -1e-9;
-  CHECK_THAT(message(o), Contains("kkt_tolerance must be positive"));
+    CHECK_THAT(s.message, Contains(bad.message));
+  }
 
   // The report's arm on its upper limit, asked to accelerate into it.
-  const Model arm = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf");
-  Task into(arm);
-  into.gravity.setZero();
-  ConstraintMatrix spin = ConstraintMatrix::Zero(6, 1);
-  spin(5, 0) = 1.0;
-  into.addConstraint("link1", spin);
-  into.targets()[0] = 5.0;
-  Workspace arm_ws(arm, into);
-  const Status s = solveWithFriction(arm, into, Eigen::VectorXd::Constant(1, arm.joint(0).upper),
-                                     Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1), arm_ws);
+  zwang::testing::IntoUpperLimit into;
+  const Status s = solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws);
   CHECK(s.code == StatusCode::Infeasible);
-  CHECK_THAT(s.message, Contains("the task drives joint 'joint1' into its upper limit (3.14159)"));
-  CHECK(arm_ws.solution.qdd.allFinite());
+  CHECK_THAT(s.message, Contains(into.message));
+  CHECK(into.ws.solution.qdd.allFinite());
 }
 
 TEST_CASE("errors: Degenerate, a joint with no inertia to move", "[errors]") {

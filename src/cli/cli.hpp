@@ -6,9 +6,12 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "zwang/model.hpp"
 
 namespace zwang::cli {
 
@@ -74,6 +77,40 @@ void printColumns(const std::vector<std::vector<std::string>>& rows, std::size_t
 // Run `gnuplot SCRIPT` in `dir`. When gnuplot is missing or fails, says so on
 // stderr in one line (naming `command`) and returns false.
 bool plotWithGnuplot(const std::string& command, const std::filesystem::path& dir, const std::string& script);
+
+// The report commands (`scenarios`, `energy`): options --out DIR, --models DIR,
+// --no-plots, no positional arguments; one model from the models directory;
+// a CSV and, with gnuplot, PNG plots into --out.
+struct ReportCommand {
+  std::string name;            // the command, for messages
+  Arguments args;
+  std::filesystem::path out;   // --out (created)
+  std::filesystem::path urdf;  // the model file loaded
+  Model model;
+  std::string shownUrdf() const;  // urdf relative to the working directory when it can be
+};
+// The model it expects: `dof` joints and these frames, described as `what` in
+// the error ("energy: PATH: expected the 7-joint Panda with frames ...").
+struct ExpectedModel {
+  const char* file;
+  int dof;
+  std::vector<std::string> frames;
+  const char* what;
+};
+// Parse, load, check and create the output directory (default `default_out`).
+// --help: prints the usage and returns nothing (exit 0). UsageError for a
+// positional argument; CliError for a model that does not load ("<command>:
+// <ModelError> (use --models DIR)") or is not the expected one, and for an
+// output directory that cannot be created.
+std::optional<ReportCommand> startReportCommand(const std::string& command, int argc, char** argv,
+                                                const std::string& default_out, const ExpectedModel& expected);
+// Unless --no-plots: write `script` to OUT/script_name, run gnuplot on it there
+// and say "wrote OUT/<pngs> (gnuplot, script <script_name>)".
+void writePlots(const ReportCommand& report, const std::string& script_name, const std::string& script,
+                const std::string& pngs);
+// kExitOk, or kExitError after "zwang: <command>: a result disagrees with
+// <reference> (see the check column)" on stderr.
+int reportExitCode(const ReportCommand& report, bool all_ok, const std::string& reference);
 
 // The commands; each returns the exit code.
 int commandSolve(int argc, char** argv);

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "cli.hpp"
+#include "zwang/urdf.hpp"
 
 namespace zwang::cli {
 
@@ -272,6 +273,56 @@ bool plotWithGnuplot(const std::string& command, const std::filesystem::path& di
     return false;
   }
   return true;
+}
+
+std::string ReportCommand::shownUrdf() const {
+  std::error_code ec;
+  const std::filesystem::path shown = std::filesystem::proximate(urdf, ec);
+  return (ec ? urdf : shown).string();
+}
+
+std::optional<ReportCommand> startReportCommand(const std::string& command, int argc, char** argv,
+                                                const std::string& default_out, const ExpectedModel& expected) {
+  ReportCommand report;
+  report.name = command;
+  report.args = parseArguments(command, argc, argv, 2, {"--no-plots"}, {"--out", "--models"});
+  if (report.args.help) {
+    std::fputs(usageText(command), stdout);
+    return std::nullopt;
+  }
+  if (!report.args.positional.empty())
+    throw UsageError(command, "unexpected argument '" + printable(report.args.positional[0], 60) + "'");
+  report.out = report.args.value("--out", default_out);
+  report.urdf = std::filesystem::path(modelsDirectory(report.args, expected.file)) / expected.file;
+  try {
+    report.model = loadUrdfFile(report.urdf.string());
+  } catch (const ModelError& e) {
+    throw CliError(kExitError, command + ": " + e.what() + " (use --models DIR)");
+  }
+  bool as_expected = report.model.dof() == expected.dof;
+  for (const std::string& frame : expected.frames) as_expected = as_expected && report.model.hasFrame(frame);
+  if (!as_expected)
+    throw CliError(kExitError, command + ": " + report.urdf.string() + ": expected " + expected.what);
+  std::error_code ec;
+  std::filesystem::create_directories(report.out, ec);
+  if (ec)
+    throw CliError(kExitError, command + ": " + report.out.string() + ": cannot create the directory (" + ec.message() + ")");
+  return report;
+}
+
+void writePlots(const ReportCommand& report, const std::string& script_name, const std::string& script,
+                const std::string& pngs) {
+  if (report.args.has("--no-plots")) return;
+  writeOutput((report.out / script_name).string(), script);
+  if (plotWithGnuplot(report.name, report.out, script_name))
+    std::printf("wrote %s/%s (gnuplot, script %s)\n", report.out.string().c_str(), pngs.c_str(), script_name.c_str());
+}
+
+int reportExitCode(const ReportCommand& report, bool all_ok, const std::string& reference) {
+  if (all_ok) return kExitOk;
+  std::fprintf(stderr, "zwang: %s: a result disagrees with %s (see the check column)\n", report.name.c_str(),
+               reference.c_str());
+  return kExitError;
 }
 
 }  // namespace zwang::cli

@@ -233,25 +233,12 @@ std::string plotScript(const Model& model, const std::vector<PoseResult>& result
 }  // namespace
 
 int commandEnergy(int argc, char** argv) {
-  const Arguments args = parseArguments("energy", argc, argv, 2, {"--no-plots"}, {"--out", "--models"});
-  if (args.help) {
-    std::fputs(usageText("energy"), stdout);
-    return kExitOk;
-  }
-  if (!args.positional.empty()) throw UsageError("energy", "unexpected argument '" + printable(args.positional[0], 60) + "'");
-  const std::filesystem::path out = args.value("--out", "energy");
-  const std::filesystem::path urdf = std::filesystem::path(modelsDirectory(args, "panda.urdf")) / "panda.urdf";
-  Model model;
-  try {
-    model = loadUrdfFile(urdf.string());
-  } catch (const ModelError& e) {
-    throw CliError(kExitError, std::string("energy: ") + e.what() + " (use --models DIR)");
-  }
-  if (model.dof() != kJoints || !model.hasFrame("tool0") || !model.hasFrame("panda_link1"))
-    throw CliError(kExitError, "energy: " + urdf.string() + ": expected the 7-joint Panda with frames panda_link1 and tool0");
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw CliError(kExitError, "energy: " + out.string() + ": cannot create the directory (" + ec.message() + ")");
+  const std::optional<ReportCommand> report = startReportCommand(
+      "energy", argc, argv, "energy",
+      {"panda.urdf", kJoints, {"tool0", "panda_link1"}, "the 7-joint Panda with frames panda_link1 and tool0"});
+  if (!report) return kExitOk;  // --help
+  const Model& model = report->model;
+  const std::filesystem::path& out = report->out;
 
   std::vector<PoseResult> results;
   bool all_ok = true;
@@ -260,10 +247,7 @@ int commandEnergy(int argc, char** argv) {
     all_ok = all_ok && results.back().ok;
   }
 
-  std::error_code path_ec;
-  const std::filesystem::path shown = std::filesystem::proximate(urdf, path_ec);
-  std::printf("zwang energy: %s holding still against gravity (0, 0, -9.81), at rest\n",
-              (path_ec ? urdf : shown).string().c_str());
+  std::printf("zwang energy: %s holding still against gravity (0, 0, -9.81), at rest\n", report->shownUrdf().c_str());
   std::printf("task: tool0 fixed (6 rows, world axes) + panda_link1 angular z (= qdd1) fixed: qdd = 0 exactly\n");
   std::printf("breakaway friction f [N·m] (URDF <dynamics friction>):");
   for (int j = 0; j < kJoints; ++j) std::printf(" %s", fmt(model.joint(j).breakaway_friction).c_str());
@@ -317,16 +301,8 @@ int commandEnergy(int argc, char** argv) {
   writeOutput((out / "panda_energy.csv").string(), csvText(results));
   std::printf("wrote %s/panda_energy.csv (pose, variant, q1-7, tau1-7 = tau_control, mu1-7, tau_norm, tau_sq, tau_abs_sum)\n",
               out.string().c_str());
-  if (!args.has("--no-plots")) {
-    writeOutput((out / "energy.gp").string(), plotScript(model, results));
-    if (plotWithGnuplot("energy", out, "energy.gp"))
-      std::printf("wrote %s/panda_energy.png, panda_energy_joints.png (gnuplot, script energy.gp)\n", out.string().c_str());
-  }
-  if (!all_ok) {
-    std::fprintf(stderr, "zwang: energy: a result disagrees with the closed form (see the check column)\n");
-    return kExitError;
-  }
-  return kExitOk;
+  writePlots(*report, "energy.gp", plotScript(model, results), "panda_energy.png, panda_energy_joints.png");
+  return reportExitCode(*report, all_ok, "the closed form");
 }
 
 }  // namespace zwang::cli

@@ -192,31 +192,16 @@ std::string plotScript(const std::vector<Result>& results, double f) {
 }  // namespace
 
 int commandScenarios(int argc, char** argv) {
-  const Arguments args = parseArguments("scenarios", argc, argv, 2, {"--no-plots"}, {"--out", "--models"});
-  if (args.help) {
-    std::fputs(usageText("scenarios"), stdout);
-    return kExitOk;
-  }
-  if (!args.positional.empty()) throw UsageError("scenarios", "unexpected argument '" + printable(args.positional[0], 60) + "'");
-  const std::filesystem::path out = args.value("--out", "scenarios");
-  const std::filesystem::path urdf = std::filesystem::path(modelsDirectory(args, "one_dof_arm.urdf")) / "one_dof_arm.urdf";
-  Model model;
-  try {
-    model = loadUrdfFile(urdf.string());
-  } catch (const ModelError& e) {
-    throw CliError(kExitError, std::string("scenarios: ") + e.what() + " (use --models DIR)");
-  }
-  if (model.dof() != 1 || !model.hasFrame("tip") || !model.hasFrame("link1"))
-    throw CliError(kExitError, "scenarios: " + urdf.string() + ": expected the 1-DOF arm with frames link1 and tip");
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw CliError(kExitError, "scenarios: " + out.string() + ": cannot create the directory (" + ec.message() + ")");
+  const std::optional<ReportCommand> report =
+      startReportCommand("scenarios", argc, argv, "scenarios",
+                         {"one_dof_arm.urdf", 1, {"tip", "link1"}, "the 1-DOF arm with frames link1 and tip"});
+  if (!report) return kExitOk;  // --help
+  const Model& model = report->model;
+  const std::filesystem::path& out = report->out;
 
   const double f = model.joint(0).breakaway_friction;
   const double inertia = model.inertia(1).Ibar(2, 2) + model.joint(0).rotor_inertia;
-  std::error_code path_ec;
-  const std::filesystem::path shown = std::filesystem::proximate(urdf, path_ec);
-  std::printf("zwang scenarios: the report's chapter 6 and Fig. 5.5 with %s\n", (path_ec ? urdf : shown).string().c_str());
+  std::printf("zwang scenarios: the report's chapter 6 and Fig. 5.5 with %s\n", report->shownUrdf().c_str());
   std::printf("1-DOF arm: inertia about the joint %s kg·m², breakaway friction f = %s N·m, no gravity, at rest.\n",
               fmt(inertia).c_str(), fmt(f).c_str());
   std::printf("Sign: mu > 0 opposes positive motion (the joint feels tau - mu); the report plots magnitudes and\n"
@@ -244,16 +229,8 @@ int commandScenarios(int argc, char** argv) {
   std::printf("wrote %s/{%s,%s,%s}.csv (columns mu, g, qdd, tau_control, tau_net)\n", out.string().c_str(),
               kScenarios[0].name, kScenarios[1].name, kScenarios[2].name);
 
-  if (!args.has("--no-plots")) {
-    writeOutput((out / "plots.gp").string(), plotScript(results, f));
-    if (plotWithGnuplot("scenarios", out, "plots.gp"))
-      std::printf("wrote %s/<scenario>_{g,qdd,tau}.png (gnuplot, script plots.gp)\n", out.string().c_str());
-  }
-  if (!all_ok) {
-    std::fprintf(stderr, "zwang: scenarios: a result disagrees with the report's (see the check column)\n");
-    return kExitError;
-  }
-  return kExitOk;
+  writePlots(*report, "plots.gp", plotScript(results, f), "<scenario>_{g,qdd,tau}.png");
+  return reportExitCode(*report, all_ok, "the report's");
 }
 
 }  // namespace zwang::cli

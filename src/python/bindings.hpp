@@ -51,7 +51,6 @@ const char* expressedName(Expressed e);
 // Read-only NumPy views of workspace memory that keep `base` alive.
 py::array vectorView(const Eigen::VectorXd& v, py::handle base, bool writeable = false);
 py::array vectorView(const double* data, Eigen::Index size, py::handle base, bool writeable = false);
-py::array rowsView(const std::vector<Vec6>& rows, py::handle base);  // (rows, 6)
 py::array matrixView(const Eigen::MatrixXd& m, py::handle base);
 py::array vectorCopy(const Eigen::Ref<const Eigen::VectorXd>& v);
 py::array matrixCopy(const Eigen::Ref<const Eigen::MatrixXd>& m);

@@ -135,15 +135,6 @@ py::array vectorView(const Eigen::VectorXd& v, py::handle base, bool writeable) 
   return vectorView(v.data(), v.size(), base, writeable);
 }
 
-py::array rowsView(const std::vector<Vec6>& rows, py::handle base) {
-  if (rows.empty()) return py::array_t<double>(std::vector<py::ssize_t>{0, 6});
-  const auto s = static_cast<py::ssize_t>(sizeof(double));
-  py::array a(py::dtype::of<double>(), {static_cast<py::ssize_t>(rows.size()), py::ssize_t{6}},
-              {static_cast<py::ssize_t>(sizeof(Vec6)), s}, rows.front().data(), base);
-  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  return a;
-}
-
 py::array matrixView(const Eigen::MatrixXd& m, py::handle base) {
   if (m.size() == 0) return py::array_t<double>(std::vector<py::ssize_t>{m.rows(), m.cols()});
   const auto s = static_cast<py::ssize_t>(sizeof(double));

@@ -89,9 +89,34 @@ bool sameSerials(const std::vector<T*>& items, const std::vector<std::uint64_t>&
   return true;
 }
 
+template <class T>
+void copySerials(const std::vector<T*>& items, std::vector<std::uint64_t>& serials) {
+  serials.clear();
+  for (const T* item : items) serials.push_back(item->serial);
+}
+
 // Reused between calls (the GIL serialises them).
 std::vector<Constraint*> g_constraints;
 std::vector<Wrench*> g_wrenches;
+
+// The frames of g_wrenches into a task being built (ModelError "wrenches[k]: …"
+// for an unknown frame).
+void addWrenches(const Model& model, Task& task) {
+  for (std::size_t k = 0; k < g_wrenches.size(); ++k) {
+    checkFrame(model, "wrenches[" + std::to_string(k) + "]", g_wrenches[k]->frame);
+    try {
+      task.addWrench(g_wrenches[k]->frame, g_wrenches[k]->expressed);
+    } catch (const ModelError& e) {
+      raiseModelError("wrenches[" + std::to_string(k) + "]", e);
+    }
+  }
+}
+
+// What changes between calls without a rebuild: the wrench values and gravity.
+void writeWrenchesAndGravity(Task& task, py::handle gravity) {
+  for (std::size_t k = 0; k < g_wrenches.size(); ++k) task.wrench(static_cast<int>(k)) = g_wrenches[k]->value;
+  task.gravity = gravity.is_none() ? kDefaultGravity : vec3Arg("gravity", gravity);
+}
 
 // The workspace's task for these constraints and wrenches: rebuilt (allocating)
 // only when the objects differ from the last call; then only b, the wrench
@@ -112,29 +137,19 @@ Task& solveTask(PyWorkspace& pw, py::handle constraints, py::handle wrenches, py
         raiseModelError("constraints[" + std::to_string(k) + "]", e);
       }
     }
-    for (std::size_t k = 0; k < g_wrenches.size(); ++k) {
-      checkFrame(*pw.model, "wrenches[" + std::to_string(k) + "]", g_wrenches[k]->frame);
-      try {
-        task->addWrench(g_wrenches[k]->frame, g_wrenches[k]->expressed);
-      } catch (const ModelError& e) {
-        raiseModelError("wrenches[" + std::to_string(k) + "]", e);
-      }
-    }
+    addWrenches(*pw.model, *task);
     pw.ensureCapacity(task->constraintRows());
     pw.task = std::move(task);
     pw.constraint_rows = std::move(first_rows);
-    pw.constraint_serials.clear();
-    for (const Constraint* c : g_constraints) pw.constraint_serials.push_back(c->serial);
-    pw.wrench_serials.clear();
-    for (const Wrench* w : g_wrenches) pw.wrench_serials.push_back(w->serial);
+    copySerials(g_constraints, pw.constraint_serials);
+    copySerials(g_wrenches, pw.wrench_serials);
     pw.task_valid = true;
     ++pw.task_builds;
   }
   Task& task = *pw.task;
   for (std::size_t k = 0; k < g_constraints.size(); ++k)
     task.targets().segment(pw.constraint_rows[k], g_constraints[k]->b.size()) = g_constraints[k]->b;
-  for (std::size_t k = 0; k < g_wrenches.size(); ++k) task.wrench(static_cast<int>(k)) = g_wrenches[k]->value;
-  task.gravity = gravity.is_none() ? kDefaultGravity : vec3Arg("gravity", gravity);
+  writeWrenchesAndGravity(task, gravity);
   return task;
 }
 
@@ -142,22 +157,13 @@ Task& idTask(PyWorkspace& pw, py::handle wrenches, py::handle gravity) {
   collect("wrenches", wrenches, g_wrenches);
   if (!pw.id_task_valid || !sameSerials(g_wrenches, pw.id_wrench_serials)) {
     auto task = std::make_unique<Task>(*pw.model);
-    for (std::size_t k = 0; k < g_wrenches.size(); ++k) {
-      checkFrame(*pw.model, "wrenches[" + std::to_string(k) + "]", g_wrenches[k]->frame);
-      try {
-        task->addWrench(g_wrenches[k]->frame, g_wrenches[k]->expressed);
-      } catch (const ModelError& e) {
-        raiseModelError("wrenches[" + std::to_string(k) + "]", e);
-      }
-    }
+    addWrenches(*pw.model, *task);
     pw.id_task = std::move(task);
-    pw.id_wrench_serials.clear();
-    for (const Wrench* w : g_wrenches) pw.id_wrench_serials.push_back(w->serial);
+    copySerials(g_wrenches, pw.id_wrench_serials);
     pw.id_task_valid = true;
   }
   Task& task = *pw.id_task;
-  for (std::size_t k = 0; k < g_wrenches.size(); ++k) task.wrench(static_cast<int>(k)) = g_wrenches[k]->value;
-  task.gravity = gravity.is_none() ? kDefaultGravity : vec3Arg("gravity", gravity);
+  writeWrenchesAndGravity(task, gravity);
   return task;
 }
 

@@ -3,13 +3,14 @@
 #include <type_traits>
 
 #include "counting_malloc.hpp"
+#include "support/bad_inputs.hpp"
 #include "zwang/zwang.hpp"
 
 using namespace zwang;
 using zwang::testing::allocationsDuring;
 
 namespace {
-Model panda() { return loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf"); }
+Model panda() { return zwang::testing::pandaModel(); }
 }  // namespace
 
 TEST_CASE("the counter sees allocations at all (guards against a test that cannot fail)") {
@@ -120,10 +121,6 @@ TEST_CASE("the friction solve allocates nothing (all joints stuck, indeterminate
 // Every entry point (issue #6): the remaining success paths, every error
 // return, and no exception out of any of them.
 
-namespace {
-Model oneDofArm() { return loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf"); }
-}  // namespace
-
 TEST_CASE("the solver entry points are declared noexcept") {
   const Model model = panda();
   Task task(model);
@@ -177,18 +174,12 @@ TEST_CASE("friction at a joint limit, with overrides, a margin and an infeasible
   CHECK(ok);
 
   // The report's arm on its upper limit, asked to accelerate into it: Infeasible.
-  const Model arm = oneDofArm();
-  Task into(arm);
-  into.gravity.setZero();
-  ConstraintMatrix spin = ConstraintMatrix::Zero(6, 1);
-  spin(5, 0) = 1.0;
-  into.addConstraint("link1", spin);
-  into.targets()[0] = 5.0;
-  Workspace arm_ws(arm, into);
-  const Eigen::VectorXd at_upper = Eigen::VectorXd::Constant(1, arm.joint(0).upper), none = Eigen::VectorXd::Zero(1);
+  zwang::testing::IntoUpperLimit into;
   Status status;
-  solveWithFriction(arm, into, at_upper, none, none, arm_ws);  // warm
-  CHECK(allocationsDuring([&] { status = solveWithFriction(arm, into, at_upper, none, none, arm_ws); }) == 0);
+  solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws);  // warm
+  CHECK(allocationsDuring([&] {
+          status = solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws);
+        }) == 0);
   CHECK(status.code == StatusCode::Infeasible);
 }
 
@@ -216,7 +207,7 @@ TEST_CASE("frame accelerations and kinematics without velocities allocate nothin
 }
 
 TEST_CASE("every error return of every entry point allocates nothing and throws nothing") {
-  const Model model = panda(), other = oneDofArm();
+  const Model model = panda(), other = zwang::testing::oneDofArmModel();
   Task task(model);
   task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
   task.addConstraint("panda_link4", ConstraintMatrix::Identity(6, 1));
@@ -225,12 +216,9 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
   const Eigen::VectorXd ok7 = Eigen::VectorXd::Constant(7, 0.1), short3 = Eigen::VectorXd::Zero(3);
   Eigen::VectorXd nan7 = ok7;
   nan7[4] = std::nan("");
-  FrictionOptions bad_margin, bad_override, bad_iterations, bad_tolerance, bad_speed;
-  bad_margin.margin = 2.0;
-  bad_override.breakaway = Eigen::VectorXd::Constant(7, -1.0);
-  bad_iterations.max_iterations = 0;
-  bad_tolerance.kkt_tolerance = 0.0;
-  bad_speed.velocity_tolerance = -1.0;
+  // Every refused friction option (the table test_stress_errors checks the messages of).
+  const std::vector<zwang::testing::BadFrictionOption> bad_options = zwang::testing::badFrictionOptions();
+  std::vector<StatusCode> option_codes(bad_options.size(), StatusCode::Ok);
   Eigen::MatrixXd J(6, 7), J_wrong(6, 3);
   const int frames = static_cast<int>(model.frames().size());
   Eigen::Isometry3d pose;
@@ -246,11 +234,8 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
     codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, foreign).code;      // ModelMismatch (workspace)
     codes[n++] = solveHybridDynamics(model, foreign_task, ok7, ok7, ok7, ws).code;   // ModelMismatch (task)
     codes[n++] = solveWithFriction(model, task, ok7, ok7, nan7, ws).code;            // NonFinite
-    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_margin).code;      // BadOption
-    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_override).code;    // BadOption
-    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_iterations).code;  // BadOption
-    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_tolerance).code;   // BadOption
-    codes[n++] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_speed).code;       // BadOption
+    for (std::size_t k = 0; k < bad_options.size(); ++k)                              // BadOption, each
+      option_codes[k] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_options[k].options).code;
     codes[n++] = inverseDynamics(model, task, ok7, short3, ok7, ws).code;            // SizeMismatch
     codes[n++] = inverseDynamics(model, task, ok7, ok7, ok7, foreign).code;          // ModelMismatch
     codes[n++] = jointSpaceInertia(model, nan7, ws).code;                            // NonFinite
@@ -273,18 +258,22 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
   });
   CHECK(count == 0);
   const StatusCode expected[] = {
-      StatusCode::SizeMismatch, StatusCode::NonFinite,    StatusCode::WorkspaceTooSmall, StatusCode::ModelMismatch,
-      StatusCode::ModelMismatch, StatusCode::NonFinite,   StatusCode::BadOption,         StatusCode::BadOption,
-      StatusCode::BadOption,     StatusCode::BadOption,   StatusCode::BadOption,         StatusCode::SizeMismatch,
-      StatusCode::ModelMismatch, StatusCode::NonFinite,   StatusCode::ModelMismatch,     StatusCode::SizeMismatch,
-      StatusCode::NonFinite,     StatusCode::ModelMismatch, StatusCode::SizeMismatch,    StatusCode::NonFinite,
-      StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,   StatusCode::ModelMismatch,
-      StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,   StatusCode::ModelMismatch,
-      StatusCode::ModelMismatch, StatusCode::ModelMismatch};
+      StatusCode::SizeMismatch,  StatusCode::NonFinite,     StatusCode::WorkspaceTooSmall, StatusCode::ModelMismatch,
+      StatusCode::ModelMismatch, StatusCode::NonFinite,     StatusCode::SizeMismatch,      StatusCode::ModelMismatch,
+      StatusCode::NonFinite,     StatusCode::ModelMismatch, StatusCode::SizeMismatch,      StatusCode::NonFinite,
+      StatusCode::ModelMismatch, StatusCode::SizeMismatch,  StatusCode::NonFinite,         StatusCode::ModelMismatch,
+      StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,     StatusCode::ModelMismatch,
+      StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,     StatusCode::ModelMismatch,
+      StatusCode::ModelMismatch};
   REQUIRE(n == static_cast<int>(sizeof expected / sizeof expected[0]));
   for (int k = 0; k < n; ++k) {
     INFO("call " << k);
     CHECK(codes[k] == expected[k]);
+  }
+  REQUIRE(bad_options.size() >= 10);
+  for (std::size_t k = 0; k < bad_options.size(); ++k) {
+    INFO("friction option: " << bad_options[k].message);
+    CHECK(option_codes[k] == StatusCode::BadOption);
   }
   // Every entry point is declared noexcept (the static_asserts above): one
   // that threw would have terminated this test binary.

@@ -1,5 +1,7 @@
 #include "support/random_problem.hpp"
 
+#include <Eigen/SVD>
+
 #include "support/random_chain.hpp"
 #include "support/urdf_writer.hpp"
 
@@ -79,5 +81,20 @@ double relativeError(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
   if (x.size() == 0) return 0.0;
   return (x - y).cwiseAbs().maxCoeff() / std::max(1.0, y.cwiseAbs().maxCoeff());
 }
+
+bool wellPosed(const DenseResult& dense, const DynamicsInput& input) {
+  if (!dense.wellConditioned(1e6) || dense.constraint_rank < input.constraintRows()) return false;
+  return input.constraintRows() == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
+}
+
+RandomInverseDynamics::RandomInverseDynamics(std::mt19937_64& rng)
+    : spec(randomChain(rng)),
+      in(randomProblem(rng, spec)),
+      model(modelFromSpec(spec)),
+      task(taskFromInput(model, in)),
+      ws(model, task),
+      qdd(randomVector(rng, spec.dof(), 5.0)) {}
+
+Status RandomInverseDynamics::solve() { return inverseDynamics(model, task, in.q, in.qd, qdd, ws); }
 
 }  // namespace zwang::testing

@@ -28,6 +28,32 @@ Model modelFromSpec(const ChainSpec& spec);
 // The same problem as a zwang Task (rows in the same order).
 Task taskFromInput(const Model& model, const DynamicsInput& input);
 
+// A draw the solver comparisons keep (test_dense, test_kdl): the dense KKT
+// system well conditioned (condition at most 1e6) and every constraint row
+// reachable — G of full row rank with its smallest singular value at least
+// 1e-6 (a row the joints cannot affect, e.g. a moment about a prismatic-only
+// chain, has G ≈ 0 and is singular by nature).
+bool wellPosed(const DenseResult& dense, const DynamicsInput& input);
+
+// A random inverse-dynamics case (test_dense, test_kdl): a chain, a problem
+// on it (state, gravity, wrenches), zwang's model, task and workspace for it,
+// and q̈ of a few units; the draws in that order. Built in place.
+struct RandomInverseDynamics {
+  explicit RandomInverseDynamics(std::mt19937_64& rng);
+  RandomInverseDynamics(const RandomInverseDynamics&) = delete;
+  RandomInverseDynamics& operator=(const RandomInverseDynamics&) = delete;
+
+  ChainSpec spec;
+  DynamicsInput in;
+  Model model;
+  Task task;
+  Workspace ws;
+  Eigen::VectorXd qdd;
+
+  // zwang's RNEA for the case: τ into ws.tau.
+  Status solve();
+};
+
 // max |x − y| / max(1, max |y|): error relative to the magnitudes involved.
 double relativeError(const Eigen::VectorXd& x, const Eigen::VectorXd& y);
 

@@ -30,11 +30,13 @@ QpScratch::QpScratch(int n)
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         const Eigen::Ref<const Eigen::VectorXd>& x) {
+  // In the units of ∇φ (accelerations), whatever the units of x: a free
+  // variable's gradient, a bounded one's gradient pointing into its room.
   double r = 0.0;
   for (Index j = 0; j < x.size(); ++j) {
     const double g = P.row(j).dot(x) - c[j];
-    const double projected = std::min(hi[j], std::max(lo[j], x[j] - g));
-    r = std::max(r, std::abs(x[j] - projected));
+    const double violation = lo[j] == hi[j] ? 0.0 : x[j] <= lo[j] ? -g : x[j] >= hi[j] ? g : std::abs(g);
+    r = std::max(r, violation);
   }
   return r;
 }

@@ -21,14 +21,17 @@
 //               to max(‖q̈(0)_Θ‖∞, ‖K_ΘΘ μ*‖∞) (the accelerations friction acts on);
 //   agreement   the two maximisers give the same q̈* (it is unique), relative to ‖q̈*‖∞
 //               plus the same acceleration scale.
-// The tolerances are stated below; the worst values are printed. The
-// dissipation, convergence and agreement conditions are asserted only by the
-// hidden strict run (`test_stress "[bug]"`); the default run counts them. The
-// maximiser's scaling bug this first exposed (the heavy/light reproducer at the
-// end of this file) is fixed; a few draws still miss (see the printed counts).
+// The tolerances are stated below; the worst values are printed. Every
+// condition is asserted on every draw, as is convergence of the active set
+// within its cap (the projected-gradient maximiser is a first-order method: its
+// misses at the cap on ill-conditioned draws are counted and printed, and it is
+// held to the conditions only when it reports convergence). Until 07b5784 the
+// dissipation, convergence and agreement conditions missed on a few draws
+// (worst 3.1e-2, two runs at the cap) and were asserted only by a hidden run.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include <catch2/catch.hpp>
 
@@ -49,6 +52,9 @@ constexpr double kSingularClosureTolerance = 1e-8;
 constexpr double kConstraintTolerance = 1e-6;
 constexpr double kTauConstraintTolerance = 1e-9;
 constexpr double kDissipationTolerance = 1e-6;
+// A singular task is solved damped; its ν, up to ~1/λ larger than the task's
+// scale, enters every acceleration, so K_ΘΘ and q̈* carry that much more rounding.
+constexpr double kSingularDissipationTolerance = 1e-5;
 constexpr double kAgreementTolerance = 1e-6;
 
 double logUniform(std::mt19937_64& rng, double lo, double hi) { return lo * std::pow(hi / lo, uniform01(rng)); }
@@ -173,7 +179,7 @@ struct Worst {
   int stuck_joints_max = 0, stuck_hist[9] = {};
   int active_iterations_max = 0, gradient_iterations_max = 0, gradient_not_converged = 0;
   int stick = 0, slip = 0;
-  int constraint_failures = 0;  // regular tasks beyond kConstraintTolerance (asserted when condition <= 1e6)
+  int constraint_failures = 0;  // regular tasks beyond kConstraintTolerance
   int singular_residual_failures = 0;  // closure or tau_c beyond tolerance (singular tasks only in the default run)
   int dissipation_violations = 0, disagreements = 0, active_not_converged = 0, feasibility_violations = 0;
 };
@@ -192,8 +198,11 @@ Residuals residuals(const Model& model, const Task& task, const DynamicsInput& i
   const Eigen::VectorXd C = scratch.tau;
   REQUIRE(inverseDynamics(model, task, in.q, in.qd, s.qdd, scratch));
   const Eigen::VectorXd id = scratch.tau;
+  // (‖G‖∞‖ν‖∞ too: τ_control holds Gᵀν, whose rounding is ε‖G‖‖ν‖ even when
+  // it cancels to a small torque, as on a damped singular task with large ν.)
+  const double constraint_forces = task.constraintRows() > 0 ? inf(dense.G) * inf(s.nu) : 0.0;
   r.closure = ratio(inf(Eigen::VectorXd(id - s.tau_control - tau_friction)),
-                    inf(H) * inf(s.qdd) + inf(C) + inf(s.tau_control) + inf(tau_friction));
+                    inf(H) * inf(s.qdd) + inf(C) + inf(s.tau_control) + inf(tau_friction) + constraint_forces);
   if (task.constraintRows() > 0) {
     r.constraint = ratio(inf(Eigen::VectorXd(dense.G * s.qdd - dense.gamma)), inf(dense.G) * inf(s.qdd) + inf(dense.gamma));
     const Eigen::MatrixXd Gt = dense.G.transpose();
@@ -204,13 +213,12 @@ Residuals residuals(const Model& model, const Task& task, const DynamicsInput& i
 
 // Asserts the residuals of one solve (plain or with friction) and records the
 // worst: closure and τ_c always; the constraint residual of a regular task only
-// (and, outside the strict run, only when its coupling condition is at most 1e6).
-void checkResiduals(const Residuals& r, bool singular, double condition, bool strict, Worst& worst) {
+void checkResiduals(const Residuals& r, bool singular, Worst& worst) {
   const double closure_tolerance = singular ? kSingularClosureTolerance : kClosureTolerance;
   CHECK(r.closure <= closure_tolerance);
   CHECK(r.tau_c <= kTauConstraintTolerance);
   if (r.closure > closure_tolerance || r.tau_c > kTauConstraintTolerance) ++worst.singular_residual_failures;
-  if (!singular && (strict || condition <= 1e6)) CHECK(r.constraint <= kConstraintTolerance);
+  if (!singular) CHECK(r.constraint <= kConstraintTolerance);
   if (!singular && r.constraint > kConstraintTolerance) ++worst.constraint_failures;
   double& closure = singular ? worst.closure_singular : worst.closure;
   closure = std::max(closure, std::max(r.closure, r.tau_c));
@@ -218,14 +226,12 @@ void checkResiduals(const Residuals& r, bool singular, double condition, bool st
   if (!singular) worst.constraint = std::max(worst.constraint, r.constraint);
 }
 
-// strict: also require maximum dissipation, |μ| ≤ f to 1e-12, a converged
-// active set, agreement of the maximisers, and the constraint residual of
-// regular tasks whose coupling condition exceeds 1e6. Until the bugs behind
-// them are fixed (the heavy/light reproducer below; constraint residuals of
-// 6e-5 on three draws since e427cb7, 1.1e-8 before), only the "[.][bug]" run is
-// strict; the default run asserts everything else and prints the counts.
-void runStress(bool strict) {
-  std::mt19937_64 rng(20240606);
+void runStress() {
+  // ZWANG_STRESS_SEED draws another 150 chains (the default seed is CI's).
+  const char* seed_text = std::getenv("ZWANG_STRESS_SEED");
+  const unsigned long long seed = seed_text ? std::strtoull(seed_text, nullptr, 10) : 20240606ULL;
+  std::printf("numerical stress: seed %llu\n", seed);
+  std::mt19937_64 rng(seed);
   Worst worst;
   const TaskKind kinds[] = {TaskKind::Random, TaskKind::Random, TaskKind::NearSingular, TaskKind::RepeatedRow,
                             TaskKind::OnBase, TaskKind::OverConstrained};
@@ -267,8 +273,7 @@ void runStress(bool strict) {
         ++worst.regular_constrained;
       }
       const Eigen::VectorXd no_friction = Eigen::VectorXd::Zero(n);
-      checkResiduals(residuals(model, task, in, dense, ws.solution, no_friction, scratch), singular, condition, strict,
-                     worst);
+      checkResiduals(residuals(model, task, in, dense, ws.solution, no_friction, scratch), singular, worst);
 
       // --- static friction, both maximisers
       Eigen::VectorXd qdd_active;
@@ -292,15 +297,14 @@ void runStress(bool strict) {
         CHECK(fr.iterations <= options.max_iterations);  // terminates within its cap
         if (active) {
           worst.active_iterations_max = std::max(worst.active_iterations_max, fr.iterations);
-          if (strict) CHECK(fr.converged);
+          CHECK(fr.converged);
           if (!fr.converged) ++worst.active_not_converged;
           worst.stuck_hist[stuck]++;
         } else {
           worst.gradient_iterations_max = std::max(worst.gradient_iterations_max, fr.iterations);
           if (!fr.converged) ++worst.gradient_not_converged;
         }
-        checkResiduals(residuals(model, task, in, dense, ws.solution, fr.tau_friction, scratch), singular, condition,
-                       strict, worst);
+        checkResiduals(residuals(model, task, in, dense, ws.solution, fr.tau_friction, scratch), singular, worst);
 
         // Maximum dissipation on Θ₀, with q̈(0) = q̈* − (∂q̈/∂μ) μ*.
         const Eigen::VectorXd& qdd = ws.solution.qdd;
@@ -331,20 +335,21 @@ void runStress(bool strict) {
         }
         INFO("stuck joints (scale " << scale << ", iterations " << fr.iterations << ", kkt " << fr.kkt_residual
                                     << ", indeterminate " << fr.indeterminate << "):" << detail);
-        if (strict) CHECK(infeasible <= 1e-12);
+        CHECK(infeasible <= 1e-12);
         CHECK(infeasible <= 1e-6);  // loose, always: μ stays in the friction box
         if (infeasible > 1e-12) ++worst.feasibility_violations;
         worst.feasibility = std::max(worst.feasibility, infeasible);
         if (active || fr.converged) {
-          if (strict) CHECK(violation <= kDissipationTolerance);
-          if (violation > kDissipationTolerance) ++worst.dissipation_violations;
+          const double dissipation_tolerance = singular ? kSingularDissipationTolerance : kDissipationTolerance;
+          CHECK(violation <= dissipation_tolerance);
+          if (violation > dissipation_tolerance) ++worst.dissipation_violations;
           worst.dissipation = std::max(worst.dissipation, violation);
         }
         if (active) {
           qdd_active = qdd;
         } else if (fr.converged) {
           const double d = ratio(inf(Eigen::VectorXd(qdd - qdd_active)), inf(qdd_active) + scale);
-          if (strict) CHECK(d <= kAgreementTolerance);
+          CHECK(d <= kAgreementTolerance);
           if (d > kAgreementTolerance) ++worst.disagreements;
           worst.agreement = std::max(worst.agreement, d);
         }
@@ -355,19 +360,18 @@ void runStress(bool strict) {
       "numerical stress: %d draws on %d chains (%d solves): %d singular tasks, %d regular constrained, %d degenerate\n"
       "  worst relative residuals, regular tasks: closure %.1e (tol %.0e), constraint %.1e (tol %.0e),"
       " tau_c vs G^T nu %.1e (tol %.0e); singular tasks: closure or tau_c %.1e\n"
-      "  friction: max dissipation violation %.1e (tol %.0e), |mu| beyond f %.1e, active set vs gradient %.1e (tol %.0e)\n"
+      "  friction: max dissipation violation %.1e (tol %.0e, singular tasks %.0e), |mu| beyond f %.1e, active set vs gradient %.1e (tol %.0e)\n"
       "  maximiser iterations: active set max %d, projected gradient max %d (%d not converged at the cap);"
       " stuck joints stick %d, slip %d\n"
       "  draws per stuck-set size 0..7:",
       worst.draws, chains, worst.solves, worst.singular, worst.regular_constrained, worst.degenerate, worst.closure,
       kClosureTolerance, worst.constraint, kConstraintTolerance, worst.tau_c, kTauConstraintTolerance,
       worst.closure_singular, worst.dissipation,
-      kDissipationTolerance, worst.feasibility, worst.agreement, kAgreementTolerance, worst.active_iterations_max,
+      kDissipationTolerance, kSingularDissipationTolerance, worst.feasibility, worst.agreement, kAgreementTolerance, worst.active_iterations_max,
       worst.gradient_iterations_max, worst.gradient_not_converged, worst.stick, worst.slip);
   for (int k = 0; k <= 7; ++k) std::printf(" %d", worst.stuck_hist[k]);
   std::printf("\n  beyond tolerance: %d solves of singular tasks miss closure or tau_c = G^T nu (asserted);"
-              " asserted only in the strict run: %d solves of regular tasks with coupling"
-              " condition > 1e6 miss the constraint tolerance, %d friction solves violate maximum dissipation,"
+              " %d solves of regular tasks miss the constraint tolerance, %d friction solves violate maximum dissipation,"
               " %d |mu| > f, %d active-set runs not converged, %d maximiser disagreements\n",
               worst.singular_residual_failures, worst.constraint_failures, worst.dissipation_violations, worst.feasibility_violations, worst.active_not_converged, worst.disagreements);
   CHECK(worst.regular_constrained > 50);  // the checks above did run on constrained tasks
@@ -378,10 +382,8 @@ void runStress(bool strict) {
 
 }  // namespace
 
-TEST_CASE("numerical stress: extreme chains, singular tasks, every stuck-set size") { runStress(false); }
-
-TEST_CASE("numerical stress, strict: maximum dissipation and convergence on every draw", "[.][bug]") {
-  runStress(true);
+TEST_CASE("numerical stress: extreme chains, singular tasks, every stuck-set size, maximum dissipation on every draw") {
+  runStress();
 }
 
 TEST_CASE("numerical stress: non-finite and wrongly sized inputs come back as a status, never as NaN") {
@@ -404,8 +406,7 @@ TEST_CASE("numerical stress: non-finite and wrongly sized inputs come back as a 
 }
 
 // ---------------------------------------------------------------------------
-// Reproducers of bugs found by the stress test, hidden from the default run
-// ("[.]") until the library is fixed: `test_stress "[bug]"` runs them.
+// Regression tests: bugs the stress test found, reduced to a few joints.
 
 namespace {
 // Two revolute joints about z, no gravity: a heavy 1 m link (1e4 kg) and a

@@ -20,7 +20,7 @@ struct QpScratch {
 
 struct QpReport {
   int iterations = 0;
-  double kkt_residual = 0.0;  // ‖x − clamp(x − ∇φ)‖∞ (box QP)
+  double kkt_residual = 0.0;  // boxQpKktResidual at the result
   bool converged = false;
   bool unbounded = false;
   int unbounded_index = -1;   // a variable that runs off to an infinite bound
@@ -46,7 +46,10 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
                                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                                 Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance);
 
-// ‖x − clamp(x − (P x − c))‖∞: zero exactly at a minimiser of the box QP.
+// The largest violation of the optimality conditions, in the units of ∇φ:
+// |∇φ_j| of a free variable, ∇φ_j pointing into the room of one on a bound
+// (x_j = lo_j needs ∇φ_j ≥ 0, x_j = hi_j needs ∇φ_j ≤ 0); zero exactly at a
+// minimiser. Unlike ‖x − clamp(x − ∇φ)‖∞ it does not mix the units of x and ∇φ.
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         const Eigen::Ref<const Eigen::VectorXd>& x);

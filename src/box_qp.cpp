@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 
-#include "internal/coupling.hpp"
 
 namespace zwang::internal {
 
@@ -13,19 +12,19 @@ using Index = Eigen::Index;
 }  // namespace
 
 QpScratch::QpScratch(int n)
-    : M(n, n),
-      V(n, n),
-      lambda(n),
+    : lambda(n),
       g(n),
       p(n),
       t1(n),
       t2(n),
-      C(2 * n, n),
+      Ct(n, 2 * n),
       d(2 * n),
-      free_index(n),
-      working(2 * n),
-      side(2 * n),
-      factor(n) {}
+      fixed(n),
+      gram(2 * n, 2 * n),
+      Ca(2 * n),
+      active(2 * n),
+      factor(n),
+      row_factor(2 * n) {}
 
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
@@ -124,17 +123,18 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
                          const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> z, QpScratch& s,
                          int max_iterations) {
   // Constraint rows, each "row·z ≤ bound": for joint j, N_j z ≤ hi_j − x0_j and
-  // −N_j z ≤ x0_j − lo_j (rows with an infinite bound are skipped).
+  // −N_j z ≤ x0_j − lo_j (rows with an infinite bound are skipped). Row r is
+  // kept as column r of Ct (contiguous).
   QpReport report;
   const Index q = N.cols(), k = N.rows();
   Index rows = 0;
   for (Index j = 0; j < k; ++j) {
     if (std::isfinite(hi[j])) {
-      s.C.row(rows).head(q) = N.row(j);
+      s.Ct.col(rows).head(q) = N.row(j).transpose();
       s.d[rows++] = hi[j] - x0[j];
     }
     if (std::isfinite(lo[j])) {
-      s.C.row(rows).head(q) = -N.row(j);
+      s.Ct.col(rows).head(q) = -N.row(j).transpose();
       s.d[rows++] = x0[j] - lo[j];
     }
   }
@@ -142,43 +142,31 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
   const double scale = 1.0 + (q > 0 ? a.cwiseAbs().maxCoeff() : 0.0) +
                        (rows > 0 ? s.d.head(rows).cwiseAbs().maxCoeff() : 0.0);
   const double tol = 1e-12 * scale;
-  Index nw = 0;  // working set: indices into the rows, s.working[0..nw)
+  const auto row = [&](Index r) { return s.Ct.col(r).head(q); };
+  // The working rows W keep a Cholesky factor of C_W C_Wᵀ updated by one row
+  // at a time, so an iteration costs O(rows·q + |W|²). The Gram entries and
+  // C a are computed as rows join W (a handful of iterations is usual).
+  auto G = s.gram.topLeftCorner(rows, rows);
+  auto Ca = s.Ca.head(rows);
+  GrowingCholesky& W = s.row_factor;
+  W.clear();
+  auto active = s.active.head(rows);
+  active.setZero();
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
     // Minimise ½‖z' − a‖² with C_W z' = d_W:  z' = a − C_Wᵀ λ,  (C_W C_Wᵀ) λ = C_W a − d_W.
+    const int nw = W.size();
     auto lam = s.p.head(nw);
-    if (nw > 0) {
-      auto G = s.M.topLeftCorner(nw, nw);
-      for (Index u = 0; u < nw; ++u)
-        for (Index v = 0; v < nw; ++v) G(u, v) = s.C.row(s.working[u]).head(q).dot(s.C.row(s.working[v]).head(q));
-      for (Index u = 0; u < nw; ++u) s.t1[u] = s.C.row(s.working[u]).head(q).dot(a) - s.d[s.working[u]];
-      auto V = s.V.topLeftCorner(nw, nw);
-      auto ev = s.lambda.head(nw);
-      // Independent working rows (the usual case): Cholesky of the Gram
-      // matrix, certified well above rounding; otherwise the pseudo-inverse
-      // from its eigen-decomposition.
-      const double diagonal_scale = G.diagonal().maxCoeff();
-      if (certifiedCholesky(G, V, ev, 1e-12 * std::max(1e-300, diagonal_scale))) {
-        lam = s.t1.head(nw);
-        choleskySolveInPlace(V, lam);
-      } else {
-        jacobiEigen(G, ev, V);
-        const double ev_tol = 1e-12 * std::max(1e-300, ev.maxCoeff());
-        s.t2.head(nw).noalias() = V.transpose() * s.t1.head(nw);
-        for (Index u = 0; u < nw; ++u) s.t2[u] = ev[u] > ev_tol ? s.t2[u] / ev[u] : 0.0;
-        lam.noalias() = V * s.t2.head(nw);
-      }
-    }
+    for (int u = 0; u < nw; ++u) lam[u] = Ca[W.index(u)] - s.d[W.index(u)];
+    W.solveInPlace(lam);
     // Candidate z' and the step towards it.
-    auto target = s.g.head(q);
-    target = a;
-    for (Index u = 0; u < nw; ++u) target -= lam[u] * s.C.row(s.working[u]).head(q).transpose();
     auto step = s.t1.head(q);
-    step = target - z;
+    step = a - z;
+    for (int u = 0; u < nw; ++u) step -= lam[u] * row(W.index(u));
     if (step.cwiseAbs().maxCoeff() <= tol) {
       // At the subproblem's minimum: optimal when every multiplier is ≥ 0.
-      Index drop = -1;
+      int drop = -1;
       double most_negative = -tol;
-      for (Index u = 0; u < nw; ++u)
+      for (int u = 0; u < nw; ++u)
         if (lam[u] < most_negative) {
           most_negative = lam[u];
           drop = u;
@@ -187,18 +175,17 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
         report.converged = true;
         break;
       }
-      s.working[drop] = s.working[--nw];
+      active[W.index(drop)] = 0;
+      W.remove(drop);
       continue;
     }
     double alpha = 1.0;
     Index blocking = -1;
     for (Index r = 0; r < rows; ++r) {
-      bool active = false;
-      for (Index u = 0; u < nw; ++u) active = active || s.working[u] == r;
-      if (active) continue;
-      const double rate = s.C.row(r).head(q).dot(step);
+      if (active[r]) continue;
+      const double rate = row(r).dot(step);
       if (rate <= 1e-15 * scale) continue;
-      const double t = (s.d[r] - s.C.row(r).head(q).dot(z)) / rate;
+      const double t = (s.d[r] - row(r).dot(z)) / rate;
       if (t < alpha) {
         alpha = std::max(0.0, t);
         blocking = r;
@@ -207,10 +194,15 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
     z += alpha * step;
     if (blocking >= 0) {
       // A blocking row is independent of the working rows (the step keeps
-      // those at zero rate), so at most q of them can be active; more would
-      // only be rounding — stop there rather than overrun the scratch.
-      if (nw == q) break;
-      s.working[nw++] = static_cast<int>(blocking);
+      // those at zero rate); one that looks dependent is rounding: stop there.
+      const auto b = static_cast<int>(blocking);
+      for (int u = 0; u < W.size(); ++u) G(W.index(u), b) = row(W.index(u)).dot(row(b));
+      G(b, b) = row(b).squaredNorm();
+      Ca[b] = row(b).dot(a);
+      const double pivot = W.schurPivot(G, b);
+      if (!(pivot > 1e-11 * G(b, b))) break;
+      W.append(b, pivot);
+      active[b] = 1;
     }
   }
   return report;

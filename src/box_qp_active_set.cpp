@@ -63,7 +63,7 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   GrowingCholesky& F = s.factor;
   auto g = s.g.head(k);
   auto noise = s.lambda.head(k);
-  auto fixed = s.working.head(k);
+  auto fixed = s.fixed.head(k);
   auto row_sums = s.t2.head(k);
   for (int j = 0; j < k; ++j) row_sums[j] = P.col(j).cwiseAbs().sum();
   const auto independent = [&](double pivot, int j) { return pivot > kDependent * P(j, j); };

@@ -10,12 +10,15 @@ namespace zwang::internal {
 
 struct QpScratch {
   explicit QpScratch(int n = 0);
-  Eigen::MatrixXd M, V;                       // n × n
-  Eigen::VectorXd lambda, g, p, t1, t2;       // n
-  Eigen::MatrixXd C;                          // 2n × n, constraint rows (least-distance QP)
-  Eigen::VectorXd d;                          // 2n
-  Eigen::VectorXi free_index, working, side;  // n, 2n, 2n
-  GrowingCholesky factor;                     // of P_FF, F the free variables (active set)
+  Eigen::VectorXd lambda, g, p, t1, t2;  // n
+  Eigen::MatrixXd Ct;                    // n × 2n, constraint rows as columns (least-distance QP)
+  Eigen::VectorXd d;                     // 2n
+  Eigen::VectorXi fixed;                 // n, 1 for a fixed variable (active set)
+  Eigen::MatrixXd gram;                  // 2n × 2n, C Cᵀ (least-distance QP)
+  Eigen::VectorXd Ca;                    // 2n
+  Eigen::VectorXi active;                // 2n, working rows (least-distance QP)
+  GrowingCholesky factor;                // of P_FF, F the free variables (active set)
+  GrowingCholesky row_factor;            // of C_W C_Wᵀ, W the working rows (least-distance QP)
 };
 
 struct QpReport {

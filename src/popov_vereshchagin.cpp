@@ -136,8 +136,8 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
 
     if (i > 1) {
       Mat6& IA_parent = ws.IA[at(i - 1)];  // line 16: I^A_{i−1} = I_{i−1} + I^a_i, I^a = I^A − I^A S D⁻¹ Sᵀ I^A
-      IA_parent = IA;
-      IA_parent.noalias() -= IAS * (IAS / D).transpose();
+      const Vec6 IAS_D = IAS / D;
+      IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
       ws.I[at(i - 1)].addTo(IA_parent);
       ws.FA[at(i - 1)] = ws.Fbias[at(i - 1)] + pA + IAS * u_D;  // lines 17–18: F^A_{i−1} = F_bias + F^a_i
     }

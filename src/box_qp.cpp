@@ -42,7 +42,8 @@ double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
 
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance) {
+                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
+                                double curvature_scale) {
   QpReport report;
   const Index k = x.size();
   if (k == 0) {
@@ -78,7 +79,7 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
     if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
     if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
   }
-  x_scale = std::max(x_scale, c.cwiseAbs().maxCoeff() / L);
+  x_scale = std::max(x_scale, c.cwiseAbs().maxCoeff() / std::max(L, curvature_scale));
   auto y = s.t1.head(k);       // extrapolated point
   auto x_prev = s.t2.head(k);  // previous iterate
   y = x;

@@ -26,9 +26,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDependent = 1e-11;
 // ∇φ_j is computed to within this multiple of ε·(Σ_l |P_jl x_l| + |c_j|).
 constexpr double kRounding = 64.0 * DBL_EPSILON;
-// A variable with an infinite bound that travels this many times the largest
-// finite bound is running off to infinity: its curvature is rounding (a zero
-// computed as a tiny number), not physics.
+// A variable with an infinite bound that travels this many times the
+// problem's own scale, max(1, largest finite bound, ‖c‖∞/L) with L ≥ λ_max(P)
+// (or the caller's curvature scale, when larger), is running off to infinity: its curvature is rounding (a zero computed as a
+// tiny number next to P's other entries), not physics. The same rule as the
+// projected gradient method's, so the two maximisers agree on what is
+// unbounded.
 constexpr double kReach = 1e12;
 
 // g = P x − c (P symmetric), and a bound on each entry's rounding from the
@@ -53,7 +56,8 @@ double room(double x, double lo, double hi, double rate) {
 
 QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance) {
+                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
+                        double curvature_scale) {
   QpReport report;
   const auto k = static_cast<int>(x.size());
   if (k == 0) {
@@ -73,6 +77,9 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
     if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
     if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
   }
+  // L: the smaller of Gershgorin's bound and the trace, both ≥ λ_max(P).
+  const double L = std::max(std::min(row_sums.maxCoeff(), P.diagonal().sum()), curvature_scale);
+  if (L > 0.0) x_scale = std::max(x_scale, c.cwiseAbs().maxCoeff() / L);
   // After a step: has a free variable run off along an infinite bound?
   const auto runAway = [&] {
     for (int a = 0; a < F.size(); ++a)

@@ -5,6 +5,7 @@
 // g(μ) = g(0) + μᵀ q̈_Θ(0) − ½ μᵀ K_ΘΘ μ is then maximised over the box Λ.
 #include "zwang/friction.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -143,6 +144,16 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   }
   for (Eigen::Index a = 0; a < k; ++a)  // symmetric in exact arithmetic (K is)
     for (Eigen::Index b = 0; b < a; ++b) P(a, b) = P(b, a) = 0.5 * (P(a, b) + P(b, a));
+  // The size of the terms K_ΘΘ is computed from (1/D_j, and the columns'
+  // entries): where the task pins the stuck joints, K_ΘΘ is that times
+  // rounding, and a stop the task pushes into must come out unbounded
+  // rather than as a 1e16 N·m torque (the maximiser's reach rule).
+  double curvature_scale = 0.0;
+  for (Eigen::Index a = 0; a < k; ++a) {
+    const int j = fr.stuck[static_cast<std::size_t>(a)];
+    curvature_scale = std::max({curvature_scale, 1.0 / ws.D[static_cast<std::size_t>(j + 1)],
+                                fr.dqdd_dmu.col(j).cwiseAbs().maxCoeff()});
+  }
   // The acceleration scale, of the stuck joints only (a light, fast joint
   // elsewhere in the chain must not set it): their accelerations q̈_Θ(0).
   double acc_max = 0.0;
@@ -155,9 +166,9 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   if (k > 0) {
     report = options.method == FrictionMethod::ActiveSet
                  ? boxQpActiveSet(P, fs.c.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp, options.max_iterations,
-                                  tolerance)
+                                  tolerance, curvature_scale)
                  : boxQpProjectedGradient(P, fs.c.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp,
-                                          options.max_iterations, tolerance);
+                                          options.max_iterations, tolerance, curvature_scale);
   }
   fr.iterations = report.iterations;
   fr.converged = k == 0 || report.converged;

@@ -696,8 +696,10 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
     }
   }
   SECTION("rounding-level curvature P_jj = 1e-30 (others O(1)): unbounded by the reach rule, not x_j ~ 1e30") {
+    // k ≥ 2: "rounding" means small next to P's other curvatures. Alone
+    // (k = 1) the problem is a rescaling of a finite one, checked below.
     for (int draw = 0; draw < 200; ++draw, ++draws) {
-      const int k = uniformInt(rng, 1, 6);
+      const int k = uniformInt(rng, 2, 6);
       const int j = uniformInt(rng, 0, k - 1);
       BoxQp q;
       q.P = MatrixXd::Zero(k, k);
@@ -730,6 +732,28 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
       REQUIRE_FALSE(bounded.unbounded);
       REQUIRE(x[j] == (up ? 1.5 : -1.5));
       REQUIRE(kktViolationRatio(q, x) <= kKktTol);
+    }
+    // One variable, P = 1e-30, c = 1, x ∈ [−1, ∞): the minimiser x = 1e30.
+    MatrixXd P1 = MatrixXd::Constant(1, 1, 1e-30);
+    VectorXd c1 = VectorXd::Ones(1), lo1 = VectorXd::Constant(1, -1.0), hi1 = VectorXd::Constant(1, kInf);
+    VectorXd x1 = VectorXd::Zero(1);
+    QpScratch scratch1(1);
+    const QpReport alone = boxQpActiveSet(P1, c1, lo1, hi1, x1, scratch1, kMaxIterations, 1e-12);
+    CAPTURE(alone.iterations, x1[0]);
+    REQUIRE(alone.converged);
+    REQUIRE_FALSE(alone.unbounded);
+    REQUIRE(x1[0] == Approx(1e30).epsilon(1e-14));
+    // The same P computed as the rounding of O(1) terms (the caller says so
+    // with curvature_scale = 1): zero curvature, unbounded; the active set
+    // and projected gradient agree.
+    for (const bool active_set : {true, false}) {
+      x1.setZero();
+      const QpReport rounding = active_set
+                                    ? boxQpActiveSet(P1, c1, lo1, hi1, x1, scratch1, kMaxIterations, 1e-12, 1.0)
+                                    : boxQpProjectedGradient(P1, c1, lo1, hi1, x1, scratch1, kPgMaxIterations, 1e-12, 1.0);
+      CAPTURE(active_set, rounding.iterations, x1[0]);
+      REQUIRE(rounding.unbounded);
+      REQUIRE(rounding.unbounded_index == 0);
     }
   }
   SECTION("rank-deficient P, c ∈ range(P), some bounds infinite: bounded (φ ≥ −½ cᵀP⁺c), converges to a KKT point") {
@@ -869,19 +893,14 @@ TEST_CASE("boxQpActiveSet: k = 40, 80 satisfies the KKT conditions in few iterat
   }
 }
 
-// Found while writing these tests (left failing, hidden): the `kReach` rule
-// of boxQpActiveSet declares a variable unbounded once |x_j| > 1e12·x_scale,
-// with x_scale = max(1, largest finite bound), whatever P's curvature. On a
-// perfectly conditioned problem with an infinite bound and a large minimiser
-// (P = I, c = (1e13, 0.5), x_0 free, x_1 ∈ [−1, 1]) the minimiser is
-// x = (1e13, 0.5), which boxQpProjectedGradient returns (its x_scale includes
-// ‖c‖∞/L), but the active set reports unbounded with unbounded_index 0.
-// The header promises invariance under diagonal scaling, yet the same problem
-// in y = x/100 (P = 1e4·I, c = (1e15, 50), y_1 ∈ [−0.01, 0.01]) is solved,
-// y = (1e11, 0.005). (The P_jj = 1e-30 case the rule exists for is a diagonal
-// rescaling of this one too, so a fix has to tell them apart another way,
-// e.g. through the size of the Schur pivot relative to P's diagonal.)
-TEST_CASE("boxQpActiveSet: a large but finite minimiser on an infinite bound is not unbounded", "[.][bug][box_qp]") {
+// The `kReach` rule once measured travel against max(1, largest finite
+// bound) only, whatever P and c: on a perfectly conditioned problem with an
+// infinite bound and a large minimiser (P = I, c = (1e13, 0.5), x_0 free,
+// x_1 ∈ [−1, 1]) it reported unbounded, while the same problem in y = x/100
+// was solved. The scale now includes ‖c‖∞/L (L ≥ λ_max(P)), as the projected
+// gradient method's does; the P_jj = 1e-30 case above (a curvature 1e-30 next
+// to O(1) ones) is still unbounded.
+TEST_CASE("boxQpActiveSet: a large but finite minimiser on an infinite bound is not unbounded", "[box_qp][active_set][unbounded]") {
   const MatrixXd P = MatrixXd::Identity(2, 2);
   VectorXd c(2), lo(2), hi(2);
   c << 1e13, 0.5;

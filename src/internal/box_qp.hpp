@@ -38,16 +38,23 @@ struct QpReport {
 // with F, along the zero-curvature direction straight to the next bound.
 // `tolerance` is on the projected gradient (plus the rounding of ∇φ).
 // Invariant under diagonal scaling of the variables: badly scaled P is fine.
+// A variable on an infinite bound that travels 1e12 times the problem's scale
+// max(1, largest finite bound, ‖c‖∞ / max(L, curvature_scale)), L ≥ λ_max(P),
+// is reported unbounded (its curvature is rounding). `curvature_scale` is the
+// size of the terms P was computed from, when the caller knows it: a P that
+// is rounding throughout (every entry ≪ that) then counts as zero.
 QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance);
+                        Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
+                        double curvature_scale = 0.0);
 
 // The same problem by accelerated projected gradient (FISTA with adaptive
 // restart), step 1/L with L ≥ λ_max(P) (Gershgorin or trace bound); a linear
-// problem (P = 0) goes to its vertex.
+// problem (P = 0) goes to its vertex. Unbounded by the same rule as above.
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance);
+                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
+                                double curvature_scale = 0.0);
 
 // The largest violation of the optimality conditions, in the units of ∇φ:
 // |∇φ_j| of a free variable, ∇φ_j pointing into the room of one on a bound

@@ -298,4 +298,32 @@ void balanceApply(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::
   }
 }
 
+void balanceApplyColumns(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::Ref<const Eigen::VectorXd>& lambda,
+                         bool by_eigen, double damping, const Eigen::Ref<const Eigen::MatrixXd>& R,
+                         Eigen::Ref<Eigen::MatrixXd> out) {
+  if (by_eigen) {
+    for (Eigen::Index c = 0; c < R.cols(); ++c) balanceApply(factor, lambda, true, damping, R.col(c), out.col(c));
+    return;
+  }
+  // X ← (C Cᵀ)⁻¹ R: forward, then backward substitution, row by row.
+  const Eigen::Index m = factor.rows(), k = R.cols();
+  out = R;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const double inverse = 1.0 / factor(i, i);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      double s = out(i, c);
+      for (Eigen::Index l = 0; l < i; ++l) s -= factor(i, l) * out(l, c);
+      out(i, c) = s * inverse;
+    }
+  }
+  for (Eigen::Index i = m - 1; i >= 0; --i) {
+    const double inverse = 1.0 / factor(i, i);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      double s = out(i, c);
+      for (Eigen::Index l = i + 1; l < m; ++l) s -= factor(l, i) * out(l, c);
+      out(i, c) = s * inverse;
+    }
+  }
+}
+
 }  // namespace zwang::internal

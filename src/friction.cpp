@@ -130,10 +130,11 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   for (int i = 0; i <= n; ++i) fs.u0[i] = ws.u[static_cast<std::size_t>(i)];
   fs.nu0.head(m) = ws.nu.head(m);
   fr.dqdd_dmu.setZero();
-  for (Eigen::Index col = 0; col < k; ++col) {
-    const int j = fr.stuck[static_cast<std::size_t>(col)];
-    unitTorqueColumn(model, task, ws, j, fs.du.col(col), fs.dU, fs.dnu.col(col), fr.dqdd_dmu.col(j));
-    fr.dqdd_dmu.col(j) *= -1.0;  // μ_j enters as the torque −μ_j
+  if (k > 0) {
+    unitTorqueColumns(model, task, ws, fr.stuck, fs.du.leftCols(k), fs.dU.topLeftCorner(m, k),
+                      fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da.leftCols(k));
+    for (Eigen::Index col = 0; col < k; ++col)  // μ_j enters as the torque −μ_j
+      fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(col)]) = -fs.dqdd.col(col);
   }
 
   // ---- max g(μ) over Λ  ⇔  min ½ μᵀ K_ΘΘ μ − μᵀ q̈_Θ(0)

@@ -93,21 +93,40 @@ Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::R
     for (Eigen::Index j = r + 1; j < n; ++j)  // Schur complement, both triangles
       for (Eigen::Index i = r + 1; i < n; ++i) A(i, j) -= A(i, r) * A(j, r);
   }
-  // In pivoted order the directions are [−L₁₁⁻ᵀ L₂₁ᵀ; I]: column e leaves the
-  // factored part's gradient unchanged while moving the remaining index r + e.
+  // The near null space is the orthogonal complement of the factored
+  // columns L (n × r, pivoted order): for d ⟂ range(L), dᵀAd = d₂ᵀ S d₂ with
+  // S the remaining Schur complement. Householder QR of L gives it directly
+  // as the last n − r columns of Q = H₀…H_{r−1}: O(n·r·(n − r)), no
+  // Gram–Schmidt. Each reflector H_j = I − 2 v vᵀ (‖v‖ = 1) is kept in
+  // column j of L, rows j…n−1.
   const Eigen::Index nullity = n - r;
+  if (nullity == 0) return 0;
+  for (Eigen::Index j = 0; j < r; ++j) {
+    for (Eigen::Index i = 0; i < j; ++i) A(i, j) = 0.0;  // L is lower trapezoidal (above: scratch)
+    for (Eigen::Index h = 0; h < j; ++h) {                // the earlier reflectors act on column j
+      double dot = 0.0;
+      for (Eigen::Index i = h; i < n; ++i) dot += A(i, h) * A(i, j);
+      for (Eigen::Index i = h; i < n; ++i) A(i, j) -= 2.0 * dot * A(i, h);
+    }
+    double norm2 = 0.0;
+    for (Eigen::Index i = j; i < n; ++i) norm2 += A(i, j) * A(i, j);
+    const double alpha = A(j, j) >= 0.0 ? std::sqrt(norm2) : -std::sqrt(norm2);
+    A(j, j) += alpha;  // v = x + sign(x_j)‖x‖ e_j, then normalised
+    const double v_norm = std::sqrt(2.0 * alpha * A(j, j));  // ‖v‖² = 2α(x_j + α)
+    const double scale = v_norm > 0.0 ? 1.0 / v_norm : 0.0;
+    for (Eigen::Index i = j; i < n; ++i) A(i, j) *= scale;
+  }
+  // N = Q [0; I], rows back in the original order: start from the unit
+  // columns e_{r+e} and apply H_{r−1}, …, H₀.
   for (Eigen::Index e = 0; e < nullity; ++e) {
     auto d = N.col(e).head(n);
     d.setZero();
     d[perm[r + e]] = 1.0;
-    for (Eigen::Index a = r - 1; a >= 0; --a) {  // L₁₁ᵀ y = −L₂₁ᵀ e
-      double x = -A(r + e, a);
-      for (Eigen::Index b = a + 1; b < r; ++b) x -= A(b, a) * d[perm[b]];
-      d[perm[a]] = x / A(a, a);
+    for (Eigen::Index h = r - 1; h >= 0; --h) {
+      double dot = 0.0;
+      for (Eigen::Index i = h; i < n; ++i) dot += A(i, h) * d[perm[i]];
+      for (Eigen::Index i = h; i < n; ++i) d[perm[i]] -= 2.0 * dot * A(i, h);
     }
-    for (int pass = 0; pass < 2; ++pass)  // modified Gram–Schmidt, twice (enough for orthogonality)
-      for (Eigen::Index f = 0; f < e; ++f) d -= N.col(f).head(n).dot(d) * N.col(f).head(n);
-    d /= d.norm();
   }
   return nullity;
 }

@@ -180,33 +180,52 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   }
 }
 
-void unitTorqueColumn(const Model& model, const Task& task, Workspace& ws, int joint, Eigen::Ref<Eigen::VectorXd> du,
-                      Eigen::Ref<Eigen::VectorXd> dU, Eigen::Ref<Eigen::VectorXd> dnu,
-                      Eigen::Ref<Eigen::VectorXd> dqdd) {
+void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
+                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
+                       Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da) {
   // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
   // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
+  // Column c is zero outward of its joint s_c, so the inward sweep at body i
+  // works on the columns with s_c ≥ i: a suffix c ≥ first, since the joints
+  // ascend.
   const int N = model.dof();
   const int m = task.constraintRows();
-  const int s = joint + 1;
-  du.setZero();
-  dU.head(m).setZero();
-  Vec6 dFA = Vec6::Zero();  // δF^A arriving at body i from its child
-  for (int i = s; i >= 1; --i) {
-    du[i] = (i == s ? 1.0 : 0.0) - ws.S[at(i)].dot(dFA);
-    const double du_D = du[i] / ws.D[at(i)];
-    const int k = task.activeColumns(i);
-    dU.head(k) += ws.SA.col(i).head(k) * du_D;  // line 20
-    dFA += ws.IAS[at(i)] * du_D;                // lines 17–18
+  const auto k = static_cast<Eigen::Index>(joints.size());
+  dU.setZero();
+  dF.setZero();  // δF^A arriving at body i from its child, per column
+  Eigen::Index first = k;
+  for (int i = N; i >= 1; --i) {
+    while (first > 0 && joints[static_cast<std::size_t>(first - 1)] + 1 >= i) --first;
+    const Vec6& S = ws.S[at(i)];
+    const Vec6& IAS = ws.IAS[at(i)];
+    const double D = ws.D[at(i)];
+    const int ki = task.activeColumns(i);
+    for (Eigen::Index c = 0; c < first; ++c) du(i, c) = 0.0;
+    for (Eigen::Index c = first; c < k; ++c) {
+      const double du_ic = (joints[static_cast<std::size_t>(c)] + 1 == i ? 1.0 : 0.0) - S.dot(dF.col(c));
+      du(i, c) = du_ic;
+      const double du_D = du_ic / D;
+      for (int r = 0; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
+      dF.col(c) += IAS * du_D;                                       // lines 17–18
+    }
   }
-  auto r = dnu.head(m);  // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
-  dU.head(m) *= -1.0;
-  balanceSolve(ws, m, dU.head(m), r);
-  Vec6 da = Vec6::Zero();
+  du.row(0).setZero();
+  dU.topRows(m) *= -1.0;  // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+  balanceApplyColumns(ws.balance_factor.topLeftCorner(m, m), ws.eigval.head(m), ws.balance_by_eigen,
+                      ws.solution.coupling.damping, dU.topRows(m), dnu.topRows(m));
+  da.setZero();
   for (int i = 1; i <= N; ++i) {  // lines 28–29 for the differences
-    const int k = task.activeColumns(i);
-    const double dq = (du[i] - ws.IAS[at(i)].dot(da) + ws.SA.col(i).head(k).dot(dnu.head(k))) / ws.D[at(i)];
-    dqdd[i - 1] = dq;
-    da += ws.S[at(i)] * dq;
+    const Vec6& S = ws.S[at(i)];
+    const Vec6& IAS = ws.IAS[at(i)];
+    const double D = ws.D[at(i)];
+    const int ki = task.activeColumns(i);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      double constraint = 0.0;
+      for (int r = 0; r < ki; ++r) constraint += ws.SA(r, i) * dnu(r, c);
+      const double dq = (du(i, c) - IAS.dot(da.col(c)) + constraint) / D;
+      dqdd(i - 1, c) = dq;
+      da.col(c) += S * dq;
+    }
   }
 }
 

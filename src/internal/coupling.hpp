@@ -27,6 +27,13 @@ void balanceApply(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::
                   bool by_eigen, double damping, const Eigen::Ref<const Eigen::VectorXd>& r,
                   Eigen::Ref<Eigen::VectorXd> out);
 
+// The same for the columns of R at once (out: m × k, not aliasing R). The
+// columns share each row's reciprocal pivot, and their substitutions run
+// side by side instead of one chain of divisions per column.
+void balanceApplyColumns(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::Ref<const Eigen::VectorXd>& lambda,
+                         bool by_eigen, double damping, const Eigen::Ref<const Eigen::MatrixXd>& R,
+                         Eigen::Ref<Eigen::MatrixXd> out);
+
 // Lower Cholesky factor C (C Cᵀ = A) of the lower triangle of A; false when a
 // pivot is not positive. C may not alias A.
 bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C);

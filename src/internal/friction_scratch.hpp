@@ -2,6 +2,7 @@
 #pragma once
 
 #include "internal/box_qp.hpp"
+#include "internal/popov_vereshchagin.hpp"
 #include "zwang/workspace.hpp"
 
 namespace zwang::internal {
@@ -11,7 +12,8 @@ struct FrictionScratch {
       : f(dof), fc(dof), b(dof), tau_eff(dof), qdd0(dof), lo(dof), hi(dof), lo_margin(dof), hi_margin(dof),
         c(dof), mu(dof), mu_alt(dof), h(dof), z(dof), za(dof), tau_total(dof), sub_mu(dof),
         sub_lo(dof), sub_hi(dof), sub_index(dof), perm(dof), u0(bodies),
-        nu0(capacity), dU(capacity), rhs(capacity), du(bodies, dof), dnu(capacity, dof), P(dof, dof),
+        nu0(capacity), dU(capacity, dof), rhs(capacity), du(bodies, dof), dnu(capacity, dof), dqdd(dof, dof), dF(6, dof),
+        da(6, dof), P(dof, dof),
         null_basis(dof, dof), V(dof, dof), qp(dof) {}
   Eigen::VectorXd f, fc, b;         // breakaway, kinetic, viscous per joint
   Eigen::VectorXd tau_eff;          // τ − kinetic friction of the moving joints
@@ -25,9 +27,12 @@ struct FrictionScratch {
   Eigen::VectorXi perm;                    // pivot order (near null space)
   Eigen::VectorXd u0;               // u_i of the μ = 0 pass
   Eigen::VectorXd nu0;              // ν of the μ = 0 pass (solver order)
-  Eigen::VectorXd dU, rhs;          // per-column δU₀ and balance right-hand side
+  Eigen::MatrixXd dU;               // capacity × k: δU₀ per unit torque
+  Eigen::VectorXd rhs;              // balance right-hand side
   Eigen::MatrixXd du;               // bodies × k: δu_i per unit torque at each stuck joint
   Eigen::MatrixXd dnu;              // capacity × k: δν per unit torque
+  Eigen::MatrixXd dqdd;             // dof × k: δq̈ per unit torque
+  Matrix6X dF, da;                  // 6 × k: δF^A and δẌ per unit torque (sweep scratch)
   Eigen::MatrixXd P;                // K_ΘΘ
   Eigen::MatrixXd null_basis, V;    // near null space of K_ΣΣ, and its working copy
   QpScratch qp;

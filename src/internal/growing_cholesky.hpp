@@ -45,10 +45,11 @@ class GrowingCholesky {
 // diagonally pivoted (rank-revealing) Cholesky, stopped when every remaining
 // Schur-complement diagonal is at most `floor`. Writes an orthonormal basis of
 // the remaining directions into the first columns of N (n × n capacity) and
-// returns their number n − r. Each has curvature dᵀ A d ≤ (n − r)·floor: the
-// Schur complement S is positive semi-definite with trace ≤ (n − r)·floor, and
-// the basis is S's directions orthonormalised (which only shrinks them). A is
-// overwritten; `perm` (n) is scratch. O(n³/3).
+// returns their number n − r: the orthogonal complement of the r factored
+// columns (Householder QR of them). Each has curvature dᵀ A d ≤ (n − r)·floor:
+// for d ⟂ range(L), dᵀAd = d₂ᵀ S d₂ with the Schur complement S positive
+// semi-definite and trace S ≤ (n − r)·floor. A is overwritten; `perm` (n) is
+// scratch. O(n³/3).
 Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::Ref<Eigen::MatrixXd> N,
                            Eigen::Ref<Eigen::VectorXi> perm);
 

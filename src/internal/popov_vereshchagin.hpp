@@ -3,12 +3,15 @@
 // right-hand sides. Not installed; the public entry is solveHybridDynamics.
 #pragma once
 
+#include <vector>
+
 #include "zwang/status.hpp"
 #include "zwang/workspace.hpp"
 
 namespace zwang::internal {
 
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
+using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 // Input checks shared by every solve.
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
@@ -34,13 +37,15 @@ void balanceSolve(const Workspace& ws, int m, const VectorRef& r, Eigen::Ref<Eig
 // Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd);
 
-// One extra right-hand side through the same sweeps: a unit torque at `joint`,
-// everything else zero. Gives δu_i (bodies), δν (m, solver order; uses dU as
-// scratch) and δq̈ = ∂q̈/∂τ_joint (n). Needs inwardSweep and balance first.
-// O(N + m²) per column: the sensitivity K_Θ of the friction extension.
-void unitTorqueColumn(const Model& model, const Task& task, Workspace& ws, int joint, Eigen::Ref<Eigen::VectorXd> du,
-                      Eigen::Ref<Eigen::VectorXd> dU, Eigen::Ref<Eigen::VectorXd> dnu,
-                      Eigen::Ref<Eigen::VectorXd> dqdd);
+// k extra right-hand sides through the same sweeps, all at once: column c is
+// a unit torque at joint joints[c] (ascending), everything else zero. Gives
+// δu_i (du: bodies × k), δν (dnu: m × k, solver order) and δq̈ = ∂q̈/∂τ_joint
+// (dqdd: n × k); dF, da (6 × k) and dU (m × k) are scratch. Needs inwardSweep
+// and balance first. O((N + m²)·k): the sensitivity K_Θ of the friction
+// extension, as matrix–row products over the k columns rather than k sweeps.
+void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
+                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
+                       Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da);
 
 // τ_c = Σ J_iᵀ A_i ν_i for ν in solver order (one inward pass of the wrenches A ν).
 void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,

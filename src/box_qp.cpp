@@ -186,9 +186,9 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
       if (active[r]) continue;
       const double rate = row(r).dot(step);
       if (rate <= 1e-15 * scale) continue;
-      const double t = (s.d[r] - row(r).dot(z)) / rate;
-      if (t < alpha) {
-        alpha = std::max(0.0, t);
+      const double slack = s.d[r] - row(r).dot(z);
+      if (slack < alpha * rate) {  // t = slack/rate < α (divide only then)
+        alpha = std::max(0.0, slack / rate);
         blocking = r;
       }
     }

@@ -127,7 +127,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   if (Status s = inwardSweep(model, task, fs.tau_eff, ws); !s) return s;
   balance(task, ws);
   outwardAccelerations(model, task, ws, fs.qdd0);
-  for (int i = 0; i <= n; ++i) fs.u0[i] = ws.u[static_cast<std::size_t>(i)];
+  fs.u0.head(n + 1) = Eigen::Map<const Eigen::VectorXd>(ws.u.data(), n + 1);
   fs.nu0.head(m) = ws.nu.head(m);
   fr.dqdd_dmu.setZero();
   if (k > 0) {
@@ -139,10 +139,9 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
 
   // ---- max g(μ) over Λ  ⇔  min ½ μᵀ K_ΘΘ μ − μᵀ q̈_Θ(0)
   auto P = fs.P.topLeftCorner(k, k);
-  for (Eigen::Index a = 0; a < k; ++a) {
-    fs.c[a] = fs.qdd0[fr.stuck[static_cast<std::size_t>(a)]];
-    for (Eigen::Index b = 0; b < k; ++b) P(a, b) = -fr.dqdd_dmu(fr.stuck[static_cast<std::size_t>(a)], fr.stuck[static_cast<std::size_t>(b)]);
-  }
+  for (Eigen::Index a = 0; a < k; ++a) fs.c[a] = fs.qdd0[fr.stuck[static_cast<std::size_t>(a)]];
+  for (Eigen::Index b = 0; b < k; ++b)  // column by column (column-major storage)
+    for (Eigen::Index a = 0; a < k; ++a) P(a, b) = fs.dqdd(fr.stuck[static_cast<std::size_t>(a)], b);
   for (Eigen::Index a = 0; a < k; ++a)  // symmetric in exact arithmetic (K is)
     for (Eigen::Index b = 0; b < a; ++b) P(a, b) = P(b, a) = 0.5 * (P(a, b) + P(b, a));
   // The size of the terms K_ΘΘ is computed from (1/D_j, and the columns'
@@ -182,8 +181,11 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   if (k > 0 && !report.unbounded) {
     const double acc_tol = 1e-9 * acc_scale;
     Eigen::Index ns = 0;
+    auto qdd_star = fs.qdd_star.head(k);  // q̈*_Θ = q̈_Θ(0) − K_ΘΘ μ*
+    qdd_star = fs.c.head(k);
+    qdd_star.noalias() -= P * mu;
     for (Eigen::Index a = 0; a < k; ++a)
-      if (std::abs(fs.c[a] - P.row(a).dot(mu)) <= acc_tol) fs.sub_index[ns++] = static_cast<int>(a);
+      if (std::abs(fs.qdd_star[a]) <= acc_tol) fs.sub_index[ns++] = static_cast<int>(a);
     // Directions along which g is flat to within the acceleration tolerance
     // over the whole box: a curvature λ moves q̈ by at most λ·W across a box
     // of width W. (None when every stuck joint slips: μ* is then unique.)
@@ -198,8 +200,8 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
       }
       width *= 2.0;
       auto Pss = fs.V.topLeftCorner(ns, ns);
-      for (Eigen::Index a = 0; a < ns; ++a)
-        for (Eigen::Index b = 0; b < ns; ++b) Pss(a, b) = P(fs.sub_index[a], fs.sub_index[b]);
+      for (Eigen::Index b = 0; b < ns; ++b)
+        for (Eigen::Index a = 0; a < ns; ++a) Pss(a, b) = P(fs.sub_index[a], fs.sub_index[b]);
       const double floor = width > 0.0 ? acc_tol / (static_cast<double>(ns) * width) : 0.0;
       nullity = nearNullSpace(Pss, floor, fs.null_basis.topLeftCorner(ns, ns), fs.perm.head(ns));
     }
@@ -254,7 +256,9 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
 
   // ---- The motion at μ*: the τ-dependent terms are linear in μ, so the last
   // outward sweep runs once more with u(μ*) and ν(μ*) (lines 26–30).
-  for (int i = 0; i <= n; ++i) ws.u[static_cast<std::size_t>(i)] = fs.u0[i] - fs.du.row(i).head(k).dot(mu);
+  Eigen::Map<Eigen::VectorXd> u(ws.u.data(), n + 1);
+  u = fs.u0.head(n + 1);
+  u.noalias() -= fs.du.topLeftCorner(n + 1, k) * mu;
   ws.nu.head(m) = fs.nu0.head(m);
   ws.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
   outwardAccelerations(model, task, ws, out.qdd);

@@ -153,6 +153,12 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
   W.clear();
   auto active = s.active.head(rows);
   active.setZero();
+  // The point x0 + N z and the rate N·step of every joint: joint j's rows are
+  // ±N_j, so one rate serves both, and the slacks are hi_j − y_j, y_j − lo_j.
+  auto y = s.t2.head(k);
+  auto rate = s.g.head(k);
+  y = x0;
+  for (Index c = 0; c < q; ++c) y += z[c] * N.col(c);
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
     // Minimise ½‖z' − a‖² with C_W z' = d_W:  z' = a − C_Wᵀ λ,  (C_W C_Wᵀ) λ = C_W a − d_W.
     const int nw = W.size();
@@ -182,17 +188,30 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
     }
     double alpha = 1.0;
     Index blocking = -1;
-    for (Index r = 0; r < rows; ++r) {
-      if (active[r]) continue;
-      const double rate = row(r).dot(step);
-      if (rate <= 1e-15 * scale) continue;
-      const double slack = s.d[r] - row(r).dot(z);
-      if (slack < alpha * rate) {  // t = slack/rate < α (divide only then)
-        alpha = std::max(0.0, slack / rate);
-        blocking = r;
+    rate.setZero();
+    for (Index c = 0; c < q; ++c) rate += step[c] * N.col(c);
+    const double rate_floor = 1e-15 * scale;
+    for (Index j = 0, r = 0; j < k; ++j) {
+      const Index r_hi = std::isfinite(hi[j]) ? r++ : -1;  // the rows in the order they were made
+      const Index r_lo = std::isfinite(lo[j]) ? r++ : -1;
+      Index blocking_row = -1;
+      double rate_j = 0.0, slack = 0.0;
+      if (r_hi >= 0 && rate[j] > rate_floor && !active[r_hi]) {
+        blocking_row = r_hi;
+        rate_j = rate[j];
+        slack = hi[j] - y[j];
+      } else if (r_lo >= 0 && -rate[j] > rate_floor && !active[r_lo]) {
+        blocking_row = r_lo;
+        rate_j = -rate[j];
+        slack = y[j] - lo[j];
+      }
+      if (blocking_row >= 0 && slack < alpha * rate_j) {  // t = slack/rate < α (divide only then)
+        alpha = std::max(0.0, slack / rate_j);
+        blocking = blocking_row;
       }
     }
     z += alpha * step;
+    y += alpha * rate;
     if (blocking >= 0) {
       // A blocking row is independent of the working rows (the step keeps
       // those at zero rate); one that looks dependent is rounding: stop there.

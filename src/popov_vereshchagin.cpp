@@ -198,13 +198,13 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
     while (first > 0 && joints[static_cast<std::size_t>(first - 1)] + 1 >= i) --first;
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
-    const double D = ws.D[at(i)];
+    const double inverse_D = 1.0 / ws.D[at(i)];
     const int ki = task.activeColumns(i);
     for (Eigen::Index c = 0; c < first; ++c) du(i, c) = 0.0;
     for (Eigen::Index c = first; c < k; ++c) {
       const double du_ic = (joints[static_cast<std::size_t>(c)] + 1 == i ? 1.0 : 0.0) - S.dot(dF.col(c));
       du(i, c) = du_ic;
-      const double du_D = du_ic / D;
+      const double du_D = du_ic * inverse_D;
       for (int r = 0; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
       dF.col(c) += IAS * du_D;                                       // lines 17–18
     }
@@ -217,12 +217,12 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   for (int i = 1; i <= N; ++i) {  // lines 28–29 for the differences
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
-    const double D = ws.D[at(i)];
+    const double inverse_D = 1.0 / ws.D[at(i)];
     const int ki = task.activeColumns(i);
     for (Eigen::Index c = 0; c < k; ++c) {
       double constraint = 0.0;
       for (int r = 0; r < ki; ++r) constraint += ws.SA(r, i) * dnu(r, c);
-      const double dq = (du(i, c) - IAS.dot(da.col(c)) + constraint) / D;
+      const double dq = (du(i, c) - IAS.dot(da.col(c)) + constraint) * inverse_D;
       dqdd(i - 1, c) = dq;
       da.col(c) += S * dq;
     }

@@ -255,13 +255,18 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   }
 
   // ---- The motion at μ*: the τ-dependent terms are linear in μ, so the last
-  // outward sweep runs once more with u(μ*) and ν(μ*) (lines 26–30).
-  Eigen::Map<Eigen::VectorXd> u(ws.u.data(), n + 1);
-  u = fs.u0.head(n + 1);
-  u.noalias() -= fs.du.topLeftCorner(n + 1, k) * mu;
-  ws.nu.head(m) = fs.nu0.head(m);
-  ws.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
-  outwardAccelerations(model, task, ws, out.qdd);
+  // outward sweep runs once more with u(μ*) and ν(μ*) (lines 26–30). With
+  // nothing stuck, μ* is empty and the μ = 0 sweep already gave it.
+  if (k > 0) {
+    Eigen::Map<Eigen::VectorXd> u(ws.u.data(), n + 1);
+    u = fs.u0.head(n + 1);
+    u.noalias() -= fs.du.topLeftCorner(n + 1, k) * mu;
+    ws.nu.head(m) = fs.nu0.head(m);
+    ws.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
+    outwardAccelerations(model, task, ws, out.qdd);
+  } else {
+    out.qdd = fs.qdd0;
+  }
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(m), out.tau_constraint);
   out.tau_control = tau + out.tau_constraint;

@@ -160,28 +160,32 @@ bool certifiedSolveFixed(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen
                          Eigen::Ref<Eigen::VectorXd> nu, Eigen::Ref<Eigen::MatrixXd> factor, double threshold,
                          double& kappa) {
   using MatM = Eigen::Matrix<double, M, M>;
+  // Divisions are slow and sit on the substitutions' dependency chains: each
+  // pivot is inverted once and the rest multiply.
   MatM C = MatM::Zero();  // 𝓛 = C Cᵀ
-  double norm2 = 0.0;     // ‖𝓛‖_F²
+  Eigen::Matrix<double, M, 1> inverse_pivot;
+  double norm2 = 0.0;  // ‖𝓛‖_F²
   for (int j = 0; j < M; ++j) {
     double d = L(j, j);
     norm2 += d * d;
     for (int k = 0; k < j; ++k) d -= C(j, k) * C(j, k);
     if (!(d > 0.0)) return false;
     C(j, j) = std::sqrt(d);
+    inverse_pivot[j] = 1.0 / C(j, j);
     for (int i = j + 1; i < M; ++i) {
       double x = L(i, j);
       norm2 += 2.0 * x * x;
       for (int k = 0; k < j; ++k) x -= C(i, k) * C(j, k);
-      C(i, j) = x / C(j, j);
+      C(i, j) = x * inverse_pivot[j];
     }
   }
   MatM W = MatM::Zero();  // C⁻¹, lower
   for (int j = 0; j < M; ++j) {
-    W(j, j) = 1.0 / C(j, j);
+    W(j, j) = inverse_pivot[j];
     for (int i = j + 1; i < M; ++i) {
       double x = 0.0;
       for (int k = j; k < i; ++k) x += C(i, k) * W(k, j);
-      W(i, j) = -x / C(i, i);
+      W(i, j) = -x * inverse_pivot[i];
     }
   }
   const MatM inverse = W.transpose() * W;  // 𝓛⁻¹, for κ_F only
@@ -193,11 +197,11 @@ bool certifiedSolveFixed(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen
   Eigen::Matrix<double, M, 1> x = r;
   for (int i = 0; i < M; ++i) {
     for (int k = 0; k < i; ++k) x[i] -= C(i, k) * x[k];
-    x[i] /= C(i, i);
+    x[i] *= inverse_pivot[i];
   }
   for (int i = M - 1; i >= 0; --i) {
     for (int k = i + 1; k < M; ++k) x[i] -= C(k, i) * x[k];
-    x[i] /= C(i, i);
+    x[i] *= inverse_pivot[i];
   }
   nu = x;
   return true;

@@ -114,29 +114,31 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     pA.noalias() += IA * c;                    // F^A + I^A Ẍ_bias
     const double u = tau[i - 1] - S.dot(pA);   // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
     ws.u[at(i)] = u;
-    const double u_D = u / D;
+    const double inverse_D = 1.0 / D;  // one division per body; the rest multiply
+    const double u_D = u * inverse_D;
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
 
     // Lines 19–21, one constraint column at a time.
     const int k = task.activeColumns(i);
     double* sA = ws.SA.col(i).data();
-    const double SS_D = S.squaredNorm() / D;
+    const double SS_D = S.squaredNorm() * inverse_D;
     for (int col = 0; col < k; ++col) {
       sA[col] = S.dot(A.col(col));                          // (Sᵀ A_i)ᵀ
       ws.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
     }
     for (int col = 0; col < k; ++col) {
-      const double sA_D = sA[col] / D;
-      ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;               // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
-      for (int r = col; r < k; ++r) ws.L(r, col) += sA[r] * sA_D;  // line 21 (sign: see top), lower triangle
-      A.col(col) -= IAS * sA_D;                                      // line 19: A_{i−1} = P^A A_i …
+      const double sA_D = sA[col] * inverse_D;
+      ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
+      double* L_col = &ws.L(0, col);                     // line 21 (sign: see top), lower triangle
+      for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
+      A.col(col) -= IAS * sA_D;  // line 19: A_{i−1} = P^A A_i …
     }
     const int kp = task.activeColumns(i - 1);  // … then body i−1's own columns
     A.middleCols(k, kp - k) = ws.A_body.middleCols(k, kp - k);
 
     if (i > 1) {
       Mat6& IA_parent = ws.IA[at(i - 1)];  // line 16: I^A_{i−1} = I_{i−1} + I^a_i, I^a = I^A − I^A S D⁻¹ Sᵀ I^A
-      const Vec6 IAS_D = IAS / D;
+      const Vec6 IAS_D = IAS * inverse_D;
       IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
       ws.I[at(i - 1)].addTo(IA_parent);
       ws.FA[at(i - 1)] = ws.Fbias[at(i - 1)] + pA + IAS * u_D;  // lines 17–18: F^A_{i−1} = F_bias + F^a_i

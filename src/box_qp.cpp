@@ -33,7 +33,7 @@ double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   // variable's gradient, a bounded one's gradient pointing into its room.
   double r = 0.0;
   for (Index j = 0; j < x.size(); ++j) {
-    const double g = P.row(j).dot(x) - c[j];
+    const double g = P.col(j).dot(x) - c[j];  // P symmetric: its contiguous column
     const double violation = lo[j] == hi[j] ? 0.0 : x[j] <= lo[j] ? -g : x[j] >= hi[j] ? g : std::abs(g);
     r = std::max(r, violation);
   }
@@ -129,13 +129,17 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
   QpReport report;
   const Index q = N.cols(), k = N.rows();
   Index rows = 0;
+  const double* n_data = N.data();  // N_j is strided: gathered element by element
+  const Index n_stride = N.outerStride();
   for (Index j = 0; j < k; ++j) {
     if (std::isfinite(hi[j])) {
-      s.Ct.col(rows).head(q) = N.row(j).transpose();
+      double* row_r = s.Ct.col(rows).data();
+      for (Index c = 0; c < q; ++c) row_r[c] = n_data[j + c * n_stride];
       s.d[rows++] = hi[j] - x0[j];
     }
     if (std::isfinite(lo[j])) {
-      s.Ct.col(rows).head(q) = -N.row(j).transpose();
+      double* row_r = s.Ct.col(rows).data();
+      for (Index c = 0; c < q; ++c) row_r[c] = -n_data[j + c * n_stride];
       s.d[rows++] = x0[j] - lo[j];
     }
   }

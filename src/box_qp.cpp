@@ -232,4 +232,96 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
   return report;
 }
 
+bool leastDistanceOnHyperplane(const Eigen::Ref<const Eigen::VectorXd>& v, double b,
+                               const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::VectorXd>& lo,
+                               const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> mu, QpScratch& s) {
+  // f(λ) = vᵀ clamp(t + λ v) − b is continuous and nondecreasing (term i
+  // grows with slope v_i² while t_i + λ v_i is inside [lo_i, hi_i], else it
+  // is flat). From λ = 0 walk the breakpoints towards the root.
+  const Index n = v.size();
+  const auto clampAt = [&](Index i, double lambda) { return std::min(hi[i], std::max(lo[i], t[i] + lambda * v[i])); };
+  double f = -b;
+  for (Index i = 0; i < n; ++i) f += v[i] * clampAt(i, 0.0);
+  const double scale = 1.0 + std::abs(b) + t.cwiseAbs().maxCoeff();
+  double lambda = 0.0;
+  if (std::abs(f) > 1e-15 * scale) {
+    // Walk up (f < 0) or down (f > 0): in the walking direction σ, term i
+    // moves by σ v_i per unit of |λ|; it is free where lo_i < value < hi_i.
+    const double sigma = f < 0.0 ? 1.0 : -1.0;
+    double slope = 0.0;  // σ d f / d|λ|: Σ v_i² over the free terms just past 0
+    Index free_terms = 0;  // (zero slope exactly when none is free)
+    Index breaks = 0;
+    auto at = s.d;          // 2n breakpoint distances |λ|
+    auto kind = s.active;   // 2i + (1 when term i becomes free there, 0 when it stops)
+    for (Index i = 0; i < n; ++i) {
+      const double rate = sigma * v[i];  // how the unclamped value moves per unit |λ|
+      if (rate == 0.0) continue;
+      const double value = t[i];
+      // Free just past 0: not already at (or beyond) the bound it moves towards.
+      const bool below = value < lo[i], above = value > hi[i];
+      const bool free_now = rate > 0.0 ? (!below && value < hi[i]) : (!above && value > lo[i]);
+      if (free_now) {
+        slope += v[i] * v[i];
+        ++free_terms;
+      }
+      // Where it enters: the near bound it comes from (only if outside now).
+      if (rate > 0.0 && below) {
+        at[breaks] = (lo[i] - value) / rate;
+        kind[breaks++] = static_cast<int>(2 * i + 1);
+      }
+      if (rate < 0.0 && above) {
+        at[breaks] = (hi[i] - value) / rate;
+        kind[breaks++] = static_cast<int>(2 * i + 1);
+      }
+      // Where it leaves: the far bound it moves towards.
+      const double far = rate > 0.0 ? hi[i] : lo[i];
+      if (std::isfinite(far) && (rate > 0.0 ? value < far : value > far)) {
+        at[breaks] = (far - value) / rate;
+        kind[breaks++] = static_cast<int>(2 * i);
+      }
+    }
+    // Sort the breakpoints by distance (insertion sort on the pairs: n is a
+    // handful of joints, and it allocates nothing).
+    for (Index a = 1; a < breaks; ++a) {
+      const double key = at[a];
+      const int key_kind = kind[a];
+      Index c = a - 1;
+      while (c >= 0 && at[c] > key) {
+        at[c + 1] = at[c];
+        kind[c + 1] = kind[c];
+        --c;
+      }
+      at[c + 1] = key;
+      kind[c + 1] = key_kind;
+    }
+    const double target = std::abs(f);  // distance to cover, in units of f
+    double covered = 0.0, position = 0.0;
+    bool found = false;
+    for (Index a = 0; a <= breaks && !found; ++a) {
+      const double next = a < breaks ? at[a] : std::numeric_limits<double>::infinity();
+      if (slope > 0.0 && covered + slope * (next - position) >= target) {
+        position += (target - covered) / slope;
+        found = true;
+        break;
+      }
+      if (a == breaks) break;
+      covered += slope * (next - position);
+      position = next;
+      const Index i = kind[a] / 2;
+      const bool enters = kind[a] % 2 == 1;
+      slope += (enters ? 1.0 : -1.0) * v[i] * v[i];
+      free_terms += enters ? 1 : -1;
+      if (free_terms == 0 || slope < 0.0) slope = 0.0;  // rounding of the running sum
+    }
+    lambda = sigma * position;
+    if (!found) {  // the slice only touches the box (at the last breakpoint): accept up to rounding
+      double residual = -b;
+      for (Index i = 0; i < n; ++i) residual += v[i] * clampAt(i, lambda);
+      if (!(std::abs(residual) <= 1e-12 * scale)) return false;
+    }
+  }
+  for (Index i = 0; i < n; ++i) mu[i] = clampAt(i, lambda);
+  return true;
+}
+
 }  // namespace zwang::internal

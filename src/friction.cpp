@@ -213,34 +213,54 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
         lo[a] = fs.lo[fs.sub_index[a]];
         hi[a] = fs.hi[fs.sub_index[a]];
       }
-      auto z = fs.z.head(nullity);
-      auto a_target = fs.za.head(nullity);
-      // (a) the smallest maximiser, as a reference point inside the set;
-      z.setZero();
-      a_target.noalias() = N.transpose() * x;
-      a_target *= -1.0;
-      leastDistanceQp(N, a_target, x, lo, hi, z, fs.qp, options.max_iterations);
+      // Both choices below are least-distance problems on the set of
+      // maximisers x + N z inside a box. With one curvature direction v
+      // (ns − nullity = 1: a 7-joint arm holding a 6-D pose, say) that set is
+      // the hyperplane vᵀμ = vᵀx, and the dual is one scalar equation.
+      const bool hyperplane = ns - nullity == 1;
+      auto v = fs.v.head(ns);
+      double plane = 0.0;
+      if (hyperplane) {  // v ⟂ N: (1 − N Nᵀ) e_p for the row p of N with the least weight
+        Eigen::Index p = 0;
+        for (Eigen::Index a = 1; a < ns; ++a)
+          if (N.row(a).squaredNorm() < N.row(p).squaredNorm()) p = a;
+        v.noalias() = -N * N.row(p).transpose();
+        v[p] += 1.0;
+        v.normalize();
+        plane = v.dot(x);
+      }
       auto x_ref = fs.mu_alt.head(ns);
+      auto t = fs.h.head(ns);
+      // x_ref ← the point of the set closest to t, inside [lo, hi] (which
+      // holds x_ref on entry).
+      const auto moveClosestTo = [&] {
+        if (hyperplane && leastDistanceOnHyperplane(v, plane, t, lo, hi, x_ref, fs.qp)) return;
+        auto z = fs.z.head(nullity);
+        auto a_target = fs.za.head(nullity);
+        z.setZero();
+        a_target.noalias() = N.transpose() * t;  // Nᵀ(t − x_ref), without a temporary
+        a_target.noalias() -= N.transpose() * x_ref;
+        leastDistanceQp(N, a_target, x_ref, lo, hi, z, fs.qp, options.max_iterations);
+        x_ref.noalias() += N * z;
+      };
+      // (a) the smallest maximiser, as a reference point inside the set;
       x_ref = x;
-      x_ref.noalias() += N * z;
+      t.setZero();
+      moveClosestTo();
       // (b) on the set, τ_control restricted to Σ is h + μ (H q̈* + C is fixed):
       //     minimise ‖h + μ‖² within the margin box.
       ws.nu.head(m) = fs.nu0.head(m);
       ws.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
       constraintTorques(model, task, ws, ws.nu.head(m), fs.tau_total);
-      auto target = fs.h.head(ns);  // becomes −h − x_ref
       for (Eigen::Index a = 0; a < ns; ++a) {
-        const Eigen::Index t = fs.sub_index[a];
-        const int j = fr.stuck[static_cast<std::size_t>(t)];
-        target[a] = -(tau[j] + fs.tau_total[j] - mu[t]) - x_ref[a];
+        const Eigen::Index ta = fs.sub_index[a];
+        const int j = fr.stuck[static_cast<std::size_t>(ta)];
+        t[a] = -(tau[j] + fs.tau_total[j] - mu[ta]);  // −h
         const double f_margin = options.margin * fs.f[j];
         if (std::isfinite(lo[a])) lo[a] = std::max(lo[a], std::min(-f_margin, x_ref[a]));  // a limit stop
         if (std::isfinite(hi[a])) hi[a] = std::min(hi[a], std::max(f_margin, x_ref[a]));   // carries any load
       }
-      z.setZero();
-      a_target.noalias() = N.transpose() * target;
-      leastDistanceQp(N, a_target, x_ref, lo, hi, z, fs.qp, options.max_iterations);
-      x_ref.noalias() += N * z;
+      moveClosestTo();
       // Indeterminate: the maximisers form more than a point.
       const double mu_scale = 1e-9 * (1.0 + fs.f.cwiseAbs().maxCoeff());
       for (Eigen::Index a = 0; a < ns; ++a) {

@@ -27,6 +27,8 @@ using zwang::internal::boxQpActiveSet;
 using zwang::internal::boxQpKktResidual;
 using zwang::internal::boxQpProjectedGradient;
 using zwang::internal::GrowingCholesky;
+using zwang::internal::leastDistanceOnHyperplane;
+using zwang::internal::leastDistanceQp;
 using zwang::internal::nearNullSpace;
 using zwang::internal::QpReport;
 using zwang::internal::QpScratch;
@@ -926,4 +928,156 @@ TEST_CASE("boxQpActiveSet: a large but finite minimiser on an infinite bound is 
       boxQpActiveSet(1e4 * P, c_y, lo_y, hi_y, z, scratch, kMaxIterations, 1e-12 * (1.0 + 1e15));
   CHECK(scaled_report.converged);
   CHECK(z[0] == Approx(1e11).epsilon(1e-12));
+}
+
+// ---------------------------------------------------------------------------
+// 4. The least-distance problems that pick among several friction maximisers:
+//   min ½‖μ − t‖²  s.t.  Aᵀμ = b (A n × r, orthonormal columns),  lo ≤ μ ≤ hi,
+// with a feasible point x (b = Aᵀx). leastDistanceQp works in μ = x + N z
+// (N the orthonormal complement of A); leastDistanceOnHyperplane (r = 1) in
+// the dual. Reference: every pattern of lower / upper / free (3^n, n ≤ 6),
+// each an equality-constrained least-squares problem solved by a complete
+// orthogonal decomposition; the lowest feasible one is the minimiser.
+
+namespace {
+
+struct SliceProblem {
+  MatrixXd A;  // n × r, orthonormal columns
+  VectorXd t, lo, hi, x;
+  double objective(const VectorXd& mu) const { return 0.5 * (mu - t).squaredNorm(); }
+};
+
+// Smallest objective over the feasible patterns (+∞ if none).
+double bruteForceSlice(const SliceProblem& p, VectorXd& best) {
+  const auto n = static_cast<int>(p.t.size());
+  int patterns = 1;
+  for (int i = 0; i < n; ++i) patterns *= 3;
+  const VectorXd b = p.A.transpose() * p.x;
+  double best_value = kInf;
+  for (int code = 0; code < patterns; ++code) {
+    VectorXd mu(n);
+    std::vector<int> free_set;
+    bool finite = true;
+    for (int i = 0, c = code; i < n; ++i, c /= 3) {
+      if (c % 3 == 0) mu[i] = p.lo[i];
+      else if (c % 3 == 1) mu[i] = p.hi[i];
+      else free_set.push_back(i);
+      if (c % 3 != 2 && !std::isfinite(mu[i])) finite = false;
+    }
+    if (!finite) continue;
+    // Free part: μ_F = t_F + A_F λ with A_Fᵀ μ_F = b − A_Bᵀ μ_B.
+    const auto nf = static_cast<Eigen::Index>(free_set.size());
+    VectorXd rhs = b;
+    for (int i = 0; i < n; ++i)
+      if (std::find(free_set.begin(), free_set.end(), i) == free_set.end()) rhs -= p.A.row(i).transpose() * mu[i];
+    MatrixXd AF(nf, p.A.cols());
+    VectorXd tF(nf);
+    for (Eigen::Index a = 0; a < nf; ++a) {
+      AF.row(a) = p.A.row(free_set[static_cast<std::size_t>(a)]);
+      tF[a] = p.t[free_set[static_cast<std::size_t>(a)]];
+    }
+    const MatrixXd G = AF.transpose() * AF;
+    const VectorXd lambda = G.completeOrthogonalDecomposition().solve(rhs - AF.transpose() * tF);
+    for (Eigen::Index a = 0; a < nf; ++a) mu[free_set[static_cast<std::size_t>(a)]] = tF[a] + AF.row(a).dot(lambda);
+    const double scale = 1.0 + p.x.lpNorm<Eigen::Infinity>() + p.t.lpNorm<Eigen::Infinity>();
+    if ((p.A.transpose() * mu - b).lpNorm<Eigen::Infinity>() > 1e-9 * scale) continue;  // pattern infeasible
+    bool inside = true;
+    for (int i = 0; i < n; ++i) inside = inside && mu[i] >= p.lo[i] - 1e-12 * scale && mu[i] <= p.hi[i] + 1e-12 * scale;
+    if (!inside) continue;
+    if (p.objective(mu) < best_value) {
+      best_value = p.objective(mu);
+      best = mu;
+    }
+  }
+  return best_value;
+}
+
+SliceProblem randomSlice(Rng& rng, int n, int r) {
+  SliceProblem p;
+  p.A = randomOrthogonal(rng, n).leftCols(r);
+  if (uniform(rng, 0, 1) < 0.25)  // a sparse normal: some joints off the hyperplane's constraint
+    for (int i = 0; i < n; ++i)
+      if (uniform(rng, 0, 1) < 0.3) p.A.row(i).setZero();
+  if (p.A.norm() == 0.0) p.A(0, 0) = 1.0;
+  Eigen::HouseholderQR<MatrixXd> qr(p.A);  // re-orthonormalise
+  p.A = MatrixXd(qr.householderQ()).leftCols(r);
+  p.t = gaussian(rng, n, 1) * uniform(rng, 0.1, 4.0);
+  p.lo.resize(n);
+  p.hi.resize(n);
+  p.x.resize(n);
+  for (int i = 0; i < n; ++i) {
+    p.lo[i] = -uniform(rng, 0.0, 2.0);
+    p.hi[i] = uniform(rng, 0.0, 2.0);
+    const double u = uniform(rng, 0, 1);
+    if (u < 0.1) p.lo[i] = p.hi[i] = 0.0;  // a point box
+    else if (u < 0.2) p.lo[i] = -kInf;      // a limit stop
+    else if (u < 0.3) p.hi[i] = kInf;
+    p.x[i] = uniform(rng, std::max(p.lo[i], -3.0), std::min(p.hi[i], 3.0));
+    if (uniform(rng, 0, 1) < 0.2) p.x[i] = uniform(rng, 0, 1) < 0.5 && std::isfinite(p.lo[i]) ? p.lo[i] : std::isfinite(p.hi[i]) ? p.hi[i] : p.x[i];
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("least-distance problems on a slice of the box: primal and dual against brute force", "[box_qp][least_distance]") {
+  Rng rng(0x736c'6963'6521'0001ULL);
+  double worst_primal = 0.0, worst_dual = 0.0, worst_plane = 0.0, worst_agreement = 0.0;
+  int draws = 0;
+  for (int draw = 0; draw < 1500; ++draw) {
+    const int n = uniformInt(rng, 1, 6);
+    const int r = draw % 3 == 0 && n > 1 ? uniformInt(rng, 2, n) : 1;
+    const SliceProblem p = randomSlice(rng, n, r);
+    VectorXd reference(n);
+    const double best = bruteForceSlice(p, reference);
+    CAPTURE(draw, n, r, p.A, p.t.transpose(), p.lo.transpose(), p.hi.transpose(), p.x.transpose());
+    REQUIRE(std::isfinite(best));  // x itself is feasible
+    const double scale = 1.0 + p.x.lpNorm<Eigen::Infinity>() + p.t.lpNorm<Eigen::Infinity>();
+    const double tol = 1e-10 * scale * scale;
+    ++draws;
+
+    // Primal: the orthonormal complement N of A, z from 0.
+    QpScratch scratch(n);
+    VectorXd primal = p.x;
+    if (r < n) {
+      Eigen::HouseholderQR<MatrixXd> qr(p.A);
+      const MatrixXd N = MatrixXd(qr.householderQ()).rightCols(n - r);
+      VectorXd z = VectorXd::Zero(n - r);
+      const VectorXd a = N.transpose() * (p.t - p.x);
+      const QpReport report = leastDistanceQp(N, a, p.x, p.lo, p.hi, z, scratch, 1000);
+      CAPTURE(report.iterations, z.transpose());
+      REQUIRE(report.converged);
+      primal = p.x + N * z;
+    }
+    CAPTURE(primal.transpose(), reference.transpose(), best);
+    for (int i = 0; i < n; ++i) {
+      REQUIRE(primal[i] >= p.lo[i] - 1e-12 * scale);
+      REQUIRE(primal[i] <= p.hi[i] + 1e-12 * scale);
+    }
+    REQUIRE(p.objective(primal) <= best + tol);
+    worst_primal = std::max(worst_primal, (p.objective(primal) - best) / (scale * scale));
+
+    if (r != 1) continue;
+    // Dual, on the hyperplane vᵀμ = b.
+    VectorXd dual = VectorXd::Constant(n, std::nan(""));
+    const VectorXd v = p.A.col(0);
+    REQUIRE(leastDistanceOnHyperplane(v, v.dot(p.x), p.t, p.lo, p.hi, dual, scratch));
+    CAPTURE(dual.transpose());
+    for (int i = 0; i < n; ++i) {  // inside the box exactly (a clamp)
+      REQUIRE(dual[i] >= p.lo[i]);
+      REQUIRE(dual[i] <= p.hi[i]);
+    }
+    const double plane = std::abs(v.dot(dual) - v.dot(p.x)) / scale;
+    REQUIRE(plane <= 1e-13);
+    REQUIRE(p.objective(dual) <= best + tol);
+    worst_dual = std::max(worst_dual, (p.objective(dual) - best) / (scale * scale));
+    worst_plane = std::max(worst_plane, plane);
+    // The minimiser is unique (strictly convex): primal and dual agree.
+    const double agreement = (dual - primal).lpNorm<Eigen::Infinity>() / scale;
+    REQUIRE(agreement <= 1e-8);
+    worst_agreement = std::max(worst_agreement, agreement);
+  }
+  std::printf("least distance on a slice, %d draws (n ≤ 6, r = 1 and 2..n): objective above brute force / scale²: "
+              "primal %.3g, dual %.3g (limit 1e-10); dual |vᵀμ − b|/scale %.3g; |dual − primal|/scale %.3g\n",
+              draws, worst_primal, worst_dual, worst_plane, worst_agreement);
 }

@@ -73,4 +73,15 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
                          const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> z, QpScratch& s,
                          int max_iterations);
 
+// The same kind of problem when the set is a hyperplane in the box:
+//   min ½‖μ − t‖²  s.t.  vᵀμ = b,  lo ≤ μ ≤ hi   (v a unit vector, t finite),
+// with a feasible point known to exist. Its dual is one monotone piecewise-
+// linear equation in the multiplier λ, vᵀ clamp(t + λ v) = b, solved exactly
+// by walking its breakpoints in order: O(n log n), against the primal active
+// set's n − 1 unknowns and 2n rows. Writes μ = clamp(t + λ v); false (μ
+// untouched) if no root is found, i.e. the hyperplane misses the box.
+bool leastDistanceOnHyperplane(const Eigen::Ref<const Eigen::VectorXd>& v, double b,
+                               const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::VectorXd>& lo,
+                               const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> mu, QpScratch& s);
+
 }  // namespace zwang::internal

@@ -10,7 +10,7 @@ namespace zwang::internal {
 struct FrictionScratch {
   FrictionScratch(int dof, int bodies, int capacity)
       : f(dof), fc(dof), b(dof), tau_eff(dof), qdd0(dof), lo(dof), hi(dof), lo_margin(dof), hi_margin(dof),
-        c(dof), qdd_star(dof), mu(dof), mu_alt(dof), h(dof), z(dof), za(dof), tau_total(dof), sub_mu(dof),
+        c(dof), qdd_star(dof), v(dof), mu(dof), mu_alt(dof), h(dof), z(dof), za(dof), tau_total(dof), sub_mu(dof),
         sub_lo(dof), sub_hi(dof), sub_index(dof), perm(dof), u0(bodies),
         nu0(capacity), dU(capacity, dof), rhs(capacity), du(bodies, dof), dnu(capacity, dof), dqdd(dof, dof), dF(6, dof),
         da(6, dof), P(dof, dof),
@@ -22,6 +22,7 @@ struct FrictionScratch {
   Eigen::VectorXd lo_margin, hi_margin;
   Eigen::VectorXd c;                // q̈_Θ(0)
   Eigen::VectorXd qdd_star;         // q̈*_Θ at the maximiser
+  Eigen::VectorXd v;                // the one curvature direction of K_ΣΣ (when its rank is 1)
   Eigen::VectorXd mu, mu_alt, h, z, za, tau_total;
   Eigen::VectorXd sub_mu, sub_lo, sub_hi;  // restricted to the sticking joints
   Eigen::VectorXi sub_index;               // positions in Θ₀ of the sticking joints

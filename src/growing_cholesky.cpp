@@ -5,7 +5,7 @@
 
 namespace zwang::internal {
 
-GrowingCholesky::GrowingCholesky(int capacity) : L_(capacity, capacity), index_(capacity), w_(capacity) {}
+GrowingCholesky::GrowingCholesky(int capacity) : U_(capacity, capacity), index_(capacity), w_(capacity) {}
 
 int GrowingCholesky::positionOf(int j) const {
   for (int a = 0; a < size_; ++a)
@@ -13,62 +13,59 @@ int GrowingCholesky::positionOf(int j) const {
   return -1;
 }
 
+// L is kept as U = Lᵀ (upper, column-major), so that L's rows, which the
+// forward substitutions read, are contiguous columns of U.
+
 double GrowingCholesky::schurPivot(const Eigen::Ref<const Eigen::MatrixXd>& P, int j) {
   double s = P(j, j);
   for (int a = 0; a < size_; ++a) {  // w = L⁻¹ P_Fj, forward substitution
-    double x = P(index_[a], j);
-    for (int b = 0; b < a; ++b) x -= L_(a, b) * w_[b];
-    w_[a] = x / L_(a, a);
+    const double x = P(index_[a], j) - U_.col(a).head(a).dot(w_.head(a));
+    w_[a] = x / U_(a, a);
     s -= w_[a] * w_[a];
   }
   return s;
 }
 
 void GrowingCholesky::append(int j, double pivot) {
-  for (int b = 0; b < size_; ++b) L_(size_, b) = w_[b];
-  L_(size_, size_) = std::sqrt(pivot);
+  U_.col(size_).head(size_) = w_.head(size_);
+  U_(size_, size_) = std::sqrt(pivot);
   index_[size_++] = j;
 }
 
 void GrowingCholesky::nullDirection(Eigen::Ref<Eigen::VectorXd> d_F) const {
-  for (int a = size_ - 1; a >= 0; --a) {  // Lᵀ d = −w, backward substitution
-    double x = -w_[a];
-    for (int b = a + 1; b < size_; ++b) x -= L_(b, a) * d_F[b];
-    d_F[a] = x / L_(a, a);
+  d_F.head(size_) = -w_.head(size_);  // Lᵀ d = U d = −w, backward by columns
+  for (int a = size_ - 1; a >= 0; --a) {
+    d_F[a] /= U_(a, a);
+    d_F.head(a) -= d_F[a] * U_.col(a).head(a);
   }
 }
 
 void GrowingCholesky::remove(int position) {
-  // Drop the row; the rows below then stick out one column to the right of
-  // the diagonal, which one Givens rotation per row folds back in.
+  // Drop L's row (U's column); the rows below then stick out one column to
+  // the right of the diagonal, which one Givens rotation per row folds back.
   for (int r = position; r + 1 < size_; ++r) {
-    for (int b = 0; b <= r + 1; ++b) L_(r, b) = L_(r + 1, b);
+    U_.col(r).head(r + 2) = U_.col(r + 1).head(r + 2);
     index_[r] = index_[r + 1];
   }
   --size_;
   for (int t = position; t < size_; ++t) {
-    const double a = L_(t, t), b = L_(t, t + 1);
+    const double a = U_(t, t), b = U_(t + 1, t);
     const double r = std::hypot(a, b);
     const double c = a / r, s = b / r;
-    for (int row = t; row < size_; ++row) {  // rotate columns t and t + 1
-      const double x = L_(row, t), y = L_(row, t + 1);
-      L_(row, t) = c * x + s * y;
-      L_(row, t + 1) = -s * x + c * y;
+    for (int column = t; column < size_; ++column) {  // rotate L's columns t and t + 1 (U's rows)
+      const double x = U_(t, column), y = U_(t + 1, column);
+      U_(t, column) = c * x + s * y;
+      U_(t + 1, column) = -s * x + c * y;
     }
-    L_(t, t + 1) = 0.0;
+    U_(t + 1, t) = 0.0;
   }
 }
 
 void GrowingCholesky::solveInPlace(Eigen::Ref<Eigen::VectorXd> x) const {
-  for (int a = 0; a < size_; ++a) {
-    double s = x[a];
-    for (int b = 0; b < a; ++b) s -= L_(a, b) * x[b];
-    x[a] = s / L_(a, a);
-  }
-  for (int a = size_ - 1; a >= 0; --a) {
-    double s = x[a];
-    for (int b = a + 1; b < size_; ++b) s -= L_(b, a) * x[b];
-    x[a] = s / L_(a, a);
+  for (int a = 0; a < size_; ++a) x[a] = (x[a] - U_.col(a).head(a).dot(x.head(a))) / U_(a, a);  // L y = x
+  for (int a = size_ - 1; a >= 0; --a) {  // U x = y, by columns
+    x[a] /= U_(a, a);
+    x.head(a) -= x[a] * U_.col(a).head(a);
   }
 }
 

@@ -35,7 +35,7 @@ class GrowingCholesky {
   void solveInPlace(Eigen::Ref<Eigen::VectorXd> x) const;
 
  private:
-  Eigen::MatrixXd L_;      // capacity², lower triangle of the top-left size_² block
+  Eigen::MatrixXd U_;      // capacity², Lᵀ: upper triangle of the top-left size_² block
   Eigen::VectorXi index_;  // F in factor order
   Eigen::VectorXd w_;      // L⁻¹ P_Fj of the last schurPivot
   int size_ = 0;

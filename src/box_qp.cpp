@@ -73,7 +73,25 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
     report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
     return report;
   }
-  const double step = 1.0 / L;
+  // Steps in the metric of P's diagonal (Jacobi preconditioning): the box
+  // stays a box, so the projection is still the clamp, and along a chain
+  // whose joints' inertias differ by orders of magnitude the scaled problem
+  // D^-1/2 P D^-1/2 is far better conditioned. A zero diagonal (a linear
+  // variable) gets a tiny one: it moves straight to its bound.
+  auto inverse_d = s.lambda.head(k);
+  const double d_floor = 1e-12 * P.diagonal().maxCoeff();
+  for (Index j = 0; j < k; ++j) inverse_d[j] = 1.0 / std::max(P(j, j), d_floor);
+  // L̃ ≥ λ_max(D^-1/2 P D^-1/2): Gershgorin of the scaled matrix, or its trace (≤ k).
+  auto root_inverse_d = s.p.head(k);  // (p is free until the iterations)
+  root_inverse_d = inverse_d.cwiseSqrt();
+  double scaled_gershgorin = 0.0;
+  for (Index j = 0; j < k; ++j)
+    scaled_gershgorin =
+        std::max(scaled_gershgorin, P.col(j).cwiseAbs().dot(root_inverse_d) * root_inverse_d[j]);
+  double scaled_trace = 0.0;  // (a diagonal that is rounding may come out negative)
+  for (Index j = 0; j < k; ++j) scaled_trace += std::max(0.0, P(j, j)) * inverse_d[j];
+  const double scaled_L = scaled_trace > 0.0 ? std::min(scaled_gershgorin, scaled_trace) : scaled_gershgorin;
+  const double step = 1.0 / scaled_L;
   double x_scale = 1.0;
   for (Index j = 0; j < k; ++j) {
     if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
@@ -88,7 +106,7 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
     s.g.head(k).noalias() = P * y;
     s.g.head(k) -= c;
-    x = y - step * s.g.head(k);
+    x = y - step * inverse_d.cwiseProduct(s.g.head(k));
     clamp(x);
     if (x.cwiseAbs().maxCoeff() > 1e12 * x_scale) {  // running off along an infinite bound
       report.unbounded = true;

@@ -49,8 +49,10 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
                         double curvature_scale = 0.0);
 
 // The same problem by accelerated projected gradient (FISTA with adaptive
-// restart), step 1/L with L ≥ λ_max(P) (Gershgorin or trace bound); a linear
-// problem (P = 0) goes to its vertex. Unbounded by the same rule as above.
+// restart) in the metric of P's diagonal D (Jacobi preconditioning: the box
+// stays a box), step 1/L̃ with L̃ ≥ λ_max(D^-1/2 P D^-1/2) (Gershgorin or
+// trace bound); a linear problem (P = 0) goes to its vertex. Unbounded by the
+// same rule as above.
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                                 Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,

@@ -56,6 +56,9 @@ constexpr double kDissipationTolerance = 1e-6;
 // scale, enters every acceleration, so K_ΘΘ and q̈* carry that much more rounding.
 constexpr double kSingularDissipationTolerance = 1e-5;
 constexpr double kAgreementTolerance = 1e-6;
+// The two maximisers' q̈* differ by that rounding too (ZWANG_STRESS_SEED=8: a
+// repeated row, 1.1e-6 apart, both KKT residuals below 1e-12).
+constexpr double kSingularAgreementTolerance = 1e-5;
 
 double logUniform(std::mt19937_64& rng, double lo, double hi) { return lo * std::pow(hi / lo, uniform01(rng)); }
 
@@ -349,8 +352,9 @@ void runStress() {
           qdd_active = qdd;
         } else if (fr.converged) {
           const double d = ratio(inf(Eigen::VectorXd(qdd - qdd_active)), inf(qdd_active) + scale);
-          CHECK(d <= kAgreementTolerance);
-          if (d > kAgreementTolerance) ++worst.disagreements;
+          const double agreement_tolerance = singular ? kSingularAgreementTolerance : kAgreementTolerance;
+          CHECK(d <= agreement_tolerance);
+          if (d > agreement_tolerance) ++worst.disagreements;
           worst.agreement = std::max(worst.agreement, d);
         }
       }
@@ -360,14 +364,15 @@ void runStress() {
       "numerical stress: %d draws on %d chains (%d solves): %d singular tasks, %d regular constrained, %d degenerate\n"
       "  worst relative residuals, regular tasks: closure %.1e (tol %.0e), constraint %.1e (tol %.0e),"
       " tau_c vs G^T nu %.1e (tol %.0e); singular tasks: closure or tau_c %.1e\n"
-      "  friction: max dissipation violation %.1e (tol %.0e, singular tasks %.0e), |mu| beyond f %.1e, active set vs gradient %.1e (tol %.0e)\n"
+      "  friction: max dissipation violation %.1e (tol %.0e, singular tasks %.0e), |mu| beyond f %.1e, active set vs gradient %.1e (tol %.0e, singular tasks %.0e)\n"
       "  maximiser iterations: active set max %d, projected gradient max %d (%d not converged at the cap);"
       " stuck joints stick %d, slip %d\n"
       "  draws per stuck-set size 0..7:",
       worst.draws, chains, worst.solves, worst.singular, worst.regular_constrained, worst.degenerate, worst.closure,
       kClosureTolerance, worst.constraint, kConstraintTolerance, worst.tau_c, kTauConstraintTolerance,
       worst.closure_singular, worst.dissipation,
-      kDissipationTolerance, kSingularDissipationTolerance, worst.feasibility, worst.agreement, kAgreementTolerance, worst.active_iterations_max,
+      kDissipationTolerance, kSingularDissipationTolerance, worst.feasibility, worst.agreement, kAgreementTolerance,
+      kSingularAgreementTolerance, worst.active_iterations_max,
       worst.gradient_iterations_max, worst.gradient_not_converged, worst.stick, worst.slip);
   for (int k = 0; k <= 7; ++k) std::printf(" %d", worst.stuck_hist[k]);
   std::printf("\n  beyond tolerance: %d solves of singular tasks miss closure or tau_c = G^T nu (asserted);"

@@ -17,6 +17,9 @@ QpScratch::QpScratch(int n)
       p(n),
       t1(n),
       t2(n),
+      Px(n),
+      Px_prev(n),
+      Py(n),
       Ct(n, 2 * n),
       d(2 * n),
       fixed(n),
@@ -26,17 +29,21 @@ QpScratch::QpScratch(int n)
       factor(n),
       row_factor(2 * n) {}
 
+namespace {
+// How far ∇φ_j = g violates optimality at x_j, in the units of ∇φ
+// (accelerations), whatever the units of x: a free variable's gradient, a
+// bounded one's gradient pointing into its room.
+double kktViolation(double g, double x, double lo, double hi) {
+  return lo == hi ? 0.0 : x <= lo ? -g : x >= hi ? g : std::abs(g);
+}
+}  // namespace
+
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         const Eigen::Ref<const Eigen::VectorXd>& x) {
-  // In the units of ∇φ (accelerations), whatever the units of x: a free
-  // variable's gradient, a bounded one's gradient pointing into its room.
   double r = 0.0;
-  for (Index j = 0; j < x.size(); ++j) {
-    const double g = P.col(j).dot(x) - c[j];  // P symmetric: its contiguous column
-    const double violation = lo[j] == hi[j] ? 0.0 : x[j] <= lo[j] ? -g : x[j] >= hi[j] ? g : std::abs(g);
-    r = std::max(r, violation);
-  }
+  for (Index j = 0; j < x.size(); ++j)  // P symmetric: its contiguous column
+    r = std::max(r, kktViolation(P.col(j).dot(x) - c[j], x[j], lo[j], hi[j]));
   return r;
 }
 
@@ -100,12 +107,22 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
   x_scale = std::max(x_scale, c.cwiseAbs().maxCoeff() / std::max(L, curvature_scale));
   auto y = s.t1.head(k);       // extrapolated point
   auto x_prev = s.t2.head(k);  // previous iterate
+  // One product with P per iteration: P x for the optimality test, and
+  // P y = (1 + β) P x − β P x_prev by linearity instead of a second product.
+  auto Px = s.Px.head(k), Px_prev = s.Px_prev.head(k), Py = s.Py.head(k);
   y = x;
   x_prev = x;
+  Px.noalias() = P * x;
+  Px_prev = Px;
+  Py = Px;
   double t = 1.0;
+  const auto kktAtX = [&] {
+    double r = 0.0;
+    for (Index j = 0; j < k; ++j) r = std::max(r, kktViolation(Px[j] - c[j], x[j], lo[j], hi[j]));
+    return r;
+  };
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
-    s.g.head(k).noalias() = P * y;
-    s.g.head(k) -= c;
+    s.g.head(k) = Py - c;
     x = y - step * inverse_d.cwiseProduct(s.g.head(k));
     clamp(x);
     if (x.cwiseAbs().maxCoeff() > 1e12 * x_scale) {  // running off along an infinite bound
@@ -116,7 +133,8 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
       report.unbounded_index = static_cast<int>(worst);
       break;
     }
-    if (boxQpKktResidual(P, c, lo, hi, x) <= tolerance) {
+    Px.noalias() = P * x;
+    if (kktAtX() <= tolerance) {
       report.converged = true;
       ++report.iterations;  // count this gradient step
       break;
@@ -127,11 +145,15 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
     if (s.g.head(k).dot(s.p.head(k)) > 0.0) {
       t = 1.0;
       y = x;
+      Py = Px;
     } else {
-      y = x + ((t - 1.0) / t_next) * s.p.head(k);
+      const double beta = (t - 1.0) / t_next;
+      y = x + beta * s.p.head(k);
+      Py = (1.0 + beta) * Px - beta * Px_prev;
       t = t_next;
     }
     x_prev = x;
+    Px_prev = Px;
   }
   report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
   return report;

@@ -11,6 +11,7 @@ namespace zwang::internal {
 struct QpScratch {
   explicit QpScratch(int n = 0);
   Eigen::VectorXd lambda, g, p, t1, t2;  // n
+  Eigen::VectorXd Px, Px_prev, Py;       // n, products with P (projected gradient)
   Eigen::MatrixXd Ct;                    // n × 2n, constraint rows as columns (least-distance QP)
   Eigen::VectorXd d;                     // 2n
   Eigen::VectorXi fixed;                 // n, 1 for a fixed variable (active set)

@@ -127,7 +127,6 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   if (Status s = inwardSweep(model, task, fs.tau_eff, ws); !s) return s;
   balance(task, ws);
   outwardAccelerations(model, task, ws, fs.qdd0);
-  fs.u0.head(n + 1) = Eigen::Map<const Eigen::VectorXd>(ws.u.data(), n + 1);
   fs.nu0.head(m) = ws.nu.head(m);
   fr.dqdd_dmu.setZero();
   if (k > 0) {
@@ -140,19 +139,28 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   // ---- max g(μ) over Λ  ⇔  min ½ μᵀ K_ΘΘ μ − μᵀ q̈_Θ(0)
   auto P = fs.P.topLeftCorner(k, k);
   for (Eigen::Index a = 0; a < k; ++a) fs.c[a] = fs.qdd0[fr.stuck[static_cast<std::size_t>(a)]];
-  for (Eigen::Index b = 0; b < k; ++b)  // column by column (column-major storage)
-    for (Eigen::Index a = 0; a < k; ++a) P(a, b) = fs.dqdd(fr.stuck[static_cast<std::size_t>(a)], b);
-  for (Eigen::Index a = 0; a < k; ++a)  // symmetric in exact arithmetic (K is)
-    for (Eigen::Index b = 0; b < a; ++b) P(a, b) = P(b, a) = 0.5 * (P(a, b) + P(b, a));
+  {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers: k² of them)
+    const int* rows = fr.stuck.data();
+    const double* dqdd = fs.dqdd.data();
+    const Eigen::Index dqdd_stride = fs.dqdd.outerStride();
+    double* p = P.data();
+    const Eigen::Index p_stride = P.outerStride();
+    for (Eigen::Index b = 0; b < k; ++b)
+      for (Eigen::Index a = 0; a < k; ++a) p[a + b * p_stride] = dqdd[rows[a] + b * dqdd_stride];
+    for (Eigen::Index b = 0; b < k; ++b)  // symmetric in exact arithmetic (K is)
+      for (Eigen::Index a = b + 1; a < k; ++a)
+        p[a + b * p_stride] = p[b + a * p_stride] = 0.5 * (p[a + b * p_stride] + p[b + a * p_stride]);
+  }
   // The size of the terms K_ΘΘ is computed from (1/D_j, and the columns'
   // entries): where the task pins the stuck joints, K_ΘΘ is that times
   // rounding, and a stop the task pushes into must come out unbounded
   // rather than as a 1e16 N·m torque (the maximiser's reach rule).
   double curvature_scale = 0.0;
-  for (Eigen::Index a = 0; a < k; ++a) {
-    const int j = fr.stuck[static_cast<std::size_t>(a)];
-    curvature_scale = std::max({curvature_scale, 1.0 / ws.D[static_cast<std::size_t>(j + 1)],
-                                fr.dqdd_dmu.col(j).cwiseAbs().maxCoeff()});
+  if (k > 0) {
+    double min_D = kInf;
+    for (Eigen::Index a = 0; a < k; ++a)
+      min_D = std::min(min_D, ws.D[static_cast<std::size_t>(fr.stuck[static_cast<std::size_t>(a)] + 1)]);
+    curvature_scale = std::max(1.0 / min_D, fs.dqdd.leftCols(k).cwiseAbs().maxCoeff());
   }
   // The acceleration scale, of the stuck joints only (a light, fast joint
   // elsewhere in the chain must not set it): their accelerations q̈_Θ(0).
@@ -200,8 +208,12 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
       }
       width *= 2.0;
       auto Pss = fs.V.topLeftCorner(ns, ns);
-      for (Eigen::Index b = 0; b < ns; ++b)
-        for (Eigen::Index a = 0; a < ns; ++a) Pss(a, b) = P(fs.sub_index[a], fs.sub_index[b]);
+      const int* sub = fs.sub_index.data();
+      for (Eigen::Index b = 0; b < ns; ++b) {
+        const double* p_column = P.data() + sub[b] * P.outerStride();
+        double* pss_column = Pss.data() + b * Pss.outerStride();
+        for (Eigen::Index a = 0; a < ns; ++a) pss_column[a] = p_column[sub[a]];
+      }
       const double floor = width > 0.0 ? acc_tol / (static_cast<double>(ns) * width) : 0.0;
       nullity = nearNullSpace(Pss, floor, fs.null_basis.topLeftCorner(ns, ns), fs.perm.head(ns));
     }
@@ -274,18 +286,16 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
     }
   }
 
-  // ---- The motion at μ*: the τ-dependent terms are linear in μ, so the last
-  // outward sweep runs once more with u(μ*) and ν(μ*) (lines 26–30). With
-  // nothing stuck, μ* is empty and the μ = 0 sweep already gave it.
+  // ---- The motion at μ*: the sweeps are linear in the torques, so
+  // q̈(μ*) = q̈(0) + (∂q̈/∂τ_Θ)(−μ*) and ν(μ*) likewise (lines 26–30 by
+  // superposition), then Ẍ from q̈ (line 29). With nothing stuck, μ* is
+  // empty and the μ = 0 sweep already gave it.
+  out.qdd = fs.qdd0;
   if (k > 0) {
-    Eigen::Map<Eigen::VectorXd> u(ws.u.data(), n + 1);
-    u = fs.u0.head(n + 1);
-    u.noalias() -= fs.du.topLeftCorner(n + 1, k) * mu;
+    out.qdd.noalias() -= fs.dqdd.leftCols(k) * mu;
     ws.nu.head(m) = fs.nu0.head(m);
     ws.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
-    outwardAccelerations(model, task, ws, out.qdd);
-  } else {
-    out.qdd = fs.qdd0;
+    bodyAccelerations(model, task, ws, out.qdd);
   }
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(m), out.tau_constraint);

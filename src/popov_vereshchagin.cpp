@@ -182,6 +182,12 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   }
 }
 
+void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd) {
+  ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  for (int i = 1; i <= model.dof(); ++i)
+    ws.a[at(i)] = ws.a[at(i - 1)] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];  // line 29
+}
+
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
                        Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
                        Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da) {

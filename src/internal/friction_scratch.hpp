@@ -11,7 +11,7 @@ struct FrictionScratch {
   FrictionScratch(int dof, int bodies, int capacity)
       : f(dof), fc(dof), b(dof), tau_eff(dof), qdd0(dof), lo(dof), hi(dof), lo_margin(dof), hi_margin(dof),
         c(dof), qdd_star(dof), v(dof), mu(dof), mu_alt(dof), h(dof), z(dof), za(dof), tau_total(dof), sub_mu(dof),
-        sub_lo(dof), sub_hi(dof), sub_index(dof), perm(dof), u0(bodies),
+        sub_lo(dof), sub_hi(dof), sub_index(dof), perm(dof),
         nu0(capacity), dU(capacity, dof), rhs(capacity), du(bodies, dof), dnu(capacity, dof), dqdd(dof, dof), dF(6, dof),
         da(6, dof), P(dof, dof),
         null_basis(dof, dof), V(dof, dof), qp(dof) {}
@@ -27,7 +27,6 @@ struct FrictionScratch {
   Eigen::VectorXd sub_mu, sub_lo, sub_hi;  // restricted to the sticking joints
   Eigen::VectorXi sub_index;               // positions in Θ₀ of the sticking joints
   Eigen::VectorXi perm;                    // pivot order (near null space)
-  Eigen::VectorXd u0;               // u_i of the μ = 0 pass
   Eigen::VectorXd nu0;              // ν of the μ = 0 pass (solver order)
   Eigen::MatrixXd dU;               // capacity × k: δU₀ per unit torque
   Eigen::VectorXd rhs;              // balance right-hand side

@@ -37,6 +37,9 @@ void balanceSolve(const Workspace& ws, int m, const VectorRef& r, Eigen::Ref<Eig
 // Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd);
 
+// Line 29 alone: Ẍ (into ws.a) from a known q̈.
+void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd);
+
 // k extra right-hand sides through the same sweeps, all at once: column c is
 // a unit torque at joint joints[c] (ascending), everything else zero. Gives
 // δu_i (du: bodies × k), δν (dnu: m × k, solver order) and δq̈ = ∂q̈/∂τ_joint

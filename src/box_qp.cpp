@@ -38,6 +38,18 @@ double kktViolation(double g, double x, double lo, double hi) {
 }
 }  // namespace
 
+double reachScale(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                  const Eigen::Ref<const Eigen::VectorXd>& c, double lambda_max_bound, double curvature_scale) {
+  double scale = 1.0;
+  for (Index j = 0; j < lo.size(); ++j) {
+    if (std::isfinite(lo[j])) scale = std::max(scale, std::abs(lo[j]));
+    if (std::isfinite(hi[j])) scale = std::max(scale, std::abs(hi[j]));
+  }
+  const double curvature = std::max(lambda_max_bound, curvature_scale);
+  if (curvature > 0.0 && c.size() > 0) scale = std::max(scale, c.cwiseAbs().maxCoeff() / curvature);
+  return scale;
+}
+
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         const Eigen::Ref<const Eigen::VectorXd>& x) {
@@ -99,12 +111,7 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
   for (Index j = 0; j < k; ++j) scaled_trace += std::max(0.0, P(j, j)) * inverse_d[j];
   const double scaled_L = scaled_trace > 0.0 ? std::min(scaled_gershgorin, scaled_trace) : scaled_gershgorin;
   const double step = 1.0 / scaled_L;
-  double x_scale = 1.0;
-  for (Index j = 0; j < k; ++j) {
-    if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
-    if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
-  }
-  x_scale = std::max(x_scale, c.cwiseAbs().maxCoeff() / std::max(L, curvature_scale));
+  const double x_scale = reachScale(lo, hi, c, L, curvature_scale);
   auto y = s.t1.head(k);       // extrapolated point
   auto x_prev = s.t2.head(k);  // previous iterate
   // One product with P per iteration: P x for the optimality test, and

@@ -72,14 +72,8 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   for (int j = 0; j < k; ++j) row_sums[j] = P.col(j).cwiseAbs().sum();
   const auto independent = [&](double pivot, int j) { return pivot > kDependent * P(j, j); };
   const auto clampTo = [&](int j, double v) { x[j] = std::min(hi[j], std::max(lo[j], v)); };
-  double x_scale = 1.0;
-  for (int j = 0; j < k; ++j) {
-    if (std::isfinite(lo[j])) x_scale = std::max(x_scale, std::abs(lo[j]));
-    if (std::isfinite(hi[j])) x_scale = std::max(x_scale, std::abs(hi[j]));
-  }
-  // L: the smaller of Gershgorin's bound and the trace, both ≥ λ_max(P).
-  const double L = std::max(std::min(row_sums.maxCoeff(), P.diagonal().sum()), curvature_scale);
-  if (L > 0.0) x_scale = std::max(x_scale, c.cwiseAbs().maxCoeff() / L);
+  // λ_max(P) ≤ the smaller of Gershgorin's bound and the trace.
+  const double x_scale = reachScale(lo, hi, c, std::min(row_sums.maxCoeff(), P.diagonal().sum()), curvature_scale);
   // After a step: has a free variable run off along an infinite bound?
   const auto runAway = [&] {
     for (int a = 0; a < F.size(); ++a)

@@ -84,18 +84,26 @@ bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::Matr
   return true;
 }
 
-// x ← (C Cᵀ)⁻¹ x, forward then backward substitution.
-void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::VectorXd> x) {
-  const Eigen::Index m = C.rows();
+// X ← (C Cᵀ)⁻¹ X, forward then backward substitution, row by row: the
+// columns share each row's reciprocal pivot, and their substitutions run
+// side by side instead of one chain of divisions per column.
+void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::MatrixXd> X) {
+  const Eigen::Index m = C.rows(), k = X.cols();
   for (Eigen::Index i = 0; i < m; ++i) {
-    double s = x[i];
-    for (Eigen::Index k = 0; k < i; ++k) s -= C(i, k) * x[k];
-    x[i] = s / C(i, i);
+    const double inverse = 1.0 / C(i, i);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      double s = X(i, c);
+      for (Eigen::Index l = 0; l < i; ++l) s -= C(i, l) * X(l, c);
+      X(i, c) = s * inverse;
+    }
   }
   for (Eigen::Index i = m - 1; i >= 0; --i) {
-    double s = x[i];
-    for (Eigen::Index k = i + 1; k < m; ++k) s -= C(k, i) * x[k];
-    x[i] = s / C(i, i);
+    const double inverse = 1.0 / C(i, i);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      double s = X(i, c);
+      for (Eigen::Index l = i + 1; l < m; ++l) s -= C(l, i) * X(l, c);
+      X(i, c) = s * inverse;
+    }
   }
 }
 
@@ -309,25 +317,8 @@ void balanceApplyColumns(const Eigen::Ref<const Eigen::MatrixXd>& factor, const 
     for (Eigen::Index c = 0; c < R.cols(); ++c) balanceApply(factor, lambda, true, damping, R.col(c), out.col(c));
     return;
   }
-  // X ← (C Cᵀ)⁻¹ R: forward, then backward substitution, row by row.
-  const Eigen::Index m = factor.rows(), k = R.cols();
   out = R;
-  for (Eigen::Index i = 0; i < m; ++i) {
-    const double inverse = 1.0 / factor(i, i);
-    for (Eigen::Index c = 0; c < k; ++c) {
-      double s = out(i, c);
-      for (Eigen::Index l = 0; l < i; ++l) s -= factor(i, l) * out(l, c);
-      out(i, c) = s * inverse;
-    }
-  }
-  for (Eigen::Index i = m - 1; i >= 0; --i) {
-    const double inverse = 1.0 / factor(i, i);
-    for (Eigen::Index c = 0; c < k; ++c) {
-      double s = out(i, c);
-      for (Eigen::Index l = i + 1; l < m; ++l) s -= factor(l, i) * out(l, c);
-      out(i, c) = s * inverse;
-    }
-  }
+  choleskySolveInPlace(factor, out);
 }
 
 }  // namespace zwang::internal

@@ -166,11 +166,6 @@ void balance(const Task& task, Workspace& ws) {
                                       task.balance, ws.balance_by_eigen);
 }
 
-void balanceSolve(const Workspace& ws, int m, const VectorRef& r, Eigen::Ref<Eigen::VectorXd> out) {
-  balanceApply(ws.balance_factor.topLeftCorner(m, m), ws.eigval.head(m), ws.balance_by_eigen,
-               ws.solution.coupling.damping, r, out);
-}
-
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
   ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
   for (int i = 1; i <= model.dof(); ++i) {

@@ -59,6 +59,11 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
                                 Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
                                 double curvature_scale = 0.0);
 
+// The scale of the reach rule above: max(1, largest finite |bound|,
+// ‖c‖∞ / max(lambda_max_bound, curvature_scale)).
+double reachScale(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                  const Eigen::Ref<const Eigen::VectorXd>& c, double lambda_max_bound, double curvature_scale);
+
 // The largest violation of the optimality conditions, in the units of ∇φ:
 // |∇φ_j| of a free variable, ∇φ_j pointing into the room of one on a bound
 // (x_j = lo_j needs ∇φ_j ≥ 0, x_j = hi_j needs ∇φ_j ≤ 0); zero exactly at a

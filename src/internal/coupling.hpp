@@ -27,9 +27,7 @@ void balanceApply(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::
                   bool by_eigen, double damping, const Eigen::Ref<const Eigen::VectorXd>& r,
                   Eigen::Ref<Eigen::VectorXd> out);
 
-// The same for the columns of R at once (out: m × k, not aliasing R). The
-// columns share each row's reciprocal pivot, and their substitutions run
-// side by side instead of one chain of divisions per column.
+// The same for the columns of R at once (out: m × k, not aliasing R).
 void balanceApplyColumns(const Eigen::Ref<const Eigen::MatrixXd>& factor, const Eigen::Ref<const Eigen::VectorXd>& lambda,
                          bool by_eigen, double damping, const Eigen::Ref<const Eigen::MatrixXd>& R,
                          Eigen::Ref<Eigen::MatrixXd> out);
@@ -38,8 +36,9 @@ void balanceApplyColumns(const Eigen::Ref<const Eigen::MatrixXd>& factor, const 
 // pivot is not positive. C may not alias A.
 bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::MatrixXd> C);
 
-// x ← (C Cᵀ)⁻¹ x with C from cholesky (its lower triangle is read).
-void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::VectorXd> x);
+// X ← (C Cᵀ)⁻¹ X, every column of X (a vector is one column), with C from
+// cholesky (its lower triangle is read).
+void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::MatrixXd> X);
 
 // cholesky, plus a certificate that every eigenvalue of A is above `floor`:
 // λ_min ≥ 1/trace(A⁻¹) = 1/‖C⁻¹‖_F² > floor. False when either fails (C then

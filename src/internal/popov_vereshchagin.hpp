@@ -26,13 +26,8 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws);
 
 // Line 25: ν = 𝓛⁻¹(b − A₀ᵀẌ₀ − U₀) into ws.nu (solver order), factoring 𝓛
-// (kept in ws.balance_factor for balanceSolve) and filling ws.solution.coupling.
+// (kept in ws.balance_factor for unitTorqueColumns) and filling ws.solution.coupling.
 void balance(const Task& task, Workspace& ws);
-
-// ν for another right-hand side r with the factorisation and damping of the
-// last balance() (𝓛⁻¹ r, or the damped Σ σ_k/(σ_k² + λ²)(e_kᵀ r) e_k when
-// singular). `out` and `r` have m rows and must not alias.
-void balanceSolve(const Workspace& ws, int m, const VectorRef& r, Eigen::Ref<Eigen::VectorXd> out);
 
 // Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd);
@@ -42,8 +37,8 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 
 // k extra right-hand sides through the same sweeps, all at once: column c is
 // a unit torque at joint joints[c] (ascending), everything else zero. Gives
-// δu_i (du: bodies × k), δν (dnu: m × k, solver order) and δq̈ = ∂q̈/∂τ_joint
-// (dqdd: n × k); dF, da (6 × k) and dU (m × k) are scratch. Needs inwardSweep
+// δν (dnu: m × k, solver order) and δq̈ = ∂q̈/∂τ_joint (dqdd: n × k); du
+// (bodies × k), dF, da (6 × k) and dU (m × k) are scratch. Needs inwardSweep
 // and balance first. O((N + m²)·k): the sensitivity K_Θ of the friction
 // extension, as matrix–row products over the k columns rather than k sweeps.
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,

@@ -22,16 +22,24 @@ enum class Expressed { Local, World, Aligned = World };
 
 using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// Options for the constraint balance ν = L⁻¹(…) (docs/solver.md, "Singular tasks").
-// With λ_max, λ_min the extreme eigenvalues of L:
-//   singular  ⇔ λ_min < singular_threshold · λ_max  (rank counts the eigenvalues above it);
-//   damping   λ = max_damping · λ_max · sqrt(1 − (λ_min / (singular_threshold·λ_max))²) when singular, else 0;
-//   ν = Σ_k σ_k/(σ_k² + λ²) (e_kᵀ r) e_k  over the eigenpairs (σ_k, e_k) of L:
-// exact when L is regular; when singular, the damped least-squares solution
-// (constraints met in the least-squares sense, no force along L's null space).
+// Options of the balance ν = 𝓛⁺ r of Algorithm 1's line 25 (docs/solver.md,
+// "Singular tasks"). 𝓛 is judged after equilibration, 𝓛̃ = E 𝓛 E with
+// E = diag(1/√𝓛_ii), so that rows in metres and radians, on heavy or light
+// links, weigh alike; its eigenvalues σ̃ lie in [0, m].
+//   σ̃ ≤ rank_tolerance                : exact rank loss: no force along it, and
+//                                       the task is met in the least-squares sense;
+//   rank_tolerance < σ̃ < singular_threshold : near-singular: damped, with
+//                                       gain σ̃ / (σ̃² + damping²·(threshold² − σ̃²)),
+//                                       which meets 1/σ̃ at the threshold (continuous)
+//                                       and keeps ν ≤ 1/threshold (damping = 1);
+//   σ̃ ≥ singular_threshold            : solved exactly (every regular task).
+// After the solve, a row counts as met when |Aᵀ Ẍ − b| ≤ residual_tolerance ×
+// the size of the terms it is computed from (BalanceReport::consistent).
 struct BalanceOptions {
-  double singular_threshold = 1e-9;
-  double max_damping = 1e-5;
+  double singular_threshold = 1e-8;
+  double rank_tolerance = 1e-11;
+  double damping = 1.0;
+  double residual_tolerance = 1e-9;
 };
 
 class Task {

@@ -213,9 +213,9 @@ py::array bodyAccelerations(const Result& r, Expressed e) {
 
 std::string resultRepr(const Result& r) {
   const Solution& s = r.solution();
-  std::string text = "<zwang.Result dof=" + std::to_string(s.qdd.size()) + " rows=" + std::to_string(s.coupling.rows);
+  std::string text = "<zwang.Result dof=" + std::to_string(s.qdd.size()) + " rows=" + std::to_string(s.balance.rows);
   if (r.with_friction) text += " friction" + std::string(r.friction().indeterminate ? " (indeterminate)" : "");
-  if (s.coupling.singular) text += " singular";
+  if (s.balance.singular) text += " singular";
   if (r.infeasible) text += " infeasible";
   return text + (r.data ? " copy>" : ">");
 }
@@ -407,11 +407,11 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("nu", [](const Result& r) { return vectorCopy(r.solution().nu); },
                              "ν, constraint magnitudes in constraint order (a copy: its length follows the task)")
       .def_property_readonly("gauss", [](const Result& r) { return r.solution().gauss; }, "Z(q̈)")
-      .def_property_readonly("rows", [](const Result& r) { return r.solution().coupling.rows; })
-      .def_property_readonly("rank", [](const Result& r) { return r.solution().coupling.rank; })
-      .def_property_readonly("condition", [](const Result& r) { return r.solution().coupling.condition; })
-      .def_property_readonly("damping", [](const Result& r) { return r.solution().coupling.damping; })
-      .def_property_readonly("singular", [](const Result& r) { return r.solution().coupling.singular; })
+      .def_property_readonly("rows", [](const Result& r) { return r.solution().balance.rows; })
+      .def_property_readonly("rank", [](const Result& r) { return r.solution().balance.rank; })
+      .def_property_readonly("condition", [](const Result& r) { return r.solution().balance.condition; })
+      .def_property_readonly("damping", [](const Result& r) { return r.solution().balance.damping; })
+      .def_property_readonly("singular", [](const Result& r) { return r.solution().balance.singular; })
       .def_property_readonly("body_acc_local", [](const Result& r) { return bodyAccelerations(r, Expressed::Local); },
                              "(bodies, 6) true classical accelerations of the body frames, body axes (a new array)")
       .def_property_readonly("body_acc_world", [](const Result& r) { return bodyAccelerations(r, Expressed::World); },

@@ -24,23 +24,6 @@ namespace {
 inline std::size_t at(int i) { return static_cast<std::size_t>(i); }
 }  // namespace
 
-Status checkBalanceOptions(const BalanceOptions& o) {
-  // The equilibrated eigenvalues lie in [0, m] with at least one ≥ 1, so a
-  // threshold of 1 or more would call every task singular.
-  if (!(o.singular_threshold > 0.0 && o.singular_threshold < 1.0))
-    return Status::error(StatusCode::BadOption, "balance singular_threshold %g must be in (0, 1)",
-                         o.singular_threshold);
-  if (!(o.rank_tolerance >= 0.0 && o.rank_tolerance < o.singular_threshold))
-    return Status::error(StatusCode::BadOption, "balance rank_tolerance %g must be in [0, singular_threshold = %g)",
-                         o.rank_tolerance, o.singular_threshold);
-  if (!(o.damping >= 0.0 && std::isfinite(o.damping)))
-    return Status::error(StatusCode::BadOption, "balance damping %g must be finite and >= 0", o.damping);
-  if (!(o.residual_tolerance > 0.0 && std::isfinite(o.residual_tolerance)))
-    return Status::error(StatusCode::BadOption, "balance residual_tolerance %g must be finite and positive",
-                         o.residual_tolerance);
-  return {};
-}
-
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
                         const VectorRef& tau, const Workspace& ws) {
   if (ws.dof() != model.dof())

@@ -13,9 +13,6 @@ namespace zwang::internal {
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
 using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// The task's balance options in range (BadOption naming the field).
-Status checkBalanceOptions(const BalanceOptions& options);
-
 // Input checks shared by every solve (the balance options included).
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
                         const VectorRef& tau, const Workspace& ws);

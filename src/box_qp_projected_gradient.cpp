@@ -38,8 +38,16 @@ constexpr double kTiny = 1e-300;
 // largest: the variable is nearly linear and moves straight to its bound.
 constexpr double kDiagonalFloor = 1e-12;
 
+using Segment = Eigen::VectorBlock<Eigen::VectorXd>;
+
+// The scratch as the iterations use it, k entries each, taken once per
+// solve (the loop then indexes them without re-deriving the views).
+struct Iterates {
+  Segment inverse_d, gradient, y, x_previous, x_change, Px, Px_previous, Py;
+};
+
 // x ← clamp(x) to the box.
-void clampToBox(const VectorRef& lo, const VectorRef& hi, Eigen::Ref<Eigen::VectorXd> x) {
+void clampToBox(const VectorRef& lo, const VectorRef& hi, Eigen::Ref<Eigen::VectorXd>& x) {
   for (Index j = 0; j < x.size(); ++j) x[j] = std::min(hi[j], std::max(lo[j], x[j]));
 }
 
@@ -81,14 +89,15 @@ double jacobiMetric(const MatrixRef& P, ProjectedGradientScratch& s) {
 }
 
 // max_j kktViolation at x, from P x already computed.
-double kktAt(const VectorRef& Px, const VectorRef& c, const VectorRef& lo, const VectorRef& hi, const VectorRef& x) {
+double kktAt(const Segment& Px, const VectorRef& c, const VectorRef& lo, const VectorRef& hi,
+             const Eigen::Ref<Eigen::VectorXd>& x) {
   double r = 0.0;
   for (Index j = 0; j < x.size(); ++j) r = std::max(r, kktViolation(Px[j] - c[j], x[j], lo[j], hi[j]));
   return r;
 }
 
 // The variable farthest out (the one that ran away).
-int farthest(const VectorRef& x) {
+int farthest(const Eigen::Ref<Eigen::VectorXd>& x) {
   Index worst = 0;
   for (Index j = 1; j < x.size(); ++j)
     if (std::abs(x[j]) > std::abs(x[worst])) worst = j;
@@ -97,24 +106,21 @@ int farthest(const VectorRef& x) {
 
 // FISTA momentum for the next extrapolated point y (and P y), restarted
 // (t = 1, y = x) when it stops helping: the gradient test ∇φ(y)·(x − x_prev) > 0.
-void momentum(const VectorRef& x, ProjectedGradientScratch& s, double& t) {
-  const Index k = x.size();
-  auto y = s.y.head(k), x_change = s.x_change.head(k);
-  auto Px = s.Px.head(k), Px_previous = s.Px_previous.head(k), Py = s.Py.head(k);
+void momentum(const Eigen::Ref<Eigen::VectorXd>& x, Iterates& v, double& t) {
   const double t_next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * t * t));
-  x_change = x - s.x_previous.head(k);
-  if (s.gradient.head(k).dot(x_change) > 0.0) {
+  v.x_change = x - v.x_previous;
+  if (v.gradient.dot(v.x_change) > 0.0) {
     t = 1.0;
-    y = x;
-    Py = Px;
+    v.y = x;
+    v.Py = v.Px;
   } else {
     const double beta = (t - 1.0) / t_next;
-    y = x + beta * x_change;
-    Py = (1.0 + beta) * Px - beta * Px_previous;
+    v.y = x + beta * v.x_change;
+    v.Py = (1.0 + beta) * v.Px - beta * v.Px_previous;
     t = t_next;
   }
-  s.x_previous.head(k) = x;
-  Px_previous = Px;
+  v.x_previous = x;
+  v.Px_previous = v.Px;
 }
 
 }  // namespace
@@ -140,30 +146,30 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
   ProjectedGradientScratch& s = scratch.projected_gradient;
   const double step = jacobiMetric(P, s);  // stage 1
   const double reach = kReach * reachScale(lo, hi, c, L, curvature_scale);
-  auto inverse_d = s.inverse_diagonal.head(k), g = s.gradient.head(k);
-  auto Px = s.Px.head(k), Py = s.Py.head(k);
-  s.y.head(k) = x;
-  s.x_previous.head(k) = x;
-  Px.noalias() = P * x;
-  s.Px_previous.head(k) = Px;
-  Py = Px;
+  Iterates v{s.inverse_diagonal.head(k), s.gradient.head(k), s.y.head(k),           s.x_previous.head(k),
+             s.x_change.head(k),         s.Px.head(k),       s.Px_previous.head(k), s.Py.head(k)};
+  v.y = x;
+  v.x_previous = x;
+  v.Px.noalias() = P * x;
+  v.Px_previous = v.Px;
+  v.Py = v.Px;
   double t = 1.0;
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
-    g = Py - c;  // stage 2: the projected gradient step from y
-    x = s.y.head(k) - step * inverse_d.cwiseProduct(g);
+    v.gradient = v.Py - c;  // stage 2: the projected gradient step from y
+    x = v.y - step * v.inverse_d.cwiseProduct(v.gradient);
     clampToBox(lo, hi, x);
     if (x.cwiseAbs().maxCoeff() > reach) {  // running off along an infinite bound
       report.unbounded = true;
       report.unbounded_index = farthest(x);
       break;
     }
-    Px.noalias() = P * x;
-    if (kktAt(Px, c, lo, hi, x) <= tolerance) {  // stage 3: optimal to the tolerance
+    v.Px.noalias() = P * x;
+    if (kktAt(v.Px, c, lo, hi, x) <= tolerance) {  // stage 3: optimal to the tolerance
       report.converged = true;
       ++report.iterations;  // count this gradient step
       break;
     }
-    momentum(x, s, t);  // stage 4
+    momentum(x, v, t);  // stage 4
   }
   report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
   return report;

@@ -44,8 +44,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // true zero could pass as curvature, and no physical friction curvature is
 // 1e-11 of the joint's own inertia term.
 constexpr double kDependent = 1e-11;
-// ∇φ_j is computed to within this multiple of ε·(Σ_l |P_jl x_l| + |c_j|):
-// the error bound of a dot product of k ≤ 64 terms (γ_k ≈ k·ε).
+// ∇φ_j is computed to within this multiple of ε·(Σ_l |P_jl| ‖x‖∞ + |c_j|):
+// the worst-case bound γ_k ≈ k·ε of a k-term dot product for k ≤ 64, and far
+// above the typical √k·ε beyond.
 constexpr double kRounding = 64.0 * DBL_EPSILON;
 
 // The problem, read-only, and the tolerance on the projected gradient.
@@ -57,6 +58,7 @@ struct Box {
   double tolerance;
 };
 
+// value clamped to x_j's bounds.
 double clampTo(const Box& box, Eigen::Index j, double value) {
   return std::min(box.hi[j], std::max(box.lo[j], value));
 }

@@ -17,11 +17,11 @@ namespace zwang::internal {
 // The reach rule of both box-QP maximisers: a variable with an infinite bound
 // that travels kReach times the problem's own scale (reachScale) is running
 // off to infinity. Its curvature is rounding (a zero computed as a tiny
-// number next to P's other entries), not physics: a real curvature stops a
-// variable within a few times that scale, while rounding-level curvature
-// (~1e-16 relative) lets it run to ~1e16. 1e12 sits between the two with
-// four orders of margin on each side. One constant, so that the two methods
-// agree on what is unbounded.
+// number next to P's other entries), not physics: along a curvature κ the
+// minimiser lies within ‖c‖∞/κ, so a rounding-level κ ~ ε·L ≈ 1e-16·L sends
+// it to ~1e16 times the scale, while 1e12 still admits real curvatures down
+// to 1e-12·L: four orders of margin above rounding. One constant, so that
+// the two methods agree on what is unbounded.
 inline constexpr double kReach = 1e12;
 
 // Scratch of boxQpActiveSet (k ≤ n variables).

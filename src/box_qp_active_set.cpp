@@ -324,12 +324,9 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         Eigen::Ref<Eigen::VectorXd> x, QpScratch& scratch, int max_iterations, double tolerance,
                         double curvature_scale) {
+  if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
   const auto k = static_cast<int>(x.size());
-  if (k == 0) {
-    report.converged = true;
-    return report;
-  }
   ActiveSetScratch& s = scratch.active_set;
   const Box box{P, c, lo, hi, tolerance};
   for (int j = 0; j < k; ++j) s.row_sums[j] = P.col(j).cwiseAbs().sum();

@@ -129,12 +129,9 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
                                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                                 Eigen::Ref<Eigen::VectorXd> x, QpScratch& scratch, int max_iterations, double tolerance,
                                 double curvature_scale) {
+  if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
   const Index k = x.size();
-  if (k == 0) {
-    report.converged = true;
-    return report;
-  }
   // Lipschitz constant of ∇φ: an upper bound of λ_max(P) in O(k²), the
   // smaller of Gershgorin's (largest absolute row sum) and the trace (P is
   // positive semi-definite), rather than an O(k³) eigen-decomposition.

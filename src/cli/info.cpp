@@ -50,7 +50,8 @@ void printTable(const std::vector<std::vector<std::string>>& rows) {
 }  // namespace
 
 int commandInfo(int argc, char** argv) {
-  const Arguments args = parseArguments("info", argc, argv, 2, {"--json"}, {"--root", "--tip"});
+  const Arguments args =
+      parseArguments("info", argc, argv, 2, {"--json", "--strict", "--attach-beyond-tip"}, {"--root", "--tip"});
   if (args.help) {
     std::fputs(usageText("info"), stdout);
     return kExitOk;
@@ -61,18 +62,22 @@ int commandInfo(int argc, char** argv) {
   UrdfOptions options;
   options.root = args.value("--root");
   options.tip = args.value("--tip");
+  options.strict = args.has("--strict");
+  options.attach_beyond_tip = args.has("--attach-beyond-tip");
+  options.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip"};
   Model model;
   try {
     model = loadUrdfFile(path, options);
   } catch (const ModelError& e) {
     throw CliError(kExitError, e.what());
   }
+  printWarnings(model);
 
-  double total_mass = 0.0, moving_mass = 0.0;
-  for (int b = 0; b < model.bodyCount(); ++b) {
-    total_mass += model.inertia(b).mass;
-    if (b > 0) moving_mass += model.inertia(b).mass;
-  }
+  // The base (body 0: the root and every link welded to it) never moves: its
+  // mass does not enter the dynamics, so it is shown apart.
+  const double base_mass = model.inertia(0).mass;
+  double moving_mass = 0.0;
+  for (int b = 1; b < model.bodyCount(); ++b) moving_mass += model.inertia(b).mass;
   auto bodyName = [&](int b) { return model.frame(model.bodyFrame(b)).name; };
 
   if (args.has("--json")) {
@@ -91,9 +96,17 @@ int commandInfo(int argc, char** argv) {
                         {"rotor_inertia", j.rotor_inertia}});
     Json frames = Json::array();
     for (const Frame& f : model.frames()) frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyName(f.body)}});
-    const Json out = {{"file", path},          {"model", model.name()},   {"dof", model.dof()},
-                      {"joints", std::move(joints)}, {"frames", std::move(frames)},
-                      {"total_mass", total_mass}, {"moving_mass", moving_mass}};
+    Json warnings = Json::array();
+    for (const ModelWarning& w : model.warnings()) warnings.push_back({{"code", toString(w.code)}, {"message", w.message}});
+    const Json out = {{"file", path},
+                      {"model", model.name()},
+                      {"dof", model.dof()},
+                      {"joints", std::move(joints)},
+                      {"frames", std::move(frames)},
+                      {"moving_mass", moving_mass},
+                      {"base_mass", base_mass},
+                      {"total_mass", moving_mass + base_mass},
+                      {"warnings", std::move(warnings)}};
     writeOutput("", prettyDump(out) + "\n");
     return kExitOk;
   }
@@ -115,7 +128,9 @@ int commandInfo(int argc, char** argv) {
   rows = {{"name", "body", "body link"}};
   for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyName(f.body)});
   printTable(rows);
-  std::printf("\ntotal mass %s kg (moving bodies %s kg)\n", cell(total_mass).c_str(), cell(moving_mass).c_str());
+  std::printf("\nmoving mass %s kg (bodies 1-%d), base mass %s kg (welded to the fixed base, not in the dynamics)\n",
+              cell(moving_mass).c_str(), model.dof(), cell(base_mass).c_str());
+  if (!model.warnings().empty()) std::printf("%zu warning%s (on stderr)\n", model.warnings().size(), model.warnings().size() == 1 ? "" : "s");
   std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (damping), kg·m² or kg (rotor inertia)\n");
   return kExitOk;
 }

@@ -277,3 +277,36 @@ TEST_CASE("point-mass and thin-rod chains agree with the dense reference", "[urd
   }
   CHECK(worst < 1e-9);
 }
+
+TEST_CASE("urdfdom's warnings become model warnings, once each", "[urdf][warnings]") {
+  const std::string visual = R"(<link name="l2"><visual><geometry><box size="0.1 0.1 0.1"/></geometry>
+      <material name="no_such_material"/></visual></link>
+    <joint name="w" type="fixed"><parent link="l1"/><child link="l2"/></joint>)";
+  const Model m = loadUrdfString(arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", visual));
+  REQUIRE(codes(m) == Codes{WarningCode::Urdfdom});
+  CHECK_THAT(m.warnings()[0].message, Contains("<string>: urdfdom: ") && Contains("no_such_material"));
+  REQUIRE_THROWS_WITH(loadUrdfString(arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", visual), strict()),
+                      Contains("strict mode") && Contains("no_such_material"));
+}
+
+TEST_CASE("a payload joint locked at a given position", "[urdf][warnings]") {
+  const ChainSpec spec = armWithFinger();
+  UrdfOptions o;
+  o.tip = "hand";
+  o.attach_beyond_tip = true;
+  o.locked_positions["finger_joint"] = 0.04;
+  const Model m = loadUrdfString(toUrdf(spec), o);
+  const Task task(m);
+  Workspace ws(m, task);
+  const Eigen::Vector2d q(0.3, -0.7);
+  REQUIRE(inverseDynamics(m, task, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), ws));
+  const Eigen::VectorXd dense =
+      denseInverseDynamics(spec, Eigen::Vector3d(0.3, -0.7, 0.04), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                           task.gravity)
+          .head(2);
+  CHECK(relativeError(ws.tau, dense) < 1e-12);
+  o.locked_positions = {{"j2", 0.1}};
+  REQUIRE_THROWS_WITH(loadUrdfString(toUrdf(spec), o),
+                      Contains("locked position for joint 'j2' (0.1): not a finite position of a moving joint beyond "
+                               "the tip (those joints: 'finger_joint')"));
+}

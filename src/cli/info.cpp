@@ -47,6 +47,74 @@ void printTable(const std::vector<std::vector<std::string>>& rows) {
   }
 }
 
+// The base (body 0: the root and every link welded to it) never moves: its
+// mass does not enter the dynamics, so it is shown apart.
+struct Masses {
+  double moving = 0.0, base = 0.0;
+  explicit Masses(const Model& model) : base(model.inertia(0).mass) {
+    for (int b = 1; b < model.bodyCount(); ++b) moving += model.inertia(b).mass;
+  }
+};
+
+std::string bodyLink(const Model& model, int body) { return model.frame(model.bodyFrame(body)).name; }
+
+Json infoJson(const Model& model, const std::string& path) {
+  Json joints = Json::array();
+  for (const Joint& j : model.joints())
+    joints.push_back({{"name", j.name},
+                      {"type", toString(j.type)},
+                      {"axis", {j.axis.x(), j.axis.y(), j.axis.z()}},
+                      {"lower", finiteOrNull(j.lower)},
+                      {"upper", finiteOrNull(j.upper)},
+                      {"effort_limit", finiteOrNull(j.effort_limit)},
+                      {"velocity_limit", finiteOrNull(j.velocity_limit)},
+                      {"breakaway_friction", j.breakaway_friction},
+                      {"kinetic_friction", j.kinetic_friction},
+                      {"damping", j.damping},
+                      {"rotor_inertia", j.rotor_inertia}});
+  Json frames = Json::array();
+  for (const Frame& f : model.frames())
+    frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyLink(model, f.body)}});
+  Json warnings = Json::array();
+  for (const ModelWarning& w : model.warnings()) warnings.push_back({{"code", toString(w.code)}, {"message", w.message}});
+  const Masses mass(model);
+  return {{"file", path},
+          {"model", model.name()},
+          {"dof", model.dof()},
+          {"joints", std::move(joints)},
+          {"frames", std::move(frames)},
+          {"moving_mass", mass.moving},
+          {"base_mass", mass.base},
+          {"total_mass", mass.moving + mass.base},
+          {"warnings", std::move(warnings)}};
+}
+
+void printInfoTable(const Model& model, const std::string& path) {
+  std::printf("%s: %d moving joint%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
+              model.dof() == 1 ? "" : "s", model.frames().size(), path.c_str());
+  std::vector<std::vector<std::string>> rows{{"#", "name", "type", "axis", "lower", "upper", "effort", "velocity",
+                                              "breakaway", "kinetic", "damping", "rotor_inertia"}};
+  for (int k = 0; k < model.dof(); ++k) {
+    const Joint& j = model.joint(k);
+    char axis[64];
+    std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
+    rows.push_back({std::to_string(k), j.name, toString(j.type), axis, cell(j.lower), cell(j.upper), cell(j.effort_limit),
+                    cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction), cell(j.damping),
+                    cell(j.rotor_inertia)});
+  }
+  printTable(rows);
+  std::printf("\nframes\n");
+  rows = {{"name", "body", "body link"}};
+  for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyLink(model, f.body)});
+  printTable(rows);
+  const Masses mass(model);
+  std::printf("\nmoving mass %s kg (bodies 1-%d), base mass %s kg (welded to the fixed base, not in the dynamics)\n",
+              cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
+  const std::size_t warnings = model.warnings().size();
+  if (warnings > 0) std::printf("%zu warning%s (on stderr)\n", warnings, warnings == 1 ? "" : "s");
+  std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (damping), kg·m² or kg (rotor inertia)\n");
+}
+
 }  // namespace
 
 int commandInfo(int argc, char** argv) {
@@ -72,66 +140,10 @@ int commandInfo(int argc, char** argv) {
     throw CliError(kExitError, e.what());
   }
   printWarnings(model);
-
-  // The base (body 0: the root and every link welded to it) never moves: its
-  // mass does not enter the dynamics, so it is shown apart.
-  const double base_mass = model.inertia(0).mass;
-  double moving_mass = 0.0;
-  for (int b = 1; b < model.bodyCount(); ++b) moving_mass += model.inertia(b).mass;
-  auto bodyName = [&](int b) { return model.frame(model.bodyFrame(b)).name; };
-
-  if (args.has("--json")) {
-    Json joints = Json::array();
-    for (const Joint& j : model.joints())
-      joints.push_back({{"name", j.name},
-                        {"type", toString(j.type)},
-                        {"axis", {j.axis.x(), j.axis.y(), j.axis.z()}},
-                        {"lower", finiteOrNull(j.lower)},
-                        {"upper", finiteOrNull(j.upper)},
-                        {"effort_limit", finiteOrNull(j.effort_limit)},
-                        {"velocity_limit", finiteOrNull(j.velocity_limit)},
-                        {"breakaway_friction", j.breakaway_friction},
-                        {"kinetic_friction", j.kinetic_friction},
-                        {"damping", j.damping},
-                        {"rotor_inertia", j.rotor_inertia}});
-    Json frames = Json::array();
-    for (const Frame& f : model.frames()) frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyName(f.body)}});
-    Json warnings = Json::array();
-    for (const ModelWarning& w : model.warnings()) warnings.push_back({{"code", toString(w.code)}, {"message", w.message}});
-    const Json out = {{"file", path},
-                      {"model", model.name()},
-                      {"dof", model.dof()},
-                      {"joints", std::move(joints)},
-                      {"frames", std::move(frames)},
-                      {"moving_mass", moving_mass},
-                      {"base_mass", base_mass},
-                      {"total_mass", moving_mass + base_mass},
-                      {"warnings", std::move(warnings)}};
-    writeOutput("", prettyDump(out) + "\n");
-    return kExitOk;
-  }
-
-  std::printf("%s: %d moving joint%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
-              model.dof() == 1 ? "" : "s", model.frames().size(), path.c_str());
-  std::vector<std::vector<std::string>> rows{{"#", "name", "type", "axis", "lower", "upper", "effort", "velocity",
-                                              "breakaway", "kinetic", "damping", "rotor_inertia"}};
-  for (int k = 0; k < model.dof(); ++k) {
-    const Joint& j = model.joint(k);
-    char axis[64];
-    std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
-    rows.push_back({std::to_string(k), j.name, toString(j.type), axis, cell(j.lower), cell(j.upper), cell(j.effort_limit),
-                    cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction), cell(j.damping),
-                    cell(j.rotor_inertia)});
-  }
-  printTable(rows);
-  std::printf("\nframes\n");
-  rows = {{"name", "body", "body link"}};
-  for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyName(f.body)});
-  printTable(rows);
-  std::printf("\nmoving mass %s kg (bodies 1-%d), base mass %s kg (welded to the fixed base, not in the dynamics)\n",
-              cell(moving_mass).c_str(), model.dof(), cell(base_mass).c_str());
-  if (!model.warnings().empty()) std::printf("%zu warning%s (on stderr)\n", model.warnings().size(), model.warnings().size() == 1 ? "" : "s");
-  std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (damping), kg·m² or kg (rotor inertia)\n");
+  if (args.has("--json"))
+    writeOutput("", prettyDump(infoJson(model, path)) + "\n");
+  else
+    printInfoTable(model, path);
   return kExitOk;
 }
 

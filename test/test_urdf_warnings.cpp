@@ -310,3 +310,37 @@ TEST_CASE("a payload joint locked at a given position", "[urdf][warnings]") {
                       Contains("locked position for joint 'j2' (0.1): not a finite position of a moving joint beyond "
                                "the tip (those joints: 'finger_joint')"));
 }
+
+TEST_CASE("world is the root link's frame: a root turned +90 deg about x needs gravity (0, -9.81, 0)",
+          "[urdf][conventions]") {
+  // docs/conventions.md, "Gravity": the same arm loaded from the upright
+  // `world` and from the turned `mount` holds with the same torques when
+  // gravity is given in the root's axes.
+  const std::string xml = R"(<robot name="tilted"><link name="world"/>
+    <joint name="mount_joint" type="fixed"><parent link="world"/><child link="mount"/>
+      <origin xyz="0 0 0.3" rpy="1.5707963267948966 0 0"/></joint>
+    <link name="mount"/>
+    <joint name="j1" type="revolute"><parent link="mount"/><child link="l1"/><axis xyz="1 0 0"/>
+      <limit lower="-3" upper="3" effort="50" velocity="2"/></joint>
+    <link name="l1"><inertial><origin xyz="0.1 0.2 0.05"/><mass value="1.5"/>
+      <inertia ixx="0.02" ixy="0" ixz="0" iyy="0.03" iyz="0" izz="0.03"/></inertial></link>
+    <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0.4 0"/><axis xyz="0 0 1"/>
+      <limit lower="-3" upper="3" effort="50" velocity="2"/></joint>
+    <link name="l2"><inertial><origin xyz="0.2 0 0"/><mass value="0.8"/>
+      <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link></robot>)";
+  UrdfOptions from_mount;
+  from_mount.root = "mount";
+  const Model upright = loadUrdfString(xml), turned = loadUrdfString(xml, from_mount);
+  Task upright_task(upright), turned_task(turned);
+  turned_task.gravity = Vec3(0.0, -9.81, 0.0);
+  Workspace upright_ws(upright, upright_task), turned_ws(turned, turned_task);
+  const Eigen::Vector2d q(0.4, -0.9), zero = Eigen::Vector2d::Zero();
+  REQUIRE(inverseDynamics(upright, upright_task, q, zero, zero, upright_ws));
+  REQUIRE(inverseDynamics(turned, turned_task, q, zero, zero, turned_ws));
+  CHECK(relativeError(turned_ws.tau, upright_ws.tau) < 1e-12);
+  CHECK(upright_ws.tau.cwiseAbs().maxCoeff() > 1.0);  // gravity does load the joints
+  // The default gravity on the turned root is wrong, visibly.
+  turned_task.gravity = Task(turned).gravity;
+  REQUIRE(inverseDynamics(turned, turned_task, q, zero, zero, turned_ws));
+  CHECK(relativeError(turned_ws.tau, upright_ws.tau) > 0.1);
+}

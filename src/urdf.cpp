@@ -647,7 +647,8 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
                            nameList(links) + ", " + fmt(beyond.mass) + " kg in all) behind moving joint" +
                            (joints.size() == 1 ? " " : "s ") + nameList(joints) + " beyond the tip '" + tip + "'";
   if (!options.attach_beyond_tip) {
-    placement.warnings.push_back({WarningCode::MassBeyondTip, what + " are not on the chain: their mass is ignored (set " +
+    const char* verb = links.size() == 1 ? " is" : " are";
+    placement.warnings.push_back({WarningCode::MassBeyondTip, what + verb + " not on the chain: their mass is ignored (set " +
                                                                   options.names.attach_beyond_tip +
                                                                   " to carry them as a payload of the tip body)"});
     return;
@@ -658,7 +659,22 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
     const RigidInertia inertia = linkInertia(report, *link, false);
     report.builder([&] { builder.addFixedFrame(link->name, joint->parent_link_name, X, inertia); });
   }
-  placement.warnings.push_back({WarningCode::PayloadAttached, what + " are welded to the tip body as a payload, those joints locked"});
+  placement.warnings.push_back({WarningCode::PayloadAttached, what + (links.size() == 1 ? " is" : " are") +
+                                                                  " welded to the tip body as a payload, those joints locked"});
+}
+
+// Strict mode: every warning about the data is an error. PayloadAttached only
+// reports what attach_beyond_tip was asked to do, so it does not count.
+void refuseWarnings(const Reporter& report, const Model& model) {
+  std::string all;
+  std::size_t count = 0;
+  for (const ModelWarning& w : model.warnings()) {
+    if (w.code == WarningCode::PayloadAttached) continue;
+    all += (all.empty() ? "" : "; ") + w.message.substr(report.source().size() + 2);  // without the "<source>: " prefix
+    ++count;
+  }
+  if (count > 0)
+    report.fail("refused in strict mode (" + std::to_string(count) + " warning" + (count == 1 ? "" : "s") + "): " + all);
 }
 
 Model load(const Reporter& report, const std::string& xml, const UrdfOptions& options) {
@@ -700,12 +716,7 @@ Model load(const Reporter& report, const std::string& xml, const UrdfOptions& op
   builder.prefixWarnings(report.source() + ": ");
   Model model;
   report.builder([&] { model = builder.build(); });
-  if (options.strict && !model.warnings().empty()) {
-    std::string all;
-    for (const ModelWarning& w : model.warnings()) all += (all.empty() ? "" : "; ") + w.message.substr(report.source().size() + 2);
-    report.fail("refused in strict mode (" + std::to_string(model.warnings().size()) + " warning" +
-                (model.warnings().size() == 1 ? "" : "s") + "): " + all);
-  }
+  if (options.strict) refuseWarnings(report, model);
   return model;
 }
 

@@ -229,6 +229,9 @@ TEST_CASE("mass beyond the tip: warned, or attached as a payload matching the de
   REQUIRE(codes(payload) == Codes{WarningCode::PayloadAttached});
   CHECK(payload.inertia(2).mass == Approx(0.7 + 0.3 + 0.1));
   CHECK(payload.hasFrame("pad"));
+  UrdfOptions strict_attach = attach;
+  strict_attach.strict = true;  // the payload note reports the user's own choice: not refused
+  CHECK(loadUrdfString(xml, strict_attach).dof() == 2);
 
   // Holding torques (q̇ = q̈ = 0) and full inverse dynamics: the dense
   // reference of the whole 3-dof chain with the finger at 0, first two entries.

@@ -78,7 +78,7 @@ enum class WarningCode {
   TriangleInequality,  // principal moments with a + b < c (no real body has them)
   PlaceholderLimits,   // <limit lower == upper, effort == velocity == 0>: read as "no limits"
   MassBeyondTip,       // links behind a moving joint below the tip carry mass the chain ignores
-  PayloadAttached,     // that mass was attached to the tip body (UrdfOptions::attach_beyond_tip)
+  PayloadAttached,     // that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
   Urdfdom,             // urdfdom's own warning, passed on once
 };
 // "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.

@@ -19,7 +19,8 @@ struct UrdfOptions {
   std::map<std::string, double> rotor_inertia;
   // Refuse doubtful data: every ModelWarning the load would record (point
   // masses, placeholder inertias or limits, triangle-inequality violations,
-  // mass beyond the tip, urdfdom's warnings) becomes a ModelError instead.
+  // mass beyond the tip, urdfdom's warnings) becomes a ModelError instead
+  // (PayloadAttached, a note on what attach_beyond_tip did, is let pass).
   bool strict = false;
   // Links behind moving joints below the tip (a gripper's fingers) are not on
   // the chain. false: their mass is ignored, with a MassBeyondTip warning.

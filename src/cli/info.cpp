@@ -26,20 +26,28 @@ std::string cell(double x) {
   return buffer;
 }
 
+// Display width of UTF-8 text (link and joint names may hold any letters):
+// the bytes that start a character.
+std::size_t displayWidth(const std::string& text) {
+  std::size_t n = 0;
+  for (const char c : text) n += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+  return n;
+}
+
 // Left-aligned text columns, right-aligned numbers (cells starting with a digit, '-' or '.').
 void printTable(const std::vector<std::vector<std::string>>& rows) {
   std::vector<std::size_t> width;
   for (const auto& row : rows)
     for (std::size_t c = 0; c < row.size(); ++c) {
       if (width.size() <= c) width.push_back(0);
-      width[c] = std::max(width[c], row[c].size());
+      width[c] = std::max(width[c], displayWidth(row[c]));
     }
   for (std::size_t r = 0; r < rows.size(); ++r) {
     std::string line = "";
     for (std::size_t c = 0; c < rows[r].size(); ++c) {
       const std::string& text = rows[r][c];
       const bool numeric = r > 0 && !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '-');
-      const std::string pad(width[c] - text.size(), ' ');
+      const std::string pad(width[c] - displayWidth(text), ' ');
       line += "  " + (numeric ? pad + text : text + pad);
     }
     while (!line.empty() && line.back() == ' ') line.pop_back();

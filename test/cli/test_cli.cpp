@@ -899,4 +899,9 @@ TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8"
     checkOneLineError(solve, 1);
     CHECK(contains(solve.err, "(set \"tip\")"));
   }
+  SECTION("valid UTF-8 passes through, other bytes are escaped") {
+    const Run r = run({"info", "--\xC3\xA9t\xC3\xA9\xFF"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "unknown option '--\xC3\xA9t\xC3\xA9\\xFF'"));
+  }
 }

@@ -10,11 +10,11 @@
 //    1/singular_threshold) is solved by Cholesky of 𝓛 itself, exactly as the
 //    report's inverse would be;
 //  * a singular 𝓛 is solved on the eigenpairs of 𝓛̃: exact along regular
-//    directions, damped along near-singular ones (continuous through the
-//    threshold, bounded), and across the exact null space the minimum-norm
-//    least-squares solution in the rows' own units: r's component along
-//    null(𝓛) is what no force can meet (dropped before the solve), and ν gets
-//    no component along null(𝓛) (removed after it).
+//    directions; across the exact null space the minimum-norm least-squares
+//    solution in the rows' own units: r's component along null(𝓛) is what no
+//    force can meet (dropped before the solve), and ν gets no component along
+//    null(𝓛) (removed after it); near-singular directions ramp between the
+//    two (bounded, and continuous in σ̃: factorByEigen).
 #include "internal/balance.hpp"
 
 #include <algorithm>
@@ -161,16 +161,10 @@ bool certifiedSolve(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen::Ref
   return true;
 }
 
-// What an eigen-direction of 𝓛̃ with eigenvalue σ̃ is multiplied by.
-double directionGain(double sigma, const BalanceOptions& options) {
-  if (sigma <= options.rank_tolerance) return 0.0;  // exact rank loss: no force along it
-  const double threshold = options.singular_threshold;
-  if (sigma >= threshold) return 1.0 / sigma;
-  // Near-singular: damped least squares with λ² = damping²·(threshold² − σ̃²),
-  // which vanishes at the threshold (1/σ̃ there: continuous) and, for
-  // damping = 1, makes the gain the straight line σ̃/threshold² (at most 1/threshold).
-  const double damping = options.damping;
-  return sigma / (sigma * sigma + damping * damping * (threshold * threshold - sigma * sigma));
+// Where σ̃ sits on the ramp between exact rank loss (0) and the threshold (1).
+double rampPosition(double sigma, const BalanceOptions& options) {
+  const double t = (sigma - options.rank_tolerance) / (options.singular_threshold - options.rank_tolerance);
+  return std::clamp(t, 0.0, 1.0);
 }
 
 // Z's first k columns made orthonormal in place (Gram–Schmidt, twice: "twice
@@ -183,12 +177,30 @@ void orthonormaliseColumns(Eigen::Ref<Eigen::MatrixXd> Z, Eigen::Index k) {
   }
 }
 
-// x ← (I − Z Zᵀ) x for the orthonormal columns of Z.
-void removeNullComponent(const Eigen::Ref<const Eigen::MatrixXd>& Z, Eigen::Ref<Eigen::VectorXd> x) {
-  for (Eigen::Index c = 0; c < Z.cols(); ++c) x -= Z.col(c) * Z.col(c).dot(x);
+// x ← (I − Σ_c w_c z_c z_cᵀ) x over the orthonormal columns z_c of Z.
+void removeNearNullComponent(const Eigen::Ref<const Eigen::MatrixXd>& Z, const Eigen::Ref<const Eigen::VectorXd>& w,
+                             Eigen::Ref<Eigen::VectorXd> x) {
+  for (Eigen::Index c = 0; c < Z.cols(); ++c) x -= Z.col(c) * (w[c] * Z.col(c).dot(x));
 }
 
-// The singular case: eigenpairs of 𝓛̃ and what each direction gets.
+// The next direction below the threshold in ascending σ̃ not yet taken (−1: none).
+Eigen::Index nextNearNull(const Eigen::Ref<const Eigen::VectorXd>& sigma, double above, Eigen::Index after,
+                          double threshold) {
+  Eigen::Index best = -1;
+  for (Eigen::Index k = 0; k < sigma.size(); ++k) {
+    const bool later = sigma[k] > above || (sigma[k] == above && k > after);
+    if (later && sigma[k] < threshold && (best < 0 || sigma[k] < sigma[best])) best = k;
+  }
+  return best;
+}
+
+// The singular case: eigenpairs of 𝓛̃ and what each direction gets. A
+// direction at ramp position t (rampPosition) gets the gain t/threshold — 0 at
+// exact rank loss, 1/σ̃ at the threshold, a straight line between — and the
+// weight 1 − t in the Euclidean projection that makes exact rank loss the
+// minimum-norm least-squares solution in the rows' own units. Both are
+// continuous in σ̃, so ν is continuous as an arm passes through a singularity,
+// and the operator r ↦ ν stays symmetric positive semi-definite.
 BalanceReport factorByEigen(Eigen::Ref<Eigen::MatrixXd> L, BalanceFactorisation& f, const BalanceOptions& options) {
   const Eigen::Index m = L.rows();
   auto e = f.equilibration.head(m);
@@ -201,25 +213,35 @@ BalanceReport factorByEigen(Eigen::Ref<Eigen::MatrixXd> L, BalanceFactorisation&
 
   BalanceReport report;
   report.rows = static_cast<int>(m);
+  report.rank = static_cast<int>(m);
   f.by_eigen = true;
-  f.nullity = 0;
   double sum_sigma2 = 0.0, sum_inverse2 = 0.0;
   for (Eigen::Index k = 0; k < m; ++k) {
     const double s = std::max(0.0, sigma[k]);  // a rounding-level negative eigenvalue is a zero one
     sigma[k] = s;
-    f.gain[k] = directionGain(s, options);
     sum_sigma2 += s * s;
     sum_inverse2 += s > 0.0 ? 1.0 / (s * s) : std::numeric_limits<double>::infinity();
-    if (s < options.singular_threshold) report.singular = true;
-    if (s <= options.rank_tolerance) {
-      f.null_basis.col(f.nullity++).head(m) = e.cwiseProduct(V.col(k));  // 𝓛 (E v) = E⁻¹ 𝓛̃ v = 0
-    } else if (s < options.singular_threshold) {
-      const double t = options.singular_threshold;
-      report.damping = std::max(report.damping, options.damping * std::sqrt(t * t - s * s));
+    if (s >= options.singular_threshold) {
+      f.gain[k] = 1.0 / s;
+      continue;
     }
+    report.singular = true;
+    const double t = rampPosition(s, options);
+    f.gain[k] = t / options.singular_threshold;
+    if (t == 0.0)
+      --report.rank;
+    else
+      report.damping = std::max(report.damping, 1.0 - t);
   }
-  orthonormaliseColumns(f.null_basis.topLeftCorner(m, f.nullity), f.nullity);
-  report.rank = static_cast<int>(m) - f.nullity;
+  // The near-null directions E v_k (𝓛 E v = E⁻¹ 𝓛̃ v = σ̃ E⁻¹ v), smallest σ̃
+  // first so that Gram–Schmidt keeps the exact null space's span in front.
+  f.near_null_count = 0;
+  for (Eigen::Index k = nextNearNull(sigma, -1.0, -1, options.singular_threshold); k >= 0;
+       k = nextNearNull(sigma, sigma[k], k, options.singular_threshold)) {
+    f.near_null_basis.col(f.near_null_count).head(m) = e.cwiseProduct(V.col(k));
+    f.near_null_weight[f.near_null_count++] = 1.0 - rampPosition(sigma[k], options);
+  }
+  orthonormaliseColumns(f.near_null_basis.topLeftCorner(m, f.near_null_count), f.near_null_count);
   report.condition = std::sqrt(sum_sigma2 * sum_inverse2);  // the fast path's κ̃_F, from the eigenvalues
   return report;
 }
@@ -231,7 +253,7 @@ BalanceReport solveBalance(Eigen::Ref<Eigen::MatrixXd> L, const Eigen::Ref<const
   BalanceReport report;
   report.rows = static_cast<int>(L.rows());
   f.by_eigen = false;
-  f.nullity = 0;
+  f.near_null_count = 0;
   if (report.rows == 0) return report;
   double kappa = 0.0;
   if (certifiedSolve(L, r, nu, f, options.singular_threshold, kappa)) {
@@ -252,16 +274,17 @@ void balanceApply(const BalanceFactorisation& f, const Eigen::Ref<const Eigen::V
     choleskySolveInPlace(f.factor.topLeftCorner(m, m), out);
     return;
   }
-  const auto Z = f.null_basis.topLeftCorner(m, f.nullity);
+  const auto Z = f.near_null_basis.topLeftCorner(m, f.near_null_count);
+  const auto w = f.near_null_weight.head(f.near_null_count);
   const auto V = f.factor.topLeftCorner(m, m);
   const auto e = f.equilibration.head(m);
-  removeNullComponent(Z, out);  // r's part along null(𝓛): no force can meet it (least squares)
+  removeNearNullComponent(Z, w, out);  // r's part along null(𝓛): no force can meet it (least squares)
   out.array() *= e.array();     // into 𝓛̃'s coordinates: 𝓛⁺ = E 𝓛̃⁺ E on range(𝓛)
   for (Eigen::Index k = 0; k < m; ++k) work[k] = f.gain[k] * V.col(k).dot(out);
   out.setZero();
   for (Eigen::Index k = 0; k < m; ++k) out += V.col(k) * work[k];
   out.array() *= e.array();
-  removeNullComponent(Z, out);  // minimum norm: no force along null(𝓛)
+  removeNearNullComponent(Z, w, out);  // minimum norm: no force along null(𝓛)
 }
 
 void balanceApplyColumns(const BalanceFactorisation& f, const Eigen::Ref<const Eigen::MatrixXd>& R,

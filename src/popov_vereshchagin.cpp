@@ -24,23 +24,6 @@ namespace {
 inline std::size_t at(int i) { return static_cast<std::size_t>(i); }
 }  // namespace
 
-Status checkBalanceOptions(const BalanceOptions& o) {
-  // The equilibrated eigenvalues lie in [0, m] with at least one ≥ 1, so a
-  // threshold of 1 or more would call every task singular.
-  if (!(o.singular_threshold > 0.0 && o.singular_threshold < 1.0))
-    return Status::error(StatusCode::BadOption, "balance singular_threshold %g must be in (0, 1)",
-                         o.singular_threshold);
-  if (!(o.rank_tolerance >= 0.0 && o.rank_tolerance < o.singular_threshold))
-    return Status::error(StatusCode::BadOption, "balance rank_tolerance %g must be in [0, singular_threshold = %g)",
-                         o.rank_tolerance, o.singular_threshold);
-  if (!(o.damping >= 0.0 && std::isfinite(o.damping)))
-    return Status::error(StatusCode::BadOption, "balance damping %g must be finite and >= 0", o.damping);
-  if (!(o.residual_tolerance > 0.0 && std::isfinite(o.residual_tolerance)))
-    return Status::error(StatusCode::BadOption, "balance residual_tolerance %g must be finite and positive",
-                         o.residual_tolerance);
-  return {};
-}
-
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
                         const VectorRef& tau, const Workspace& ws) {
   if (ws.dof() != model.dof())
@@ -216,14 +199,14 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   dF.setZero();  // δF^A arriving at body i from its child, per column
   Eigen::Index first = k;
   for (int i = N; i >= 1; --i) {
-    while (first > 0 && joints[static_cast<std::size_t>(first - 1)] + 1 >= i) --first;
+    while (first > 0 && bodyOfJoint(joints[static_cast<std::size_t>(first - 1)]) >= i) --first;
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
     const double inverse_D = 1.0 / ws.D[at(i)];
     const int ki = task.activeColumns(i);
     for (Eigen::Index c = 0; c < first; ++c) du(i, c) = 0.0;
     for (Eigen::Index c = first; c < k; ++c) {
-      const double du_ic = (joints[static_cast<std::size_t>(c)] + 1 == i ? 1.0 : 0.0) - S.dot(dF.col(c));
+      const double du_ic = (bodyOfJoint(joints[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
       du(i, c) = du_ic;
       const double du_D = du_ic * inverse_D;
       for (int r = 0; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20

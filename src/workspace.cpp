@@ -35,7 +35,8 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   balance_factorisation.eigenvalues.setZero(m);
   balance_factorisation.gain.setZero(m);
   balance_factorisation.equilibration.setZero(m);
-  balance_factorisation.null_basis.setZero(m, m);
+  balance_factorisation.near_null_basis.setZero(m, m);
+  balance_factorisation.near_null_weight.setZero(m);
   balance_factorisation.work.setZero(m);
   rhs.setZero(m);
   nu.setZero(m);

@@ -8,6 +8,11 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <catch2/catch.hpp>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <stdexcept>
 
 #include "support/frame_values.hpp"
 #include "support/random_chain.hpp"
@@ -411,4 +416,168 @@ TEST_CASE("6- and 7-joint arms at wrist, elbow and shoulder singularities: met e
                                                << ", ν " << worst.nu << ", residual " << worst.residual
                                                << "; consistent tasks met to " << worst.met);
   CHECK(worst.tested == 160);
+}
+
+namespace {
+
+struct SweepSample {
+  double s = 0.0;  // q5, the wrist angle
+  Eigen::VectorXd nu;
+  double residual = 0.0, damping = 0.0;
+  bool consistent = true;
+};
+
+// The 6R arm moving through its wrist singularity (q5 = s for s in
+// [−span, span], `points` samples), the tool held still (six world rows,
+// b = 0) while the joints move: near s = 0 the velocity terms ask for a tool
+// acceleration the arm cannot cancel.
+std::vector<SweepSample> wristSweep(int points, double span, const BalanceOptions& options) {
+  std::mt19937_64 rng(4242);
+  const ChainSpec spec = sixJointArm(rng, false);
+  const Model model = modelFromSpec(spec);
+  Task task(model);
+  task.balance = options;
+  task.addConstraint("tool", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  Workspace ws(model, task);
+  Eigen::VectorXd q(6), qd(6), tau(6);
+  q << 0.4, -0.7, 1.1, 0.6, 0.0, -0.5;
+  qd << 0.3, -0.2, 0.4, 0.5, -0.6, 0.2;
+  tau << 1.0, -2.0, 0.5, 0.2, -0.1, 0.05;
+  std::vector<SweepSample> samples;
+  for (int i = 0; i < points; ++i) {
+    SweepSample sample;
+    sample.s = -span + 2.0 * span * i / (points - 1);
+    q[4] = sample.s;
+    const Status status = solveHybridDynamics(model, task, q, qd, tau, ws);
+    if (!status) throw std::runtime_error(status.message);
+    sample.nu = ws.solution.nu;
+    sample.residual = ws.solution.balance.residual;
+    sample.damping = ws.solution.balance.damping;
+    sample.consistent = ws.solution.balance.consistent;
+    samples.push_back(sample);
+  }
+  return samples;
+}
+
+double largestStep(const std::vector<SweepSample>& samples) {
+  double step = 0.0;
+  for (std::size_t i = 1; i < samples.size(); ++i) step = std::max(step, (samples[i].nu - samples[i - 1].nu).norm());
+  return step;
+}
+
+double largestNu(const std::vector<SweepSample>& samples) {
+  double largest = 0.0;
+  for (const SweepSample& s : samples) largest = std::max(largest, s.nu.norm());
+  return largest;
+}
+
+}  // namespace
+
+TEST_CASE("through a wrist singularity: ν bounded and continuous, the residual reported", "[sweep]") {
+  const double span = 4e-3;  // σ̃_min ~ q5²: the ramp (σ̃ < 1e-6) spans |q5| ≲ 1e-3
+  const std::vector<SweepSample> coarse = wristSweep(801, span, BalanceOptions{});
+  const std::vector<SweepSample> fine = wristSweep(1601, span, BalanceOptions{});
+  // Continuity by finite differences: a Lipschitz path's largest step halves
+  // with the step; a jump would not shrink.
+  const double step_coarse = largestStep(coarse), step_fine = largestStep(fine);
+  INFO("largest |Δν|: step h " << step_coarse << ", step h/2 " << step_fine << "; largest |ν| " << largestNu(fine));
+  CHECK(step_fine <= 0.6 * step_coarse);
+  // Bounded: without the ramp (threshold just above the rank tolerance, the
+  // plain pseudo-inverse) ν grows like 1/q5² as the wrist aligns.
+  BalanceOptions undamped;
+  undamped.singular_threshold = 2.0 * undamped.rank_tolerance;
+  const double plain = largestNu(wristSweep(801, span, undamped));
+  INFO("largest |ν| undamped " << plain);
+  CHECK(largestNu(coarse) * 100.0 < plain);
+  // Honest reporting: met away from the singularity, not met (and said so)
+  // at it; the residual is continuous too.
+  CHECK(fine.front().consistent);
+  CHECK(fine.back().consistent);
+  CHECK(fine.front().residual < 1e-10);
+  const SweepSample& middle = fine[fine.size() / 2];
+  CHECK(middle.s == 0.0);
+  CHECK_FALSE(middle.consistent);
+  CHECK(middle.residual > 1e-3);
+  const auto residual_step = [](const std::vector<SweepSample>& samples) {
+    double step = 0.0;
+    for (std::size_t i = 1; i < samples.size(); ++i)
+      step = std::max(step, std::abs(samples[i].residual - samples[i - 1].residual));
+    return step;
+  };
+  CHECK(residual_step(fine) <= 0.6 * residual_step(coarse));
+  // The figure of docs/solver.md: ZWANG_SINGULAR_CSV=<file> writes the path.
+  if (const char* path = std::getenv("ZWANG_SINGULAR_CSV")) {
+    std::ofstream csv(path);
+    csv << "# q5 [rad], |nu| default [N, N·m], |nu| undamped, residual |A^T Xdd - b| default [m/s², rad/s²], "
+           "residual undamped, damping (0..1)\n";
+    const std::vector<SweepSample> plain_fine = wristSweep(1601, span, undamped);
+    for (std::size_t i = 0; i < fine.size(); ++i)
+      csv << fine[i].s << ' ' << fine[i].nu.norm() << ' ' << plain_fine[i].nu.norm() << ' ' << fine[i].residual << ' '
+          << plain_fine[i].residual << ' ' << fine[i].damping << '\n';
+  }
+}
+
+TEST_CASE("friction on a singular task: a held tip with stuck joints on a 5-joint arm stays held") {
+  std::mt19937_64 rng(909);
+  RandomChainOptions chain_options;
+  chain_options.min_moving_joints = chain_options.max_moving_joints = 5;
+  int tested = 0;
+  double worst_tip = 0.0, worst_qdd = 0.0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const ChainSpec spec = randomChain(rng, chain_options);
+    const Model model = modelFromSpec(spec);
+    Task task(model);
+    const int tip = static_cast<int>(model.frames().size()) - 1;
+    task.addConstraint(tip, ConstraintMatrix::Identity(6, 6), Expressed::World);
+    Workspace ws(model, task);
+    const Eigen::VectorXd q = randomVector(rng, 5, 2.5), qd = Eigen::VectorXd::Zero(5);
+    const Eigen::VectorXd tau = randomVector(rng, 5, 2.0);
+    REQUIRE(solveWithFriction(model, task, q, qd, tau, ws));
+    REQUIRE(ws.friction.stuck.size() == 5u);
+    // At rest the task (b = 0) is consistent: q̈ = 0 meets it, and the
+    // joints, all stuck, have friction to spare for whatever the held tip
+    // leaves free.
+    const Vec6 a = accelerationOf(model, ws, tip, Expressed::World);
+    INFO("trial " << trial << ", tip acceleration " << a.transpose() << ", q̈ " << ws.solution.qdd.transpose());
+    CHECK(ws.solution.balance.singular);
+    CHECK(ws.solution.balance.rank <= 5);
+    CHECK(ws.solution.balance.consistent);
+    CHECK(a.norm() < 1e-10);
+    CHECK(ws.solution.qdd.norm() < 1e-10);
+    worst_tip = std::max(worst_tip, a.norm());
+    worst_qdd = std::max(worst_qdd, ws.solution.qdd.norm());
+    ++tested;
+  }
+  WARN("held tip with friction, 5-joint arms: " << tested << " solves, tip acceleration at most " << worst_tip
+                                                << ", |q̈| at most " << worst_qdd);
+}
+
+TEST_CASE("balance options out of range: clear errors") {
+  const ChainSpec spec = planarArm();
+  const Model model = modelFromSpec(spec);
+  Task task(model);
+  task.addConstraint("tip", ConstraintMatrix::Identity(6, 2));
+  Workspace ws(model, task);
+  const Eigen::Vector2d q(0.3, 0.4), qd(0.0, 0.0), tau(0.0, 0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<std::pair<std::function<void(BalanceOptions&)>, std::string>> cases = {
+      {[](BalanceOptions& o) { o.singular_threshold = 0.0; }, "singular_threshold 0 must be in (0, 1)"},
+      {[](BalanceOptions& o) { o.singular_threshold = 1.0; }, "singular_threshold 1 must be in (0, 1)"},
+      {[nan](BalanceOptions& o) { o.singular_threshold = nan; }, "singular_threshold nan must be in (0, 1)"},
+      {[](BalanceOptions& o) { o.rank_tolerance = -1e-12; }, "rank_tolerance -1e-12 must be in [0, singular_threshold"},
+      {[](BalanceOptions& o) { o.rank_tolerance = 1e-6; }, "rank_tolerance 1e-06 must be in [0, singular_threshold = 1e-06)"},
+      {[](BalanceOptions& o) { o.residual_tolerance = 0.0; }, "residual_tolerance 0 must be finite and positive"},
+      {[](BalanceOptions& o) { o.residual_tolerance = std::numeric_limits<double>::infinity(); },
+       "residual_tolerance inf must be finite and positive"},
+  };
+  for (const auto& [set, message] : cases) {
+    task.balance = BalanceOptions{};
+    set(task.balance);
+    const Status plain = solveHybridDynamics(model, task, q, qd, tau, ws);
+    INFO(plain.message);
+    CHECK(plain.code == StatusCode::BadOption);
+    CHECK(std::string(plain.message).find(message) != std::string::npos);
+    const Status friction = solveWithFriction(model, task, q, qd, tau, ws);
+    CHECK(friction.code == StatusCode::BadOption);
+  }
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "zwang/model.hpp"
+#include "zwang/status.hpp"
 
 namespace zwang {
 
@@ -26,21 +27,27 @@ using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 // "Singular tasks"). 𝓛 is judged after equilibration, 𝓛̃ = E 𝓛 E with
 // E = diag(1/√𝓛_ii), so that rows in metres and radians, on heavy or light
 // links, weigh alike; its eigenvalues σ̃ lie in [0, m].
-//   σ̃ ≤ rank_tolerance                : exact rank loss: no force along it, and
-//                                       the task is met in the least-squares sense;
-//   rank_tolerance < σ̃ < singular_threshold : near-singular: damped, with
-//                                       gain σ̃ / (σ̃² + damping²·(threshold² − σ̃²)),
-//                                       which meets 1/σ̃ at the threshold (continuous)
-//                                       and keeps ν ≤ 1/threshold (damping = 1);
-//   σ̃ ≥ singular_threshold            : solved exactly (every regular task).
-// After the solve, a row counts as met when |Aᵀ Ẍ − b| ≤ residual_tolerance ×
+//   σ̃ ≥ singular_threshold : solved exactly (every regular task);
+//   σ̃ ≤ rank_tolerance     : exact rank loss: no force along it, and the task
+//                            is met in the least-squares sense (rows' units);
+//   in between             : near-singular: the gain ramps linearly from 0 to
+//                            1/σ̃ (and the least-squares projection from full
+//                            to none), so ν stays bounded (at most
+//                            1/singular_threshold in 𝓛̃'s units) and
+//                            continuous as an arm passes through a singularity.
+// After the solve a row counts as met when |Aᵀ Ẍ − b| ≤ residual_tolerance ×
 // the size of the terms it is computed from (BalanceReport::consistent).
 struct BalanceOptions {
-  double singular_threshold = 1e-8;
+  // Exact null directions come out at ~1e-15 (rounding) and regular ones of
+  // random chains above ~1e-3 (test_singular prints both): a wide gap.
+  double singular_threshold = 1e-6;
   double rank_tolerance = 1e-11;
-  double damping = 1.0;
   double residual_tolerance = 1e-9;
 };
+
+// BadOption naming the field when an option is out of range (every solve
+// checks the task's options this way).
+Status checkBalanceOptions(const BalanceOptions& options);
 
 class Task {
  public:

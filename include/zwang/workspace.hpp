@@ -26,8 +26,10 @@ struct BalanceReport {
   // Frobenius condition number ‖𝓛̃‖_F ‖𝓛̃⁻¹‖_F of the equilibrated matrix
   // (infinite when 𝓛 is singular): at least σ̃_max/σ̃_min and at most m times it.
   double condition = 1.0;
-  // Largest damping applied to a near-singular direction (in σ̃'s units); 0
-  // when every direction was solved exactly or dropped as rank loss.
+  // How far the most damped near-singular direction is from being solved
+  // exactly, in [0, 1): 1 − (σ̃ − rank_tolerance)/(singular_threshold −
+  // rank_tolerance); 0 when every direction was solved exactly or dropped as
+  // exact rank loss.
   double damping = 0.0;
   bool singular = false;    // some σ̃ below singular_threshold: a direction was dropped or damped
   // ‖Aᵀ Ẍ − b‖₂ over the task's rows, in the rows' own units (m/s², rad/s²),
@@ -47,8 +49,12 @@ struct BalanceFactorisation {
   Eigen::VectorXd eigenvalues;    // σ̃_k (by_eigen)
   Eigen::VectorXd gain;           // what each eigen-direction is multiplied by: 1/σ̃, damped, or 0
   Eigen::VectorXd equilibration;  // E_ii = 1/√𝓛_ii (1 on a row nothing moves)
-  Eigen::MatrixXd null_basis;     // orthonormal basis of null(𝓛): its first `nullity` columns
-  int nullity = 0;
+  // Orthonormal basis of the directions E v_k with σ̃_k below singular_threshold
+  // (the first `near_null_count` columns), and the weight of each in the
+  // Euclidean projection: 1 at exact rank loss, falling to 0 at the threshold.
+  Eigen::MatrixXd near_null_basis;
+  Eigen::VectorXd near_null_weight;
+  int near_null_count = 0;
   Eigen::VectorXd work;           // scratch of balanceApply (V's coordinates)
 };
 
@@ -103,7 +109,9 @@ class Workspace {
   std::vector<double> u;             // τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
   Eigen::MatrixXd SA;                // column i: (S_iᵀ A_i)ᵀ, capacity × bodies
   ConstraintMatrix Ahat;             // A_i (6 × capacity), updated in place from A_N down to A_0
-  Eigen::VectorXd U;                 // U_0, acceleration energy of bias forces and torques
+  // U_0, acceleration energy of bias forces and torques: the report's U (not
+  // Featherstone's or Pinocchio's U = I^A S, which is IAS here).
+  Eigen::VectorXd U;
   Eigen::VectorXd L_scale;           // Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
   Eigen::MatrixXd L;                 // 𝓛_0, constraint coupling matrix (capacity², lower triangle)
 

@@ -79,6 +79,8 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
   }
   out["status"] = {{"singular", s.balance.singular},
                    {"rank", s.balance.rank},
+                   {"residual", s.balance.residual},
+                   {"consistent", s.balance.consistent},
                    {"infeasible", status.code == StatusCode::Infeasible}};
   Json frame_map = Json::object();
   for (const int f : frames) {

@@ -17,7 +17,7 @@ void warnOutsideLimits(const std::string& file, const Model& model, const Eigen:
     const Joint& joint = model.joint(j);
     if (std::isnan(q[j]) || (q[j] >= joint.lower && q[j] <= joint.upper)) continue;  // NaN: the solve refuses it
     std::fprintf(stderr, "zwang: warning: %s: q[%d] = %g puts joint '%s' outside its limits [%g, %g]\n", file.c_str(), j,
-                 q[j], printable(joint.name).c_str(), joint.lower, joint.upper);
+                 q[j], printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
   }
 }
 
@@ -47,6 +47,9 @@ int commandSolve(int argc, char** argv) {
 
   const Json solution = solutionJson(bound.model, ws, bound.with_friction, status, bound.reported_frames);
   writeOutput(output, (args.has("--pretty") ? prettyDump(solution) : solution.dump()) + "\n");
+  if (!ws.solution.balance.consistent)  // met only in the least-squares sense, or a damped direction gave
+    std::fprintf(stderr, "zwang: warning: %s: the task is not met: |A^T Xdd - b| = %.3g (status.consistent = false)\n",
+                 problem.file.c_str(), ws.solution.balance.residual);
   if (infeasible) {
     std::fprintf(stderr, "zwang: %s: infeasible: %s\n", problem.file.c_str(), status.message);
     return kExitInfeasible;

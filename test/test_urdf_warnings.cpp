@@ -269,15 +269,19 @@ TEST_CASE("point-mass and thin-rod chains agree with the dense reference", "[urd
   CHECK(codes(model) == (Codes{WarningCode::PointMass, WarningCode::PointMass}));
   std::mt19937_64 rng(160);
   double worst = 0.0;
-  for (int trial = 0; trial < 50; ++trial) {
+  int compared = 0;
+  for (int trial = 0; trial < 200; ++trial) {
     const DynamicsInput in = randomProblem(rng, spec);
     const DenseResult ref = denseDynamics(spec, in);
     if (!wellPosed(ref, in)) continue;
+    ++compared;
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
     REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
     worst = std::max({worst, relativeError(ws.solution.qdd, ref.qdd), relativeError(ws.solution.nu, ref.nu)});
   }
+  INFO(compared << " of 200 draws well posed, worst relative error " << worst);
+  CHECK(compared >= 50);  // the comparison is not vacuous (a 3-dof chain cannot meet many of up to 6 random rows)
   CHECK(worst < 1e-9);
 }
 

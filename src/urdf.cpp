@@ -657,7 +657,9 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
     const auto locked = options.locked_positions.find(joint->name);
     const Transform X = lockedPlacement(report, *joint, locked == options.locked_positions.end() ? 0.0 : locked->second);
     const RigidInertia inertia = linkInertia(report, *link, false);
-    report.builder([&] { builder.addFixedFrame(link->name, joint->parent_link_name, X, inertia); });
+    const std::string& name = link->name;  // clang 14: a lambda cannot capture structured bindings
+    const std::string& parent = joint->parent_link_name;
+    report.builder([&] { builder.addFixedFrame(name, parent, X, inertia); });
   }
   placement.warnings.push_back({WarningCode::PayloadAttached, what + (links.size() == 1 ? " is" : " are") +
                                                                   " welded to the tip body as a payload, those joints locked"});

@@ -1,4 +1,4 @@
-// Static friction: the exact maximum-dissipation motion (SPEC §2–§3, the
+// Static friction: the exact maximum-dissipation motion (docs/friction.md; the
 // report's chapter 5). One pass of the Popov–Vereshchagin sweeps with μ = 0,
 // plus one extra right-hand side per stuck joint through the same sweeps,
 // gives the characteristic equation q̈(μ) = q̈(0) − K_Θ μ (eq. 5.10); the dual
@@ -85,7 +85,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   FrictionResult& fr = ws.friction;
   Solution& out = ws.solution;
 
-  // ---- Friction parameters, the stuck set Θ₀ and kinetic friction (SPEC §2)
+  // ---- Friction parameters, the stuck set Θ₀ and kinetic friction (docs/friction.md, "The model of friction")
   for (int j = 0; j < n; ++j) {
     const Joint& joint = model.joint(j);
     fs.f[j] = options.breakaway.size() ? options.breakaway[j] : joint.breakaway_friction;
@@ -181,7 +181,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   fr.iterations = report.iterations;
   fr.converged = k == 0 || report.converged;
 
-  // ---- Several maximisers? They all give the same q̈* (SPEC §2), so they
+  // ---- Several maximisers? They all give the same q̈* (docs/theory.md §5), so they
   // differ only along null(K_ΘΘ); and g is linear there with slope q̈*_Θ, so a
   // slipping joint (q̈_j ≠ 0) cannot move. The maximisers are μ* + d with d on
   // the sticking joints Σ, K_ΣΣ d = 0, inside the box. Among them pick the one

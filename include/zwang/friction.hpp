@@ -1,4 +1,4 @@
-// Static friction (SPEC §2–§3; the report's chapter 5): the exact
+// Static friction (docs/friction.md; the report's chapter 5): the exact
 // maximum-dissipation motion for any number of stuck joints.
 //
 // Joints with |q̇_j| ≤ velocity_tolerance form the stuck set Θ₀ (k joints).
@@ -12,9 +12,9 @@
 // active-set method (or projected gradient).
 //
 // A stuck joint resting on a position limit gets a one-sided reaction: at the
-// lower limit μ_j ∈ (−∞, f_j], at the upper μ_j ∈ [−f_j, ∞) (SPEC §3).
+// lower limit μ_j ∈ (−∞, f_j], at the upper μ_j ∈ [−f_j, ∞) (docs/friction.md, "Joint position limits").
 //
-// Sign (SPEC): μ_j > 0 opposes positive motion; the joint feels τ_j − μ_j.
+// Sign (docs/conventions.md, "Signs of the outputs"): μ_j > 0 opposes positive motion; the joint feels τ_j − μ_j.
 #pragma once
 
 #include <vector>

@@ -1,4 +1,4 @@
-// The Popov–Vereshchagin constrained hybrid dynamics solver (SPEC §1; the
+// The Popov–Vereshchagin constrained hybrid dynamics solver (docs/solver.md; the
 // report's Algorithm 1, extended to constraints on any number of frames).
 //
 // Minimises the Gauss function Z(q̈) subject to Aᵀ Ẍ = b on the task's frames

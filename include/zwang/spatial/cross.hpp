@@ -1,4 +1,4 @@
-// Spatial cross products in linear-first Plücker coordinates (SPEC):
+// Spatial cross products in linear-first Plücker coordinates (docs/conventions.md):
 //   v×  = [ω×  v×; 0  ω×]   acting on motion vectors,
 //   v×* = -(v×)ᵀ = [ω×  0; v×  ω×]   acting on force vectors.
 #pragma once

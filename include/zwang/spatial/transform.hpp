@@ -4,7 +4,7 @@
 // Transform X = ᴮX_A takes coordinates in frame A to coordinates in frame B:
 //   E : rotation with x_B = E x_A  (so E = ᴮR_A = (ᴬR_B)ᵀ),
 //   r : origin of B, expressed in A.
-// With linear-first vectors (SPEC):
+// With linear-first vectors (docs/conventions.md, "Spatial vectors: linear part first"):
 //   motion  [v; ω]_B = [E(v − r×ω); Eω]
 //   force   [f; n]_B = [E f; E(n − r×f)]
 // The force transform B → A is Xᵀ, which is what `inverseApplyForce` computes.

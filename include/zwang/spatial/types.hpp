@@ -1,6 +1,6 @@
 // Fixed-size Eigen types and the 3-D helpers the spatial algebra is built on.
 // Spatial vectors are 6-vectors in Plücker coordinates, LINEAR PART FIRST:
-// motion [v; ω], force [f; n] (SPEC "Conventions").
+// motion [v; ω], force [f; n] (docs/conventions.md, "Spatial vectors: linear part first").
 #pragma once
 
 #include <Eigen/Core>

@@ -735,7 +735,8 @@ TEST_CASE("KDL conventions: the sign of ν and what constraint_torques are", "[r
     }
     worst_articulated = std::max(worst_articulated, relErr(kdl.constraint_torques_kdl, articulated));
 
-    // Closure (docs/solver.md, "Constraint torques: why not eq. 4.4"): the unconstrained arm driven by τ + τ_c replays q̈;
+    // Closure (docs/solver.md, "Constraint torques: why not eq. 4.4"): the
+    // unconstrained arm driven by τ + τ_c replays q̈;
     // driven by τ + KDL's constraint_torques it does not (except in special
     // draws where the tip wrench loads no distal joint, J_fᵀ W = 0).
     DynamicsInput free = in;

@@ -11,7 +11,6 @@
 
 #include "internal/box_qp.hpp"
 #include "internal/checks.hpp"
-#include "internal/coupling.hpp"
 #include "internal/friction_scratch.hpp"
 #include "internal/growing_cholesky.hpp"
 #include "internal/popov_vereshchagin.hpp"
@@ -297,6 +296,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
     ws.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
     bodyAccelerations(model, task, ws, out.qdd);
   }
+  taskResidual(task, ws);
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(m), out.tau_constraint);
   out.tau_control = tau + out.tau_constraint;

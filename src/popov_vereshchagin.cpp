@@ -11,10 +11,11 @@
 //    i..N, and each body adds its own columns as the inward sweep reaches it.
 #include "internal/popov_vereshchagin.hpp"
 
+#include <cmath>
 #include <limits>
 
 #include "internal/checks.hpp"
-#include "internal/coupling.hpp"
+#include "internal/balance.hpp"
 #include "internal/sweeps.hpp"
 
 namespace zwang::internal {
@@ -35,6 +36,7 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
     return Status::error(StatusCode::WorkspaceTooSmall,
                          "task has %d constraint rows, the workspace was made for at most %d", task.constraintRows(),
                          ws.constraintCapacity());
+  if (Status s = checkBalanceOptions(task.balance); !s) return s;
   if (Status s = checkVector("q", q, model.dof()); !s) return s;
   if (Status s = checkVector("qd", qd, model.dof()); !s) return s;
   if (Status s = checkVector("tau", tau, model.dof()); !s) return s;
@@ -161,9 +163,8 @@ void balance(const Task& task, Workspace& ws) {
     }
   ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);  // line 25 …
   ws.rhs.head(m).noalias() -= ws.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
-  ws.solution.coupling = solveBalance(ws.L.topLeftCorner(m, m), ws.rhs.head(m), ws.nu.head(m),
-                                      ws.balance_factor.topLeftCorner(m, m), ws.eigval.head(m), ws.scratch.head(m),
-                                      task.balance, ws.balance_by_eigen);
+  ws.solution.balance =
+      solveBalance(ws.L.topLeftCorner(m, m), ws.rhs.head(m), ws.nu.head(m), ws.balance_factorisation, task.balance);
 }
 
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
@@ -214,8 +215,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
   du.row(0).setZero();
   dU.topRows(m) *= -1.0;  // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
-  balanceApplyColumns(ws.balance_factor.topLeftCorner(m, m), ws.eigval.head(m), ws.balance_by_eigen,
-                      ws.solution.coupling.damping, dU.topRows(m), dnu.topRows(m));
+  balanceApplyColumns(ws.balance_factorisation, dU.topRows(m), dnu.topRows(m), ws.balance_factorisation.work.head(m));
   da.setZero();
   for (int i = 1; i <= N; ++i) {  // lines 28–29 for the differences
     const Vec6& S = ws.S[at(i)];
@@ -230,6 +230,32 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
       da.col(c) += S * dq;
     }
   }
+}
+
+void taskResidual(const Task& task, Workspace& ws) {
+  // Aᵀ Ẍ − b row by row on the final accelerations. In sweep form both sides
+  // carry the same gravity and velocity shifts (constraintsInBodyForm), so the
+  // difference is the row's error in its own units. A row counts as met when
+  // the error is within residual_tolerance of the size of what it is computed
+  // from: the accelerations it reads, its set point, and the balance's
+  // right-hand side (what the constraint force had to correct).
+  const int m = task.constraintRows();
+  BalanceReport& report = ws.solution.balance;
+  double sum2 = 0.0;
+  bool met = true;
+  int col = 0;
+  for (const Task::ConstraintGroup& g : task.groups()) {
+    const Vec6& a = ws.a[at(g.body)];
+    for (int k = 0; k < g.rows; ++k, ++col) {
+      const auto A = ws.A_body.col(col);
+      const double error = A.dot(a) - ws.b_body[col];
+      const double size = A.cwiseAbs().dot(a.cwiseAbs()) + std::abs(ws.b_body[col]) + std::abs(ws.rhs[col]);
+      sum2 += error * error;
+      met = met && std::abs(error) <= task.balance.residual_tolerance * size;
+    }
+  }
+  report.residual = m > 0 ? std::sqrt(sum2) : 0.0;
+  report.consistent = met;
 }
 
 void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,

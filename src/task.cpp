@@ -1,6 +1,7 @@
 #include "zwang/task.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace zwang {
@@ -63,6 +64,21 @@ void Task::reorder() {
       if (g.body >= body) count += g.rows;
     active_[static_cast<std::size_t>(body)] = count;
   }
+}
+
+Status checkBalanceOptions(const BalanceOptions& o) {
+  // The equilibrated eigenvalues lie in [0, m] with at least one ≥ 1, so a
+  // threshold of 1 or more would call every task singular.
+  if (!(o.singular_threshold > 0.0 && o.singular_threshold < 1.0))
+    return Status::error(StatusCode::BadOption, "balance singular_threshold %g must be in (0, 1)",
+                         o.singular_threshold);
+  if (!(o.rank_tolerance >= 0.0 && o.rank_tolerance < o.singular_threshold))
+    return Status::error(StatusCode::BadOption, "balance rank_tolerance %g must be in [0, singular_threshold = %g)",
+                         o.rank_tolerance, o.singular_threshold);
+  if (!(o.residual_tolerance > 0.0 && std::isfinite(o.residual_tolerance)))
+    return Status::error(StatusCode::BadOption, "balance residual_tolerance %g must be finite and positive",
+                         o.residual_tolerance);
+  return {};
 }
 
 }  // namespace zwang

@@ -31,11 +31,15 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   L_scale.setZero(m);
   A_body.setZero(6, m);
   b_body.setZero(m);
-  balance_factor.setZero(m, m);
-  eigval.setZero(m);
+  balance_factorisation.factor.setZero(m, m);
+  balance_factorisation.eigenvalues.setZero(m);
+  balance_factorisation.gain.setZero(m);
+  balance_factorisation.equilibration.setZero(m);
+  balance_factorisation.near_null_basis.setZero(m, m);
+  balance_factorisation.near_null_weight.setZero(m);
+  balance_factorisation.work.setZero(m);
   rhs.setZero(m);
   nu.setZero(m);
-  scratch.setZero(m);
   a.assign(bodies, Vec6::Zero());
   f.assign(bodies, Vec6::Zero());
   Ic.assign(bodies, Mat6::Zero());

@@ -85,8 +85,8 @@ TEST_CASE("1-DOF arm fully constrained (the report's Fig. 5.5 task): τ_c = I·5
   CHECK(ws.solution.nu[0] == Approx(2.25 * 5.0 - 1.0).epsilon(1e-14));
   CHECK(ws.solution.tau_constraint[0] == Approx(2.25 * 5.0 - 1.0).epsilon(1e-14));
   CHECK(ws.solution.tau_control[0] == Approx(2.25 * 5.0).epsilon(1e-14));
-  CHECK_FALSE(ws.solution.coupling.singular);
-  CHECK(ws.solution.coupling.rank == 1);
+  CHECK_FALSE(ws.solution.balance.singular);
+  CHECK(ws.solution.balance.rank == 1);
 }
 
 TEST_CASE("1-DOF arm: constraints and accelerations are classical (ω×v included)") {

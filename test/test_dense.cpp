@@ -43,7 +43,7 @@ TEST_CASE("hybrid dynamics matches the dense KKT solution on 500+ random chains"
     INFO("chain " << accepted << ": " << spec.dof() << " dof, " << in.constraintRows() << " rows; " << status.message);
     REQUIRE(status.ok());
     const Solution& s = ws.solution;
-    CHECK_FALSE(s.coupling.singular);
+    CHECK_FALSE(s.balance.singular);
     qdd_err.add(relativeError(s.qdd, ref.qdd));
     nu_err.add(relativeError(s.nu, ref.nu));
     tauc_err.add(relativeError(s.tau_constraint, ref.tau_c));

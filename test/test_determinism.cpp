@@ -53,8 +53,8 @@ std::uint64_t solveAll(const Model& model, const Task& task, const DynamicsInput
     hash.add(ws.solution.tau_constraint);
     hash.add(ws.solution.tau_control);
     hash.add(ws.solution.gauss);
-    hash.add(ws.solution.coupling.condition);
-    hash.add(ws.solution.coupling.damping);
+    hash.add(ws.solution.balance.condition);
+    hash.add(ws.solution.balance.damping);
     for (int f = 0; f < static_cast<int>(model.frames().size()); ++f)
       hash.add(accelerationOf(model, ws, f, Expressed::World).data(), sizeof(double) * 6);
   };

@@ -368,8 +368,8 @@ TEST_CASE("indeterminate hold-still on the Panda: friction carries load, effort 
     const Eigen::VectorXd qd = Eigen::VectorXd::Zero(7), tau = Eigen::VectorXd::Zero(7);
     Workspace free_ws(model, task);
     REQUIRE(solveHybridDynamics(model, task, q, qd, tau, free_ws));
-    REQUIRE(free_ws.solution.coupling.rank == 7);  // every joint's acceleration is fixed
-    REQUIRE_FALSE(free_ws.solution.coupling.singular);
+    REQUIRE(free_ws.solution.balance.rank == 7);  // every joint's acceleration is fixed
+    REQUIRE_FALSE(free_ws.solution.balance.singular);
     const Eigen::VectorXd G = free_ws.solution.tau_control;  // gravity torques, held by the motors
     for (double margin : {1.0, 0.5, 0.0}) {
       INFO("pose " << q.transpose() << ", margin " << margin);

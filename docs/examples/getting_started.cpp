@@ -26,6 +26,6 @@ int main(int argc, char** argv) {
                 clean(plain[j]), clean(ws.solution.qdd[j]), clean(ws.solution.tau_control[j]), clean(ws.friction.mu[j]),
                 zwang::toString(ws.friction.state[j]));
   std::printf("|tau|^2: %.1f plain, %.1f with friction; rank %d, singular %s, indeterminate %s\n",
-              plain.squaredNorm(), ws.solution.tau_control.squaredNorm(), ws.solution.coupling.rank,
-              ws.solution.coupling.singular ? "yes" : "no", ws.friction.indeterminate ? "yes" : "no");
+              plain.squaredNorm(), ws.solution.tau_control.squaredNorm(), ws.solution.balance.rank,
+              ws.solution.balance.singular ? "yes" : "no", ws.friction.indeterminate ? "yes" : "no");
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "zwang/model.hpp"
+#include "zwang/status.hpp"
 
 namespace zwang {
 
@@ -24,17 +25,31 @@ enum class Expressed { Local, World, Aligned = World };
 /// A: 6×m, one unit constraint force [l; r] (linear part first) per column.
 using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// Options for the constraint balance ν = L⁻¹(…) (docs/solver.md, "Singular tasks").
-// With λ_max, λ_min the extreme eigenvalues of L:
-//   singular  ⇔ λ_min < singular_threshold · λ_max  (rank counts the eigenvalues above it);
-//   damping   λ = max_damping · λ_max · sqrt(1 − (λ_min / (singular_threshold·λ_max))²) when singular, else 0;
-//   ν = Σ_k σ_k/(σ_k² + λ²) (e_kᵀ r) e_k  over the eigenpairs (σ_k, e_k) of L:
-// exact when L is regular; when singular, the damped least-squares solution
-// (constraints met in the least-squares sense, no force along L's null space).
+// Options of the balance ν = 𝓛⁺ r of Algorithm 1's line 25 (docs/solver.md,
+// "Singular tasks"). 𝓛 is judged after equilibration, 𝓛̃ = E 𝓛 E with
+// E = diag(1/√𝓛_ii), so that rows in metres and radians, on heavy or light
+// links, weigh alike; its eigenvalues σ̃ lie in [0, m].
+//   σ̃ ≥ singular_threshold : solved exactly (every regular task);
+//   σ̃ ≤ rank_tolerance     : exact rank loss: no force along it, and the task
+//                            is met in the least-squares sense (rows' units);
+//   in between             : near-singular: the gain ramps linearly from 0 to
+//                            1/σ̃ (and the least-squares projection from full
+//                            to none), so ν stays bounded (at most
+//                            1/singular_threshold in 𝓛̃'s units) and
+//                            continuous as an arm passes through a singularity.
+// After the solve a row counts as met when |Aᵀ Ẍ − b| ≤ residual_tolerance ×
+// the size of the terms it is computed from (BalanceReport::consistent).
 struct BalanceOptions {
-  double singular_threshold = 1e-9;
-  double max_damping = 1e-5;
+  // Exact null directions come out at ~1e-15 (rounding) and regular ones of
+  // random chains above ~1e-3 (test_singular prints both): a wide gap.
+  double singular_threshold = 1e-6;
+  double rank_tolerance = 1e-11;
+  double residual_tolerance = 1e-9;
 };
+
+/// BadOption naming the field when an option is out of range (every solve
+/// checks the task's options this way).
+Status checkBalanceOptions(const BalanceOptions& options);
 
 /// What a solve is asked to do besides the joint state: see the file comment.
 class Task {
@@ -43,7 +58,7 @@ class Task {
   explicit Task(const Model& model);
 
   Vec3 gravity{0.0, 0.0, -9.81};  ///< world axes [m/s²] (docs/conventions.md, "Gravity")
-  BalanceOptions balance;         ///< singular threshold and damping of the balance
+  BalanceOptions balance;         ///< thresholds of the balance (BalanceOptions)
 
   /// Constrain the classical acceleration of `frame`'s origin along the columns
   /// of A (6×m, unit constraint forces, linear part first): Aᵀ Ẍ = b. b starts

@@ -19,16 +19,44 @@ namespace internal {
 struct FrictionScratch;
 }
 
-// State of the constraint coupling matrix L at the balance (docs/solver.md).
-struct CouplingDiagnostics {
+// How the balance of line 25 went (docs/solver.md, "Singular tasks"). The
+// eigenvalues meant here are those of the equilibrated 𝓛̃ (see BalanceOptions).
+struct BalanceReport {
   int rows = 0;             // m, the number of constraint rows
-  int rank = 0;             // eigenvalues of L above singular_threshold·λ_max
-  // Frobenius condition number ‖L‖_F ‖L⁻¹‖_F (infinite when L is singular):
-  // at least λ_max/λ_min and at most m times it. Computed from the Cholesky
-  // factor in the usual case, from the eigenvalues near a singularity.
+  int rank = 0;             // m minus the directions of exact rank loss (σ̃ ≤ rank_tolerance)
+  // Frobenius condition number ‖𝓛̃‖_F ‖𝓛̃⁻¹‖_F of the equilibrated matrix
+  // (infinite when 𝓛 is singular): at least σ̃_max/σ̃_min and at most m times it.
   double condition = 1.0;
-  double damping = 0.0;     // λ used in ν = (L² + λ²)⁻¹ L r; 0 when not singular
-  bool singular = false;    // the task asked for more than the robot can do here
+  // How far the most damped near-singular direction is from being solved
+  // exactly, in [0, 1): 1 − (σ̃ − rank_tolerance)/(singular_threshold −
+  // rank_tolerance); 0 when every direction was solved exactly or dropped as
+  // exact rank loss.
+  double damping = 0.0;
+  bool singular = false;    // some σ̃ below singular_threshold: a direction was dropped or damped
+  // ‖Aᵀ Ẍ − b‖₂ over the task's rows, in the rows' own units (m/s², rad/s²),
+  // measured on the final accelerations.
+  double residual = 0.0;
+  // Every row met to within residual_tolerance of its terms' size. False for
+  // an inconsistent task (met in the least-squares sense only) and for a
+  // damped direction that had to give.
+  bool consistent = true;
+};
+
+/// The factorisation of the last balance, kept so that further right-hand sides
+/// (the friction extension's unit torques) reuse it (src/balance.cpp).
+struct BalanceFactorisation {
+  bool by_eigen = false;          ///< false: 𝓛 = C Cᵀ (certified regular); true: eigenpairs of 𝓛̃
+  Eigen::MatrixXd factor;         ///< C (lower), or the eigenvectors V of 𝓛̃ (by_eigen)
+  Eigen::VectorXd eigenvalues;    ///< σ̃_k (by_eigen)
+  Eigen::VectorXd gain;           ///< what each eigen-direction is multiplied by: 1/σ̃, damped, or 0
+  Eigen::VectorXd equilibration;  ///< E_ii = 1/√𝓛_ii (1 on a row nothing moves)
+  /// Orthonormal basis of the directions E v_k with σ̃_k below singular_threshold
+  /// (the first `near_null_count` columns), and the weight of each in the
+  /// Euclidean projection: 1 at exact rank loss, falling to 0 at the threshold.
+  Eigen::MatrixXd near_null_basis;
+  Eigen::VectorXd near_null_weight;  ///< the weight of each of those directions (see near_null_basis)
+  int near_null_count = 0;        ///< columns of near_null_basis in use
+  Eigen::VectorXd work;           ///< scratch of balanceApply (V's coordinates)
 };
 
 /// What a solve computes (Workspace::solution).
@@ -41,7 +69,7 @@ struct Solution {
   Eigen::VectorXd tau_constraint;  ///< τ_c = Σ J_iᵀ A_i ν_i, the joint torques of the constraint forces
   Eigen::VectorXd tau_control;     ///< τ + τ_c, what is sent to the motors
   double gauss = 0.0;              ///< Z(q̈), the Gauss function (acceleration energy) at the solution
-  CouplingDiagnostics coupling;    ///< the state of 𝓛 at the balance: rows, rank, condition, damping, singular
+  BalanceReport balance;           ///< how the balance went: rank, condition, damping, residual, consistent
   // The true classical acceleration of any frame (a body's own frame:
   // model.bodyFrame(b)) is computed on demand from the sweep by
   // frameAcceleration() (kinematics.hpp), so a solve does not pay for it.
@@ -97,14 +125,10 @@ class Workspace {
   ConstraintMatrix A_body;  ///< columns of each constraint, as unit forces on its body
   Eigen::VectorXd b_body;   ///< set points as the sweep's (gravity-shifted, spatial) accelerations
 
-  // --- balance (line 25): 𝓛 = C Cᵀ (Cholesky, lower C) when certified regular,
-  // else its eigen-decomposition (src/coupling.cpp)
-  Eigen::MatrixXd balance_factor;  ///< C, or the eigenvectors of 𝓛 when balance_by_eigen
-  Eigen::VectorXd eigval;          ///< eigenvalues of 𝓛 when balance_by_eigen (else scratch)
-  bool balance_by_eigen = false;   ///< the balance used the eigen-decomposition
+  // --- balance (line 25), src/balance.cpp
+  BalanceFactorisation balance_factorisation;  ///< the last balance's factorisation
   Eigen::VectorXd rhs;      ///< b − A_0ᵀẌ_0 − U_0
   Eigen::VectorXd nu;       ///< ν in solver order
-  Eigen::VectorXd scratch;  ///< scratch of the balance
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
   std::vector<Vec6> a;      ///< Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])

@@ -118,9 +118,9 @@ PoseResult run(const Model& model, const Pose& pose) {
     e.sq = e.tau.squaredNorm();
     e.norm = std::sqrt(e.sq);
     e.abs_sum = e.tau.cwiseAbs().sum();
-    r.rank = ws.solution.coupling.rank;
+    r.rank = ws.solution.balance.rank;
     r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
-    if (ws.solution.coupling.singular) throw CliError(kExitError, where + "the hold-still task is singular here");
+    if (ws.solution.balance.singular) throw CliError(kExitError, where + "the hold-still task is singular here");
     // The closed form: τ_control = G(q) + μ with the effort-minimising μ.
     for (int j = 0; j < n; ++j) {
       const double f = variant.margin < 0 ? 0.0 : variant.margin * model.joint(j).breakaway_friction;

@@ -75,6 +75,30 @@ FrictionSpec parseFriction(const JsonReader& in, const Json& value, const std::s
   return f;
 }
 
+// The balance of line 25 (docs/solver.md, "Singular tasks"); the ranges are
+// the library's (checkBalanceOptions), said here with the key's path.
+BalanceOptions parseBalance(const JsonReader& in, const Json& value, const std::string& path) {
+  in.object(value, path, {"singular_threshold", "rank_tolerance", "residual_tolerance"});
+  BalanceOptions o;
+  if (value.contains("singular_threshold")) {
+    const std::string p = childPath(path, "singular_threshold");
+    o.singular_threshold = in.number(value["singular_threshold"], p);
+    if (!(o.singular_threshold > 0.0 && o.singular_threshold < 1.0)) in.fail(p, "must be between 0 and 1 (exclusive)");
+  }
+  if (value.contains("rank_tolerance")) {
+    const std::string p = childPath(path, "rank_tolerance");
+    o.rank_tolerance = in.number(value["rank_tolerance"], p);
+    if (!(o.rank_tolerance >= 0.0 && o.rank_tolerance < o.singular_threshold))
+      in.fail(p, "must be >= 0 and below singular_threshold (" + formatNumber(o.singular_threshold) + ")");
+  }
+  if (value.contains("residual_tolerance")) {
+    const std::string p = childPath(path, "residual_tolerance");
+    o.residual_tolerance = in.number(value["residual_tolerance"], p);
+    if (!(o.residual_tolerance > 0.0)) in.fail(p, "must be positive");
+  }
+  return o;
+}
+
 // Per-joint overrides must be non-negative.
 Eigen::VectorXd nonNegative(const JsonReader& in, const Json& value, const std::string& path) {
   Eigen::VectorXd v = in.numbers(value, path);
@@ -104,7 +128,7 @@ Problem readProblem(const std::string& file) {
   if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
   in.object(doc, "",
             {"model", "root", "tip", "gravity", "q", "qd", "tau", "rotor_inertia", "breakaway", "wrenches",
-             "constraints", "friction"});
+             "constraints", "friction", "balance"});
 
   Problem p;
   p.file = file;
@@ -134,6 +158,7 @@ Problem readProblem(const std::string& file) {
       p.constraints.push_back(parseConstraint(in, list[k], childPath("constraints", k)));
   }
   if (doc.contains("friction")) p.friction = parseFriction(in, doc["friction"], "friction");
+  if (doc.contains("balance")) p.balance = parseBalance(in, doc["balance"], "balance");
   if (p.breakaway && !p.friction.present)
     in.fail("breakaway", "has no effect without a \"friction\" section (add \"friction\": {} to solve with friction)");
   return p;
@@ -187,6 +212,7 @@ BoundProblem bindProblem(const Problem& p) {
   b.task = std::make_unique<Task>(m);
   Task& task = *b.task;
   if (p.gravity) task.gravity = *p.gravity;
+  task.balance = p.balance;
 
   auto frameIndex = [&](const std::string& name, const std::string& path) {
     if (!m.hasFrame(name))

@@ -42,6 +42,7 @@ struct Problem {
   std::vector<WrenchSpec> wrenches;
   std::vector<ConstraintSpec> constraints;
   FrictionSpec friction;
+  BalanceOptions balance;  // "balance" (defaults when absent)
 };
 
 // Read, parse and check a problem file; CliError "FILE: PATH: what" on any fault.

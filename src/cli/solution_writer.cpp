@@ -77,8 +77,10 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
                        {"iterations", f.iterations},
                        {"kkt_residual", f.kkt_residual}};
   }
-  out["status"] = {{"singular", s.coupling.singular},
-                   {"rank", s.coupling.rank},
+  out["status"] = {{"singular", s.balance.singular},
+                   {"rank", s.balance.rank},
+                   {"residual", s.balance.residual},
+                   {"consistent", s.balance.consistent},
                    {"infeasible", status.code == StatusCode::Infeasible}};
   Json frame_map = Json::object();
   for (const int f : frames) {

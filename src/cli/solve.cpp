@@ -29,6 +29,9 @@ int commandSolve(int argc, char** argv) {
 
   const Json solution = solutionJson(bound.model, ws, bound.with_friction, status, bound.reported_frames);
   writeOutput(output, (args.has("--pretty") ? prettyDump(solution) : solution.dump()) + "\n");
+  if (!ws.solution.balance.consistent)  // met only in the least-squares sense, or a damped direction gave
+    std::fprintf(stderr, "zwang: warning: %s: the task is not met: |A^T Xdd - b| = %.3g (status.consistent = false)\n",
+                 problem.file.c_str(), ws.solution.balance.residual);
   if (infeasible) {
     std::fprintf(stderr, "zwang: %s: infeasible: %s\n", problem.file.c_str(), status.message);
     return kExitInfeasible;

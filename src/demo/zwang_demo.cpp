@@ -61,8 +61,8 @@ int main(int argc, char** argv) {
     printVector("tau_control [Nm]", s.tau_control);
     std::printf("  tool acceleration (check 0)  %9.2e\n", a_tool.norm());
     std::printf("  Gauss function Z            %9.4f\n", s.gauss);
-    std::printf("  coupling L: rows %d, rank %d, condition %.3g, damping %.3g, singular %s\n", s.coupling.rows,
-                s.coupling.rank, s.coupling.condition, s.coupling.damping, s.coupling.singular ? "yes" : "no");
+    std::printf("  balance (line 25): rows %d, rank %d, condition %.3g, damping %.3g, singular %s\n", s.balance.rows,
+                s.balance.rank, s.balance.condition, s.balance.damping, s.balance.singular ? "yes" : "no");
 
     // For comparison: holding every joint still takes the gravity torques.
     zwang::Task free_task(model);

@@ -13,7 +13,7 @@ namespace zwang::internal {
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
 using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// Input checks shared by every solve.
+// Input checks shared by every solve (the balance options included).
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
                         const VectorRef& tau, const Workspace& ws);
 
@@ -25,8 +25,9 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 // Fails (Degenerate) when a joint has no inertia to move.
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws);
 
-// Line 25: ν = 𝓛⁻¹(b − A₀ᵀẌ₀ − U₀) into ws.nu (solver order), factoring 𝓛
-// (kept in ws.balance_factor for unitTorqueColumns) and filling ws.solution.coupling.
+// Line 25: ν = 𝓛⁺(b − A₀ᵀẌ₀ − U₀) into ws.nu (solver order), factoring 𝓛
+// (kept in ws.balance_factorisation for unitTorqueColumns) and filling
+// ws.solution.balance (all but the residual: see taskResidual).
 void balance(const Task& task, Workspace& ws);
 
 // Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.
@@ -44,6 +45,10 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
                        Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
                        Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da);
+
+// After the final accelerations (ws.a): ‖Aᵀ Ẍ − b‖ and whether every row is
+// met, into ws.solution.balance.
+void taskResidual(const Task& task, Workspace& ws);
 
 // τ_c = Σ J_iᵀ A_i ν_i for ν in solver order (one inward pass of the wrenches A ν).
 void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,

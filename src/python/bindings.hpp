@@ -75,6 +75,10 @@ struct Friction {
   FrictionOptions options;
 };
 
+struct Balance {
+  BalanceOptions options;
+};
+
 struct PyWorkspace {
   PyWorkspace(std::shared_ptr<Model> model, int max_constraint_rows);
 

@@ -183,6 +183,14 @@ const FrictionOptions* frictionArg(py::handle friction) {
                              std::string(py::str(py::type::handle_of(friction).attr("__name__"))));
 }
 
+const BalanceOptions& balanceArg(py::handle balance) {
+  static const BalanceOptions defaults;
+  if (balance.is_none()) return defaults;
+  if (py::isinstance<Balance>(balance)) return balance.cast<Balance&>().options;
+  raise(PyExc_TypeError, "balance: expected zwang.Balance(...) or None, got " +
+                             std::string(py::str(py::type::handle_of(balance).attr("__name__"))));
+}
+
 Eigen::VectorXd optionalOverride(const char* name, py::handle value) {
   if (value.is_none()) return {};
   Eigen::VectorXd buffer;
@@ -213,9 +221,9 @@ py::array bodyAccelerations(const Result& r, Expressed e) {
 
 std::string resultRepr(const Result& r) {
   const Solution& s = r.solution();
-  std::string text = "<zwang.Result dof=" + std::to_string(s.qdd.size()) + " rows=" + std::to_string(s.coupling.rows);
+  std::string text = "<zwang.Result dof=" + std::to_string(s.qdd.size()) + " rows=" + std::to_string(s.balance.rows);
   if (r.with_friction) text += " friction" + std::string(r.friction().indeterminate ? " (indeterminate)" : "");
-  if (s.coupling.singular) text += " singular";
+  if (s.balance.singular) text += " singular";
   if (r.infeasible) text += " infeasible";
   return text + (r.data ? " copy>" : ">");
 }
@@ -394,6 +402,31 @@ void bindSolve(py::module_& m) {
         return "<zwang.Friction margin=" + std::string(py::str(py::float_(f.options.margin))) + ">";
       });
 
+  // ---- Balance -------------------------------------------------------------
+  py::class_<Balance>(m, "Balance",
+                      "Options of the balance of line 25 (zwang::BalanceOptions; docs/solver.md, 'Singular tasks'):\n"
+                      "equilibrated eigenvalues at or below rank_tolerance are exact rank loss (least squares, no\n"
+                      "force), below singular_threshold near-singular (a continuous, bounded ramp); a row is met when\n"
+                      "its residual is within residual_tolerance of its terms' size (Result.consistent).")
+      .def(py::init([](double singular_threshold, double rank_tolerance, double residual_tolerance) {
+             Balance b;
+             b.options.singular_threshold = singular_threshold;
+             b.options.rank_tolerance = rank_tolerance;
+             b.options.residual_tolerance = residual_tolerance;
+             if (const Status s = checkBalanceOptions(b.options); !s) raise(PyExc_ValueError, s.message);
+             return b;
+           }),
+           py::kw_only(), py::arg("singular_threshold") = BalanceOptions{}.singular_threshold,
+           py::arg("rank_tolerance") = BalanceOptions{}.rank_tolerance,
+           py::arg("residual_tolerance") = BalanceOptions{}.residual_tolerance)
+      .def_property_readonly("singular_threshold", [](const Balance& b) { return b.options.singular_threshold; })
+      .def_property_readonly("rank_tolerance", [](const Balance& b) { return b.options.rank_tolerance; })
+      .def_property_readonly("residual_tolerance", [](const Balance& b) { return b.options.residual_tolerance; })
+      .def("__repr__", [](const Balance& b) {
+        return "<zwang.Balance singular_threshold=" + std::string(py::str(py::float_(b.options.singular_threshold))) +
+               " rank_tolerance=" + std::string(py::str(py::float_(b.options.rank_tolerance))) + ">";
+      });
+
   // ---- Result --------------------------------------------------------------
   py::class_<Result>(m, "Result",
                      "What solve() computed. Arrays are read-only NumPy views on the workspace (no copy), valid\n"
@@ -407,11 +440,15 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("nu", [](const Result& r) { return vectorCopy(r.solution().nu); },
                              "ν, constraint magnitudes in constraint order (a copy: its length follows the task)")
       .def_property_readonly("gauss", [](const Result& r) { return r.solution().gauss; }, "Z(q̈)")
-      .def_property_readonly("rows", [](const Result& r) { return r.solution().coupling.rows; })
-      .def_property_readonly("rank", [](const Result& r) { return r.solution().coupling.rank; })
-      .def_property_readonly("condition", [](const Result& r) { return r.solution().coupling.condition; })
-      .def_property_readonly("damping", [](const Result& r) { return r.solution().coupling.damping; })
-      .def_property_readonly("singular", [](const Result& r) { return r.solution().coupling.singular; })
+      .def_property_readonly("rows", [](const Result& r) { return r.solution().balance.rows; })
+      .def_property_readonly("rank", [](const Result& r) { return r.solution().balance.rank; })
+      .def_property_readonly("condition", [](const Result& r) { return r.solution().balance.condition; })
+      .def_property_readonly("damping", [](const Result& r) { return r.solution().balance.damping; })
+      .def_property_readonly("singular", [](const Result& r) { return r.solution().balance.singular; })
+      .def_property_readonly("residual", [](const Result& r) { return r.solution().balance.residual; },
+                             "‖Aᵀ Ẍ − b‖ over the constraint rows, in their own units")
+      .def_property_readonly("consistent", [](const Result& r) { return r.solution().balance.consistent; },
+                             "every constraint row met (False: least squares only, or a damped direction gave)")
       .def_property_readonly("body_acc_local", [](const Result& r) { return bodyAccelerations(r, Expressed::Local); },
                              "(bodies, 6) true classical accelerations of the body frames, body axes (a new array)")
       .def_property_readonly("body_acc_world", [](const Result& r) { return bodyAccelerations(r, Expressed::World); },
@@ -480,10 +517,13 @@ void bindSolve(py::module_& m) {
 
   // ---- solve ---------------------------------------------------------------
   m.def("solve", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
-                    py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity) {
+                    py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
+                    py::handle balance) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const FrictionOptions* options = frictionArg(friction);
+    const BalanceOptions& balance_options = balanceArg(balance);
     Task& task = solveTask(pw, constraints, wrenches, gravity);
+    task.balance = balance_options;
     const auto qv = vectorArg("q", q, pw.q_buf);
     const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
     const auto tauv = optionalVector("tau", tau, pw.tau_buf, pw.zeros);
@@ -506,11 +546,12 @@ void bindSolve(py::module_& m) {
     return r;
   }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
         py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
-        py::arg("friction") = py::none(), py::arg("gravity") = py::none(),
+        py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("balance") = py::none(),
         "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
         "q, qd, tau: one entry per joint (qd, tau default to zeros); float64 arrays are read in place.\n"
         "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
-        "gravity: 3-vector, default (0, 0, -9.81). The task is rebuilt only when the constraint or wrench\n"
+        "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
+        "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
         "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
         "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions).");
 

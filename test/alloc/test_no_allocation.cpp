@@ -60,7 +60,7 @@ TEST_CASE("a singular task (damped balance) allocates nothing") {
   Workspace ws(model, task);
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7), qd = Eigen::VectorXd::Zero(7), tau = Eigen::VectorXd::Zero(7);
   REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
-  CHECK(ws.solution.coupling.singular);
+  CHECK(ws.solution.balance.singular);
   bool ok = false;
   CHECK(allocationsDuring([&] { ok = solveHybridDynamics(model, task, q, qd, tau, ws).ok(); }) == 0);
   CHECK(ok);

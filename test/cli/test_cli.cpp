@@ -245,6 +245,28 @@ TEST_CASE("An infeasible task: the solution with status.infeasible, exit code 3"
   CHECK(contains(r.err, "upper limit"));
 }
 
+TEST_CASE("A task the arm cannot meet: least squares, status.residual and consistent, a warning", "[golden]") {
+  // The 1-DOF arm at rest, its tip asked for 2 m/s² along the link (no joint
+  // can give that) and 0.5 m/s² across it: the across row is met (q̈ = 0.5),
+  // the along row is the least-squares residual, no force pushes along it.
+  const Run r = run({"solve", problem("arm_unreachable.json")});
+  INFO("stderr: " << r.err);
+  CHECK(r.exit_code == 0);
+  CHECK(contains(r.err, "zwang: warning: "));
+  CHECK(contains(r.err, "arm_unreachable.json: the task is not met"));
+  const Json s = parse(r.out);
+  CHECK(numbers(s["qdd"])[0] == Approx(0.5).epsilon(1e-12));
+  CHECK(std::abs(numbers(s["nu"])[0]) < 1e-12);
+  CHECK(s["status"]["singular"] == true);
+  CHECK(s["status"]["rank"] == 1);
+  CHECK(s["status"]["consistent"] == false);
+  CHECK(s["status"]["residual"].get<double>() == Approx(2.0).epsilon(1e-12));
+  // The regular golden problems report a met task.
+  const Json hold = solve(problem("panda_hold.json"));
+  CHECK(hold["status"]["consistent"] == true);
+  CHECK(hold["status"]["residual"].get<double>() < 1e-12);
+}
+
 // ---------------------------------------------------------------------------
 // Every error path: exit code and a one-line message naming file, path and what.
 
@@ -278,6 +300,9 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_missing_frame_key.json", {": constraints[0]: missing key \"frame\""}},
       {"err_no_directions.json", {": constraints[0].directions: needs at least one direction"}},
       {"err_bad_tip.json", {": model: ", "nowhere"}},
+      {"err_balance_threshold.json", {": balance.singular_threshold: must be between 0 and 1"}},
+      {"err_balance_rank.json", {": balance.rank_tolerance: must be >= 0 and below singular_threshold (0.0001)"}},
+      {"err_balance_key.json", {": balance.max_damping: unknown key"}},
   };
   for (const Case& c : cases) {
     SECTION(c.file) {

@@ -212,3 +212,16 @@ print("ok", count)
     out = subprocess.run([sys.executable, "-c", code, str(PANDA)], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.startswith("ok")
+
+
+def test_balance_options_out_of_range(panda, ws):
+    with pytest.raises(ValueError, match=r"singular_threshold 0 must be in \(0, 1\)"):
+        zwang.Balance(singular_threshold=0)
+    with pytest.raises(ValueError, match="rank_tolerance 0.001 must be in"):
+        zwang.Balance(singular_threshold=1e-4, rank_tolerance=1e-3)
+    with pytest.raises(ValueError, match="residual_tolerance nan must be finite and positive"):
+        zwang.Balance(residual_tolerance=float("nan"))
+    with pytest.raises(TypeError, match="balance: expected zwang.Balance"):
+        solve(panda, ws, balance={"singular_threshold": 1e-6})
+    with pytest.raises(TypeError):
+        zwang.Balance(1e-6)  # keyword-only

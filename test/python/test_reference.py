@@ -154,3 +154,23 @@ def test_pendulum_rnea_crba_kinematics(panda):
     qd = np.linspace(-0.5, 0.5, 7)
     np.testing.assert_allclose(zwang.frame_velocity(panda, ws, q, qd, "tool0", "world"), J @ qd, atol=1e-12)
     assert math.isclose(T0[3, 3], 1.0)
+
+
+def test_unreachable_row_least_squares_reported(arm):
+    """The 1-DOF arm at rest, its tip asked for 2 m/s² along the link (out of
+    reach) and 0.5 m/s² across it: the across row is met, the along row is the
+    least-squares residual with no force along it, and the result says so."""
+    ws = arm.workspace()
+    A = np.zeros((6, 2))
+    A[0, 0] = A[1, 1] = 1.0
+    c = zwang.Constraint("tip", A, b=[2.0, 0.5], expressed="local")
+    res = zwang.solve(arm, ws, [0.0], [0.0], [0.0], constraints=[c], gravity=[0, 0, 0],
+                      balance=zwang.Balance(singular_threshold=1e-5))
+    assert res.qdd[0] == pytest.approx(0.5, rel=1e-12)
+    assert abs(res.nu[0]) < 1e-12
+    assert res.singular and res.rank == 1
+    assert not res.consistent
+    assert res.residual == pytest.approx(2.0, rel=1e-12)
+    held = zwang.solve(arm, ws, [0.0], [0.0], [0.0], constraints=[zwang.Constraint("tip", A[:, 1:], b=[0.5])],
+                       gravity=[0, 0, 0])
+    assert held.consistent and held.residual < 1e-12

@@ -199,14 +199,14 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   dF.setZero();  // δF^A arriving at body i from its child, per column
   Eigen::Index first = k;
   for (int i = N; i >= 1; --i) {
-    while (first > 0 && joints[static_cast<std::size_t>(first - 1)] + 1 >= i) --first;
+    while (first > 0 && bodyOfJoint(joints[static_cast<std::size_t>(first - 1)]) >= i) --first;
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
     const double inverse_D = 1.0 / ws.D[at(i)];
     const int ki = task.activeColumns(i);
     for (Eigen::Index c = 0; c < first; ++c) du(i, c) = 0.0;
     for (Eigen::Index c = first; c < k; ++c) {
-      const double du_ic = (joints[static_cast<std::size_t>(c)] + 1 == i ? 1.0 : 0.0) - S.dot(dF.col(c));
+      const double du_ic = (bodyOfJoint(joints[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
       du(i, c) = du_ic;
       const double du_D = du_ic * inverse_D;
       for (int r = 0; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20

@@ -1,0 +1,57 @@
+// When μ* is not unique (docs/friction.md, "When μ* is not unique"): every
+// maximiser of g gives the same q̈*, so they differ only along null(K_ΣΣ), Σ
+// the stuck joints that stick at μ*. Among them pick the one that minimises
+// the motors' effort within the margin box.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "internal/box_qp.hpp"
+
+namespace zwang::internal {
+
+// Scratch of the choice, sized once for n joints. Indices a run over Θ₀ (the
+// k stuck joints), s over Σ ⊆ Θ₀ (the ns sticking ones).
+struct MaximiserChoiceScratch {
+  explicit MaximiserChoiceScratch(int n)
+      : qdd_star(n), sticking(n), K_sticking(n, n), null_basis(n, n), pivots(n), mu_first(n), lo(n), hi(n),
+        curvature_direction(n), mu_chosen(n), target(n), z(n), z_target(n), qp(n) {}
+  Eigen::VectorXd qdd_star;             // q̈*_Θ = q̈_Θ(0) − K_ΘΘ μ* (k)
+  Eigen::VectorXi sticking;             // position in Θ₀ of each sticking joint (ns)
+  Eigen::MatrixXd K_sticking;           // K_ΣΣ (ns × ns), factored in place by nearNullSpace
+  Eigen::MatrixXd null_basis;           // N: orthonormal basis of null(K_ΣΣ) (ns × nullity)
+  Eigen::VectorXi pivots;               // nearNullSpace's pivot order
+  Eigen::VectorXd mu_first;             // μ* on Σ as the maximiser returned it
+  Eigen::VectorXd lo, hi;               // Λ on Σ, then the margin box
+  Eigen::VectorXd curvature_direction;  // v ⟂ N when K_ΣΣ has rank one
+  Eigen::VectorXd mu_chosen;            // the maximiser being moved (on Σ)
+  Eigen::VectorXd target;               // the point it is moved closest to
+  Eigen::VectorXd z, z_target;          // μ = μ_chosen + N z, and Nᵀ(target − μ_chosen)
+  QpScratch qp;                         // of the least-distance solvers
+};
+
+// Step 1: the sticking joints Σ (|q̈*_j| ≤ acc_tolerance) and the directions
+// of K_ΣΣ along which g is flat to within acc_tolerance over the whole box.
+// K (k × k), the QP's linear term qdd0_stuck (q̈_Θ(0)), its result mu and the
+// box Λ = [lo, hi] are on Θ₀. Returns the nullity (0: μ* is unique); fills
+// s.sticking, s.null_basis and the count of sticking joints `ns`.
+Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
+                            const Eigen::Ref<const Eigen::VectorXd>& qdd0_stuck,
+                            const Eigen::Ref<const Eigen::VectorXd>& mu, const Eigen::Ref<const Eigen::VectorXd>& lo,
+                            const Eigen::Ref<const Eigen::VectorXd>& hi, double acc_tolerance,
+                            MaximiserChoiceScratch& s, Eigen::Index& ns);
+
+// Step 2, when flatDirections found a nullity > 0: (a) the smallest maximiser
+// as a reference point, (b) the one minimising ‖h + μ‖² on Σ within the margin
+// box |μ_j| ≤ margin_limit_j, where h_a = τ_control,a − μ*_a is what the
+// motor of stuck joint a would carry without friction (fixed on the set).
+// Overwrites mu on Σ; returns whether the maximisers form more than a point
+// (indeterminate). margin_limit and effort_offset are on Θ₀; mu_scale is the
+// size below which two maximisers count as the same.
+bool leastEffortMaximiser(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                          const Eigen::Ref<const Eigen::VectorXd>& margin_limit,
+                          const Eigen::Ref<const Eigen::VectorXd>& effort_offset, Eigen::Index ns,
+                          Eigen::Index nullity, double mu_scale, int max_iterations, Eigen::Ref<Eigen::VectorXd> mu,
+                          MaximiserChoiceScratch& s);
+
+}  // namespace zwang::internal

@@ -117,7 +117,9 @@ class Workspace {
   std::vector<double> u;             ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
   Eigen::MatrixXd SA;                ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
   ConstraintMatrix Ahat;             ///< A_i (6 × capacity), updated in place from A_N down to A_0
-  Eigen::VectorXd U;                 ///< U_0, acceleration energy of bias forces and torques
+  /// U_0, acceleration energy of bias forces and torques: the report's U (not
+  /// Featherstone's or Pinocchio's U = I^A S, which is IAS here).
+  Eigen::VectorXd U;
   Eigen::VectorXd L_scale;           ///< Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
   Eigen::MatrixXd L;                 ///< 𝓛_0, constraint coupling matrix (capacity², lower triangle)
 

@@ -26,11 +26,6 @@ inline Transform framePlacementInBase(const Model& model, const Workspace& ws, i
   return f.placement * ws.Xworld[static_cast<std::size_t>(f.body)];
 }
 
-// World-frame rotation ᵂR_f of a frame, after outwardKinematics.
-inline Mat3 frameRotation(const Model& model, const Workspace& ws, int frame) {
-  return framePlacementInBase(model, ws, frame).E.transpose();
-}
-
 // A spatial force given at a frame's origin (local or world axes), in base
 // coordinates: [f; n + p × f] with p the frame origin, all in world axes.
 inline Vec6 wrenchInBase(const Model& model, const Workspace& ws, int frame, Expressed expressed, const Vec6& w) {

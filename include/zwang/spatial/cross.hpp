@@ -20,16 +20,4 @@ inline Vec6 crossForce(const Vec6& v, const Vec6& f) {
   return stack(w.cross(lin(f)), w.cross(ang(f)) + Vec3(lin(v)).cross(lin(f)));
 }
 
-/// The 6×6 matrices, for tests and for code that needs the operator itself.
-inline Mat6 crossMotionMatrix(const Vec6& v) {
-  Mat6 x = Mat6::Zero();
-  x.topLeftCorner<3, 3>() = skew(ang(v));
-  x.topRightCorner<3, 3>() = skew(lin(v));
-  x.bottomRightCorner<3, 3>() = skew(ang(v));
-  return x;
-}
-
-/// The 6×6 matrix of v×* = −(v×)ᵀ.
-inline Mat6 crossForceMatrix(const Vec6& v) { return -crossMotionMatrix(v).transpose(); }
-
 }  // namespace zwang::spatial

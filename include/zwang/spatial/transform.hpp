@@ -61,12 +61,6 @@ struct Transform {
     return stack(fl, E.transpose() * ang(f) + r.cross(fl));
   }
 
-  /// Columnwise versions for 6×m blocks of force vectors (constraint directions).
-  template <class In, class Out>
-  void inverseApplyForceColumns(const In& F, Out&& out) const {
-    for (Eigen::Index k = 0; k < F.cols(); ++k) out.col(k) = inverseApplyForce(F.col(k));
-  }
-
   /// Xᵀ I X: a 6×6 symmetric (articulated) inertia given in B, expressed in A.
   /// With I = [M H; Hᵀ C] and X = blkdiag(E,E)·[1 −r×; 0 1]: rotate the blocks
   /// (M' = EᵀME, H' = EᵀHE, C' = EᵀCE), then shift:

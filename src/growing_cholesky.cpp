@@ -1,3 +1,12 @@
+// Cholesky factors that grow and shrink by one index, and a rank-revealing
+// null space, for the friction maximiser. Against the textbook updates
+// (Golub & Van Loan, Matrix Computations, §6.5):
+//  * the factor is of a principal submatrix P_FF chosen index by index, so
+//    "adding a column" is one forward substitution (schurPivot) whose Schur
+//    pivot the caller judges first: a dependent index never enters;
+//  * L is kept as U = Lᵀ so that the substitutions read contiguous columns;
+//  * removal shifts U's columns left and folds the sub-diagonal back with one
+//    Givens rotation per row (no refactorisation).
 #include "internal/growing_cholesky.hpp"
 
 #include <cmath>

@@ -265,7 +265,7 @@ void runStress() {
       REQUIRE(finiteSolution(ws.solution));
       const bool singular = ws.solution.balance.singular;
       const double condition = ws.solution.balance.condition;
-      INFO("coupling condition " << condition);
+      INFO("balance condition " << condition);
       if (kind == TaskKind::RepeatedRow || kind == TaskKind::OnBase || kind == TaskKind::NearSingular ||
           (kind == TaskKind::OverConstrained && n < 6))
         CHECK(singular);

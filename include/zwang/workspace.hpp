@@ -121,7 +121,7 @@ class Workspace {
   /// Featherstone's or Pinocchio's U = I^A S, which is IAS here).
   Eigen::VectorXd U;
   Eigen::VectorXd L_scale;           ///< Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
-  Eigen::MatrixXd L;                 ///< 𝓛_0, constraint coupling matrix (capacity², lower triangle)
+  Eigen::MatrixXd L;                 ///< 𝓛_0, the balance matrix of line 25 (capacity², lower triangle)
 
   // --- the task in sweep form, solver column order (see Task::groups)
   ConstraintMatrix A_body;  ///< columns of each constraint, as unit forces on its body

@@ -1,6 +1,12 @@
 // Small dense convex QPs for the friction maximiser (no allocation: all
 // memory comes from a scratch sized once for n variables).
+//   src/box_qp.cpp                    shared: the reach rule, the KKT residual
+//   src/box_qp_active_set.cpp         boxQpActiveSet (the default maximiser)
+//   src/box_qp_projected_gradient.cpp boxQpProjectedGradient
+//   src/least_distance.cpp            leastDistanceQp, leastDistanceOnHyperplane
 #pragma once
+
+#include <cmath>
 
 #include <Eigen/Core>
 
@@ -8,18 +14,71 @@
 
 namespace zwang::internal {
 
+// The reach rule of both box-QP maximisers: a variable with an infinite bound
+// that travels kReach times the problem's own scale (reachScale) is running
+// off to infinity. Its curvature is rounding (a zero computed as a tiny
+// number next to P's other entries), not physics: along a curvature κ the
+// minimiser lies within ‖c‖∞/κ, so a rounding-level κ ~ ε·L ≈ 1e-16·L sends
+// it to ~1e16 times the scale, while 1e12 still admits real curvatures down
+// to 1e-12·L: four orders of margin above rounding. One constant, so that
+// the two methods agree on what is unbounded.
+inline constexpr double kReach = 1e12;
+
+// Scratch of boxQpActiveSet (k ≤ n variables).
+struct ActiveSetScratch {
+  explicit ActiveSetScratch(int n);
+  Eigen::VectorXd gradient;        // n, ∇φ = P x − c
+  Eigen::VectorXd gradient_noise;  // n, a bound on the rounding of each ∇φ_j
+  Eigen::VectorXd row_sums;        // n, Σ_l |P_jl| (for gradient_noise and λ_max(P))
+  Eigen::VectorXi fixed;           // n, 1 for a variable not in F
+  Eigen::VectorXd step;            // n, the Newton step on F, in F's order
+  Eigen::VectorXd direction;       // n, the zero-curvature direction on F, in F's order
+  Eigen::VectorXd delta;           // n, the projected Newton step Δ (zero off F)
+  Eigen::VectorXd P_delta;         // n, P Δ
+  GrowingCholesky free_factor;     // of P_FF, F the free variables
+};
+
+// Scratch of boxQpProjectedGradient.
+struct ProjectedGradientScratch {
+  explicit ProjectedGradientScratch(int n);
+  Eigen::VectorXd inverse_diagonal;       // n, D⁻¹ (the Jacobi metric)
+  Eigen::VectorXd root_inverse_diagonal;  // n, D^-1/2 (for L̃)
+  Eigen::VectorXd gradient;               // n, ∇φ at the extrapolated point y
+  Eigen::VectorXd y;                      // n, the extrapolated point
+  Eigen::VectorXd x_previous;             // n, the previous iterate
+  Eigen::VectorXd x_change;               // n, x − x_previous (momentum and restart test)
+  Eigen::VectorXd Px, Px_previous, Py;    // n, products with P
+};
+
+// Scratch of leastDistanceQp (k ≤ n joints, q ≤ n unknowns, ≤ 2n rows).
+struct LeastDistanceScratch {
+  explicit LeastDistanceScratch(int n);
+  Eigen::MatrixXd rows;          // n × 2n, constraint row r as column r (contiguous)
+  Eigen::VectorXd row_bounds;    // 2n, d_r of "row_r · z ≤ d_r"
+  Eigen::MatrixXd gram;          // 2n × 2n, C Cᵀ, filled as rows join W
+  Eigen::VectorXd row_dot_a;     // 2n, C a, filled as rows join W
+  Eigen::VectorXi working;       // 2n, 1 for a row in W
+  Eigen::VectorXd multipliers;   // n, λ_W
+  Eigen::VectorXd step;          // n, towards the subproblem's minimum z'
+  Eigen::VectorXd point;         // n, x0 + N z, per joint
+  Eigen::VectorXd rate;          // n, N·step, per joint
+  GrowingCholesky working_factor;  // of C_W C_Wᵀ
+};
+
+// Scratch of leastDistanceOnHyperplane.
+struct HyperplaneScratch {
+  explicit HyperplaneScratch(int n);
+  Eigen::VectorXd breakpoints;     // 2n, distances |λ| where a term enters or leaves
+  Eigen::VectorXi breakpoint_kind;  // 2n, 2i + (1 when term i becomes free there, 0 when it stops)
+};
+
+// All the solvers' scratch: callers construct it with n and pass it on.
 struct QpScratch {
   explicit QpScratch(int n = 0);
-  Eigen::VectorXd lambda, g, p, t1, t2;  // n
-  Eigen::VectorXd Px, Px_prev, Py;       // n, products with P (projected gradient)
-  Eigen::MatrixXd Ct;                    // n × 2n, constraint rows as columns (least-distance QP)
-  Eigen::VectorXd d;                     // 2n
-  Eigen::VectorXi fixed;                 // n, 1 for a fixed variable (active set)
-  Eigen::MatrixXd gram;                  // 2n × 2n, C Cᵀ (least-distance QP)
-  Eigen::VectorXd Ca;                    // 2n
-  Eigen::VectorXi active;                // 2n, working rows (least-distance QP)
-  GrowingCholesky factor;                // of P_FF, F the free variables (active set)
-  GrowingCholesky row_factor;            // of C_W C_Wᵀ, W the working rows (least-distance QP)
+  ActiveSetScratch active_set;
+  ProjectedGradientScratch projected_gradient;
+  LeastDistanceScratch least_distance;
+  HyperplaneScratch hyperplane;
 };
 
 struct QpReport {
@@ -39,7 +98,7 @@ struct QpReport {
 // with F, along the zero-curvature direction straight to the next bound.
 // `tolerance` is on the projected gradient (plus the rounding of ∇φ).
 // Invariant under diagonal scaling of the variables: badly scaled P is fine.
-// A variable on an infinite bound that travels 1e12 times the problem's scale
+// A variable on an infinite bound that travels kReach times the problem's scale
 // max(1, largest finite bound, ‖c‖∞ / max(L, curvature_scale)), L ≥ λ_max(P),
 // is reported unbounded (its curvature is rounding). `curvature_scale` is the
 // size of the terms P was computed from, when the caller knows it: a P that
@@ -64,10 +123,24 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
 double reachScale(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                   const Eigen::Ref<const Eigen::VectorXd>& c, double lambda_max_bound, double curvature_scale);
 
-// The largest violation of the optimality conditions, in the units of ∇φ:
-// |∇φ_j| of a free variable, ∇φ_j pointing into the room of one on a bound
-// (x_j = lo_j needs ∇φ_j ≥ 0, x_j = hi_j needs ∇φ_j ≤ 0); zero exactly at a
-// minimiser. Unlike ‖x − clamp(x − ∇φ)‖∞ it does not mix the units of x and ∇φ.
+// How far ∇φ_j = g violates optimality at x_j, in the units of ∇φ, whatever
+// the units of x: a free variable's |g|, a bounded one's g pointing into its
+// room (x_j = lo_j needs g ≥ 0, x_j = hi_j needs g ≤ 0); zero on a point box.
+// Inline: it runs once per variable in the solvers' inner loops.
+inline double kktViolation(double g, double x, double lo, double hi) {
+  return lo == hi ? 0.0 : x <= lo ? -g : x >= hi ? g : std::abs(g);
+}
+
+// Does ∇φ_j = g point into x_j's room by more than its rounding `noise` plus
+// `tolerance`, i.e. would moving x_j lower φ? (NaN counts as yes, so that a
+// broken gradient is not mistaken for optimality.)
+inline bool pointsIntoRoom(double g, double noise, double x, double lo, double hi, double tolerance) {
+  return lo != hi && !(kktViolation(g, x, lo, hi) - noise <= tolerance);
+}
+
+// The largest violation of the optimality conditions, max_j kktViolation;
+// zero exactly at a minimiser. Unlike ‖x − clamp(x − ∇φ)‖∞ it does not mix
+// the units of x and ∇φ.
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         const Eigen::Ref<const Eigen::VectorXd>& x);

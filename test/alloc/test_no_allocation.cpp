@@ -121,6 +121,22 @@ TEST_CASE("the friction solve allocates nothing (all joints stuck, indeterminate
 // Every entry point (issue #6): the remaining success paths, every error
 // return, and no exception out of any of them.
 
+TEST_CASE("the friction solve allocates nothing when the maximisers form a hyperplane (7 joints, 6 rows)") {
+  // K_ΣΣ of rank one: the least-effort choice takes the dual, scalar path
+  // (leastDistanceOnHyperplane), which once copied its scratch (two
+  // allocations per call, found by callgrind).
+  const Model model = panda();
+  Task task(model);
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  Workspace ws(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), zero = Eigen::VectorXd::Zero(7);
+  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws));  // warm
+  REQUIRE(ws.friction.indeterminate);                          // the choice among maximisers ran
+  bool ok = false;
+  CHECK(allocationsDuring([&] { ok = solveWithFriction(model, task, q, zero, zero, ws).ok(); }) == 0);
+  CHECK(ok);
+}
+
 TEST_CASE("the solver entry points are declared noexcept") {
   const Model model = panda();
   Task task(model);

@@ -250,6 +250,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   FrictionResult& fr = ws.friction;
   Solution& out = ws.solution;
 
+  jointsOutsideLimits(model, q, out);  // a warning: solved as given
   stuckSetAndKineticFriction(model, q, qd, tau, options, fs, fr);
   const auto k = static_cast<Eigen::Index>(fr.stuck.size());
   if (Status s = sweepsWithSensitivities(model, task, q, qd, fr.stuck, ws, fs); !s) return s;

@@ -3,6 +3,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <iomanip>
+#include <limits>
 #include <sstream>
 
 namespace zwang {
@@ -50,31 +52,98 @@ int Model::frameIndex(const std::string& name) const {
   throw ModelError("model '" + name_ + "' has no frame '" + name + "' (frames: " + knownNames(names) + ")");
 }
 
-void validate::rigidInertia(const std::string& where, double mass, const Vec3& com, const Mat3& I_com) {
+const char* toString(WarningCode code) {
+  switch (code) {
+    case WarningCode::PointMass: return "point_mass";
+    case WarningCode::PlaceholderInertia: return "placeholder_inertia";
+    case WarningCode::TriangleInequality: return "triangle_inequality";
+    case WarningCode::PlaceholderLimits: return "placeholder_limits";
+    case WarningCode::MassBeyondTip: return "mass_beyond_tip";
+    case WarningCode::PayloadAttached: return "payload_attached";
+    case WarningCode::Urdfdom: return "urdfdom";
+  }
+  return "unknown";
+}
+
+namespace {
+
+std::string number(double x) {
+  std::ostringstream out;
+  out << std::setprecision(6) << x;
+  return out.str();
+}
+
+std::string momentsText(const Vec3& moments) {
+  return number(moments(0)) + ", " + number(moments(1)) + ", " + number(moments(2));
+}
+
+// The densest element (osmium, 22 590 kg/m³): a body of mass m is at least a
+// ball of radius R = (3m / 4πρ)^⅓, and a ball has the smallest Σ r² dm for its
+// volume, (3/5) m R². Σ r² dm is half the trace of the COM inertia, so a
+// smaller half-trace cannot belong to a real body of that mass.
+constexpr double kDensestMatter = 22590.0;
+
+double smallestHalfTrace(double mass) {
+  const double radius = std::cbrt(3.0 * mass / (4.0 * 3.14159265358979323846 * kDensestMatter));
+  return 0.6 * mass * radius * radius;
+}
+
+// What a physical but doubtful inertia gets (mass > 0, moments ≥ −tolerance).
+std::vector<ModelWarning> doubts(const std::string& where, double mass, const Vec3& moments, double tolerance) {
+  const std::string figures = " (mass " + number(mass) + " kg, principal moments " + momentsText(moments) + " kg·m²)";
+  if (moments.maxCoeff() <= tolerance)
+    return {{WarningCode::PointMass, where + ": a point mass: its rotational inertia is zero to rounding" + figures +
+                                         "; it turns only through its distance from the joint axes"}};
+  if (moments(0) + moments(1) < moments(2) - tolerance)
+    return {{WarningCode::TriangleInequality,
+             where + ": inertia violates the triangle inequality, " + number(moments(0)) + " + " + number(moments(1)) +
+                 " < " + number(moments(2)) + figures + "; no real body has these moments, they are used as given"}};
+  if (0.5 * moments.sum() < smallestHalfTrace(mass))
+    return {{WarningCode::PlaceholderInertia,
+             where + ": inertia too small for the mass: a body this compact would be denser than osmium" + figures +
+                 "; a placeholder? it is used as given"}};
+  return {};
+}
+
+}  // namespace
+
+// Each step from URDF numbers to the COM inertia (rotation into the link frame,
+// Ī = I_c − m·c×c×, merging through welded frames, back to I_c = Ī + m·c×c×,
+// the eigen-solver) errs by a few ulps of the largest term it handles; 1024
+// ulps of the whole scale covers hundreds of such steps and is still 2e-13 of
+// it, far below the moments of any real link.
+double validate::roundingTolerance(double scale) { return 1024.0 * std::numeric_limits<double>::epsilon() * scale; }
+
+std::vector<ModelWarning> validate::rigidInertia(const std::string& where, double mass, const Vec3& com,
+                                                 const Mat3& I_com, double rounding_scale) {
   if (!std::isfinite(mass)) throw ModelError(where + ": mass is not finite");
   if (!com.allFinite()) throw ModelError(where + ": centre of mass is not finite");
   if (!I_com.allFinite()) throw ModelError(where + ": inertia is not finite");
   if (mass < 0.0) throw ModelError(where + ": mass " + std::to_string(mass) + " is negative");
+  // Beyond these a solve's products (m·|c|²·ω², sums over the chain) lose the
+  // other links' figures in rounding or leave the range of double.
+  if (mass > kMaxMass)
+    throw ModelError(where + ": mass " + number(mass) + " kg is above " + number(kMaxMass) +
+                     " kg, the heaviest link zwang accepts (a typo?)");
+  if (I_com.cwiseAbs().maxCoeff() > kMaxMoment)
+    throw ModelError(where + ": inertia entry " + number(I_com.cwiseAbs().maxCoeff()) + " kg·m² is above " +
+                     number(kMaxMoment) + " kg·m², the largest zwang accepts (a typo?)");
   if ((I_com - I_com.transpose()).cwiseAbs().maxCoeff() > 1e-12 * (1.0 + I_com.cwiseAbs().maxCoeff()))
     throw ModelError(where + ": inertia is not symmetric");
-  const Eigen::Vector3d moments = Eigen::SelfAdjointEigenSolver<Mat3>(I_com, Eigen::EigenvaluesOnly).eigenvalues();
-  const double scale = std::max(1e-300, moments.cwiseAbs().maxCoeff());
-  const bool all_zero = moments.cwiseAbs().maxCoeff() == 0.0;
-  if (mass > 0.0 || !all_zero) {
-    if (moments.minCoeff() <= 1e-12 * scale) {
-      std::ostringstream out;
-      out << where << ": inertia is not positive definite (principal moments " << moments.transpose() << ")";
-      throw ModelError(out.str());
-    }
-    // Principal moments of a real body: each is at most the sum of the other two.
-    const double slack = 1e-9 * scale;
-    if (moments(0) + moments(1) < moments(2) - slack) {
-      std::ostringstream out;
-      out << where << ": inertia violates the triangle inequality (principal moments " << moments.transpose()
-          << ", " << moments(0) << " + " << moments(1) << " < " << moments(2) << ")";
-      throw ModelError(out.str());
-    }
-  }
+  const Vec3 moments = Eigen::SelfAdjointEigenSolver<Mat3>(I_com, Eigen::EigenvaluesOnly).eigenvalues();
+  const double tolerance = roundingTolerance(std::max(rounding_scale, I_com.cwiseAbs().sum()));
+  if (moments.minCoeff() < -tolerance)
+    throw ModelError(where + ": inertia is not positive semi-definite: principal moment " + number(moments.minCoeff()) +
+                     " kg·m² is negative (principal moments " + momentsText(moments) + "; rounding allows ±" +
+                     number(tolerance) + ")");
+  if (mass == 0.0) return {};  // a massless link: any semi-definite inertia (e.g. a rotor) is fine
+  return doubts(where, mass, moments, tolerance);
+}
+
+std::vector<ModelWarning> validate::rigidInertia(const std::string& where, const RigidInertia& inertia) {
+  // Ī holds m·|c|² on its diagonal: the scale I_c was recovered from.
+  const double scale = inertia.Ibar.allFinite() ? inertia.Ibar.cwiseAbs().sum() : 0.0;
+  return rigidInertia(where, inertia.mass, inertia.com(), inertia.inertiaAboutCom(), scale);
 }
 
 ModelBuilder::ModelBuilder(std::string robot_name, std::string base_frame) {
@@ -121,8 +190,7 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
     throw ModelError(where + ": effort limit must be non-negative");
   if (std::isnan(joint.velocity_limit) || joint.velocity_limit < 0.0)
     throw ModelError(where + ": velocity limit must be non-negative");
-  validate::rigidInertia("link '" + child_frame + "'", child_inertia.mass, child_inertia.com(),
-                         child_inertia.inertiaAboutCom());
+  checkLinkInertia(child_frame, model_.bodyCount(), child_inertia);
 
   // The joint's placement is relative to the parent link's frame; rebase it on
   // the parent body's frame (they differ when the parent link was merged in).
@@ -141,12 +209,32 @@ ModelBuilder& ModelBuilder::addFixedFrame(const std::string& name, const std::st
   const std::string where = "link '" + name + "'";
   if (model_.hasFrame(name)) throw ModelError(where + ": a frame of that name exists already");
   if (!finite(placement)) throw ModelError(where + ": origin of its fixed joint is not finite");
-  validate::rigidInertia(where, inertia.mass, inertia.com(), inertia.inertiaAboutCom());
   const Frame& parent = model_.frame(model_.frameIndex(parent_frame));
+  checkLinkInertia(name, parent.body, inertia);
   // ᶠX_body = ᶠX_parent · ᵖX_body
   const Frame frame{name, parent.body, placement * parent.placement};
   model_.inertias_[static_cast<std::size_t>(frame.body)] += spatial::inverseTransformInertia(frame.placement, inertia);
   model_.frames_.push_back(frame);
+  return *this;
+}
+
+void ModelBuilder::checkLinkInertia(const std::string& link, int body, const RigidInertia& inertia) {
+  // The base never moves: what is welded to it does not enter the dynamics, so
+  // its flaws cannot change an answer (and the verdict must not depend on
+  // which link the user picks as the root).
+  if (body == 0) return;
+  for (const ModelWarning& w : validate::rigidInertia("link '" + link + "'", inertia)) addWarning(w.code, w.message);
+}
+
+ModelBuilder& ModelBuilder::addWarning(WarningCode code, const std::string& message) {
+  for (const ModelWarning& w : model_.warnings_)
+    if (w.message == message) return *this;
+  model_.warnings_.push_back({code, message});
+  return *this;
+}
+
+ModelBuilder& ModelBuilder::prefixWarnings(const std::string& prefix) {
+  for (ModelWarning& w : model_.warnings_) w.message = prefix + w.message;
   return *this;
 }
 
@@ -173,6 +261,13 @@ ModelBuilder& ModelBuilder::setFriction(const std::string& joint, double breakaw
 }
 
 Model ModelBuilder::build() const {
+  // Each link passed on its own; their sum is checked too, to rounding of the
+  // merged figures, so no moving body reaches a solve with a negative moment.
+  for (int b = 1; b < model_.bodyCount(); ++b) {
+    const std::string link = model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(b)])].name;
+    validate::rigidInertia("body of link '" + link + "' (with the links welded to it)",
+                           model_.inertias_[static_cast<std::size_t>(b)]);
+  }
   // A moving body must carry inertia somewhere at or beyond it (or its joint a
   // rotor inertia), or its acceleration is undetermined. The last body is the
   // one the chain leaves bare most often, so check from the tip inward.

@@ -232,6 +232,16 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
 }
 
+void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out) {
+  out.joints_outside_limits = 0;
+  out.first_joint_outside_limits = -1;
+  for (int j = 0; j < model.dof(); ++j) {
+    const Joint& joint = model.joint(j);
+    if (q[j] >= joint.lower && q[j] <= joint.upper) continue;
+    if (out.joints_outside_limits++ == 0) out.first_joint_outside_limits = j;
+  }
+}
+
 void taskResidual(const Task& task, Workspace& ws) {
   // Aᵀ Ẍ − b row by row on the final accelerations. In sweep form both sides
   // carry the same gravity and velocity shifts (constraintsInBodyForm), so the

@@ -170,17 +170,21 @@ void checkAllNumbers(const Reporter& report, const TiXmlElement* robot) {
 // so the capturing handler is a process-lifetime object: if anybody later
 // restores "the previous handler" and gets this one, it forwards to the
 // handler that was active when the last load started. Loads are serialised
-// by a mutex while the handler is installed.
+// by a mutex while the handler is installed. During a load nothing reaches
+// the console: errors fail the load, warnings become ModelWarnings (once
+// each), informational and debug lines are dropped.
 class CaptureHandler final : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char* filename, int line) override {
-    if (sink != nullptr && level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
-      sink->push_back(text);
+    if (errors != nullptr) {
+      if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors->push_back(text);
+      else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) warnings->push_back(text);
     } else if (forward != nullptr && forward != this && level >= forward_level) {
       forward->log(text, level, filename, line);
     }
   }
-  std::vector<std::string>* sink = nullptr;
+  std::vector<std::string>* errors = nullptr;
+  std::vector<std::string>* warnings = nullptr;
   console_bridge::OutputHandler* forward = nullptr;
   console_bridge::LogLevel forward_level = console_bridge::CONSOLE_BRIDGE_LOG_WARN;
 };
@@ -195,8 +199,10 @@ CaptureHandler& captureHandler() {
   return *handler;
 }
 
-urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const std::string& xml) {
-  std::vector<std::string> errors;
+// urdfdom's model; its logged warnings are appended to `warnings`.
+urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const std::string& xml,
+                                               std::vector<ModelWarning>& warnings) {
+  std::vector<std::string> errors, logged_warnings;
   urdf::ModelInterfaceSharedPtr model;
   {
     const std::lock_guard<std::mutex> lock(captureMutex());
@@ -205,9 +211,9 @@ urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const std
     const console_bridge::LogLevel previous_level = console_bridge::getLogLevel();
     handler.forward = previous;
     handler.forward_level = previous_level;
-    handler.sink = &errors;
-    if (previous_level > console_bridge::CONSOLE_BRIDGE_LOG_ERROR)
-      console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
+    handler.errors = &errors;
+    handler.warnings = &logged_warnings;
+    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_WARN);  // warnings reach the handler
     console_bridge::useOutputHandler(&handler);
     struct Restore {
       CaptureHandler& handler;
@@ -216,7 +222,8 @@ urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const std
       ~Restore() {
         console_bridge::useOutputHandler(previous);
         console_bridge::setLogLevel(level);
-        handler.sink = nullptr;
+        handler.errors = nullptr;
+        handler.warnings = nullptr;
       }
     } restore{handler, previous, previous_level};
     try {
@@ -232,6 +239,7 @@ urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const std
     report.fail("urdfdom rejected the URDF: " + joined);
   }
   if (!model) report.fail("urdfdom could not parse the URDF (it gave no reason)");
+  for (const std::string& text : logged_warnings) warnings.push_back({WarningCode::Urdfdom, "urdfdom: " + text});
   return model;
 }
 
@@ -304,21 +312,27 @@ Transform placementOf(const urdf::Joint& joint) {
 }
 
 // The link's inertia in its own frame; a link without <inertial> is massless.
-RigidInertia linkInertia(const Reporter& report, const urdf::Link& link) {
+// Its mass is checked here, naming the URDF field; whether the rotational
+// inertia is a body's is the ModelBuilder's check, made only for links that
+// move (anything welded to the base is skipped: the base never moves).
+RigidInertia linkInertia(const Reporter& report, const urdf::Link& link, bool on_base) {
   if (!link.inertial) return RigidInertia{};
   const urdf::Inertial& in = *link.inertial;
   const std::string who = "link '" + link.name + "': <inertial>";
-  if (!std::isfinite(in.mass)) report.fail(who + " <mass> value is not finite");
-  if (in.mass < 0.0) report.fail(who + " <mass> value " + fmt(in.mass) + " is negative");
+  if (!on_base) {
+    if (!std::isfinite(in.mass)) report.fail(who + " <mass> value is not finite");
+    if (in.mass < 0.0) report.fail(who + " <mass> value " + fmt(in.mass) + " is negative");
+    if (in.mass > validate::kMaxMass)
+      report.fail(who + " <mass> value " + fmt(in.mass) + " kg is above " + fmt(validate::kMaxMass) +
+                  " kg, the heaviest link zwang accepts (a typo?)");
+  }
   Mat3 I_frame;  // in the COM frame given by <inertial><origin>
   I_frame << in.ixx, in.ixy, in.ixz,  //
       in.ixy, in.iyy, in.iyz,         //
       in.ixz, in.iyz, in.izz;
   const Mat3 R = rotationOf(in.origin.rotation);  // COM frame axes in the link frame
   const Mat3 I_com = R * I_frame * R.transpose();
-  const Vec3 com = vectorOf(in.origin.position);
-  validate::rigidInertia(report.source() + ": " + who, in.mass, com, I_com);
-  return RigidInertia::fromMassComInertia(in.mass, com, I_com);
+  return RigidInertia::fromMassComInertia(in.mass, vectorOf(in.origin.position), I_com);
 }
 
 bool isMoving(const urdf::Joint& joint) { return joint.type != urdf::Joint::FIXED; }
@@ -335,8 +349,38 @@ const char* typeName(int type) {
   }
 }
 
+// <limit> into `joint`, every field checked. Placeholder limits (lower ==
+// upper, effort == velocity == 0: a CAD exporter's "unknown") would lock the
+// joint and give it no torque; they are read as "no limits", with a warning.
+void readLimits(const Reporter& report, const urdf::Joint& uj, Joint& joint, std::vector<ModelWarning>& warnings) {
+  const std::string who = "joint '" + uj.name + "'";
+  const urdf::JointLimits& lim = *uj.limits;
+  const struct {
+    const char* name;
+    double value;
+  } fields[] = {{"lower", lim.lower}, {"upper", lim.upper}, {"effort", lim.effort}, {"velocity", lim.velocity}};
+  for (const auto& f : fields)
+    if (!std::isfinite(f.value)) report.fail(who + ": <limit> " + f.name + " is not finite");
+  if (lim.effort < 0.0) report.fail(who + ": <limit> effort " + fmt(lim.effort) + " is negative");
+  if (lim.velocity < 0.0) report.fail(who + ": <limit> velocity " + fmt(lim.velocity) + " is negative");
+  if (lim.lower == lim.upper && lim.effort == 0.0 && lim.velocity == 0.0) {
+    warnings.push_back({WarningCode::PlaceholderLimits,
+                        who + ": placeholder <limit lower=\"" + fmt(lim.lower) + "\" upper=\"" + fmt(lim.upper) +
+                            "\" effort=\"0\" velocity=\"0\"/> read as no limits (position, effort and velocity)"});
+    return;  // Joint's defaults are infinite
+  }
+  joint.effort_limit = lim.effort;
+  joint.velocity_limit = lim.velocity;
+  if (joint.type == JointType::Continuous) return;  // a continuous joint has no position limits
+  if (lim.lower > lim.upper)
+    report.fail(who + ": <limit> lower " + fmt(lim.lower) + " is greater than upper " + fmt(lim.upper));
+  joint.lower = lim.lower;
+  joint.upper = lim.upper;
+}
+
 // The zwang joint for a moving URDF joint, every field checked.
-Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<std::string, double>& rotor) {
+Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<std::string, double>& rotor,
+                std::vector<ModelWarning>& warnings) {
   const std::string who = "joint '" + uj.name + "'";
   Joint joint;
   joint.name = uj.name;
@@ -360,25 +404,7 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
                 "\" is zero (it must give the joint's direction)");
   joint.axis.normalize();
 
-  if (uj.limits) {
-    const urdf::JointLimits& lim = *uj.limits;
-    const struct {
-      const char* name;
-      double value;
-    } fields[] = {{"lower", lim.lower}, {"upper", lim.upper}, {"effort", lim.effort}, {"velocity", lim.velocity}};
-    for (const auto& f : fields)
-      if (!std::isfinite(f.value)) report.fail(who + ": <limit> " + f.name + " is not finite");
-    if (lim.effort < 0.0) report.fail(who + ": <limit> effort " + fmt(lim.effort) + " is negative");
-    if (lim.velocity < 0.0) report.fail(who + ": <limit> velocity " + fmt(lim.velocity) + " is negative");
-    joint.effort_limit = lim.effort;
-    joint.velocity_limit = lim.velocity;
-    if (joint.type != JointType::Continuous) {  // a continuous joint has no position limits
-      if (lim.lower > lim.upper)
-        report.fail(who + ": <limit> lower " + fmt(lim.lower) + " is greater than upper " + fmt(lim.upper));
-      joint.lower = lim.lower;
-      joint.upper = lim.upper;
-    }
-  }
+  if (uj.limits) readLimits(report, uj, joint, warnings);
   if (joint.type == JointType::Continuous) {
     joint.lower = -kInf;
     joint.upper = kInf;
@@ -421,7 +447,7 @@ void collectLeaves(const urdf::Link& link, std::vector<std::string>& leaves) {
 
 // The links from root to tip (root first).
 std::vector<LinkPtr> chainLinks(const Reporter& report, const urdf::ModelInterface& model, const LinkPtr& root,
-                                const std::string& tip_name) {
+                                const std::string& tip_name, const std::string& tip_option) {
   std::vector<LinkPtr> path;
   if (!tip_name.empty()) {
     const LinkPtr tip = model.getLink(tip_name);
@@ -454,7 +480,7 @@ std::vector<LinkPtr> chainLinks(const Reporter& report, const urdf::ModelInterfa
       std::vector<std::string> candidates;
       for (const LinkPtr& b : branches) collectLeaves(*b, candidates);
       report.fail("no tip link given and the tree branches into moving joints at link '" + link->name +
-                  "'; candidate tips: " + nameList(candidates) + " (set UrdfOptions::tip)");
+                  "'; candidate tips: " + nameList(candidates) + " (set " + tip_option + ")");
     }
     link = branches.front();
     path.push_back(link);
@@ -469,9 +495,8 @@ std::vector<std::string> allLinkNames(const urdf::ModelInterface& model) {
 
 // ---------------------------------------------------------------------------
 
-Model load(const Reporter& report, const std::string& xml, const UrdfOptions& options) {
-  // Pass 1: well-formed XML, and every number finite.
-  TiXmlDocument doc;
+// Pass 1: well-formed XML with a <robot> on top.
+const TiXmlElement* parseXml(const Reporter& report, const std::string& xml, TiXmlDocument& doc) {
   doc.Parse(xml.c_str());
   if (doc.Error()) {
     std::string where;
@@ -483,28 +508,192 @@ Model load(const Reporter& report, const std::string& xml, const UrdfOptions& op
   if (robot == nullptr || std::string(robot->Value()) != "robot")
     report.fail("the XML's top element is not <robot>" +
                 (robot ? std::string(" (found <") + robot->Value() + ">)" : std::string()));
-  checkAllNumbers(report, robot);
+  return robot;
+}
 
-  // Pass 2: the tree.
-  const urdf::ModelInterfaceSharedPtr urdf_model = parseWithUrdfdom(report, xml);
-  if (!urdf_model->getRoot()) report.fail("the URDF has no root link");
+// zwang needs a joint that moves somewhere; say so before any root/tip
+// reasoning (a floating or planar joint counts here: the chain check names it).
+void requireMovingJoint(const Reporter& report, const urdf::ModelInterface& model) {
+  for (const auto& entry : model.joints_)
+    if (entry.second->type != urdf::Joint::FIXED) return;
+  report.fail("the URDF has no moving joint (" +
+              (model.joints_.empty() ? std::string("it has no joint at all")
+                                     : "all " + std::to_string(model.joints_.size()) + " joints are fixed") +
+              "): zwang needs at least one revolute, continuous or prismatic joint");
+}
 
-  // Pass 3: rotor inertias, then the options' overrides.
-  std::map<std::string, double> rotor = readTransmissions(report, robot, *urdf_model);
+std::map<std::string, double> rotorInertias(const Reporter& report, const TiXmlElement* robot,
+                                            const urdf::ModelInterface& urdf_model, const UrdfOptions& options) {
+  std::map<std::string, double> rotor = readTransmissions(report, robot, urdf_model);
   for (const auto& [name, value] : options.rotor_inertia) {
     if (!std::isfinite(value) || value < 0.0)
-      report.fail("UrdfOptions::rotor_inertia for joint '" + name + "': " + fmt(value) +
+      report.fail(options.names.rotor_inertia + " for joint '" + name + "': " + fmt(value) +
                   " is not a finite non-negative number");
     rotor[name] = value;
   }
+  return rotor;
+}
 
-  // Root and tip.
+// Links placed into the builder, and the ones on the last body (the tip body).
+struct Placement {
+  std::set<std::string> placed;
+  std::vector<LinkPtr> tip_body;
+  std::vector<ModelWarning> warnings;  // the loader's own (limits, beyond the tip, urdfdom)
+};
+
+// Every link welded to `anchor` (down, and up off the root), breadth first.
+void addWelded(const Reporter& report, ModelBuilder& builder, Placement& placement, const LinkPtr& anchor,
+               bool on_base) {
+  std::vector<LinkPtr> queue{anchor};
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const LinkPtr from = queue[head];
+    for (std::size_t k = 0; k < from->child_joints.size(); ++k) {
+      const auto& joint = from->child_joints[k];
+      const LinkPtr child = from->child_links[k];
+      if (isMoving(*joint) || placement.placed.count(child->name)) continue;
+      const RigidInertia inertia = linkInertia(report, *child, on_base);
+      report.builder([&] { builder.addFixedFrame(child->name, from->name, placementOf(*joint), inertia); });
+      placement.placed.insert(child->name);
+      placement.tip_body.push_back(child);
+      queue.push_back(child);
+    }
+    // Upwards: a parent welded to this link (only ever off the root).
+    const LinkPtr parent = from->getParent();
+    if (parent && from->parent_joint && !isMoving(*from->parent_joint) && !placement.placed.count(parent->name)) {
+      const RigidInertia inertia = linkInertia(report, *parent, on_base);
+      const Transform X = placementOf(*from->parent_joint).inverse();  // ᵖX_from
+      report.builder([&] { builder.addFixedFrame(parent->name, from->name, X, inertia); });
+      placement.placed.insert(parent->name);
+      queue.push_back(parent);
+    }
+  }
+}
+
+// The chain links in order; after each, the links welded to it.
+void addChain(const Reporter& report, ModelBuilder& builder, Placement& placement, const std::vector<LinkPtr>& chain,
+              const std::map<std::string, double>& rotor) {
+  for (const LinkPtr& link : chain) placement.placed.insert(link->name);
+  bool on_base = true;  // until the first moving joint
+  placement.tip_body = {chain.front()};
+  addWelded(report, builder, placement, chain.front(), on_base);
+  for (std::size_t k = 1; k < chain.size(); ++k) {
+    const LinkPtr& link = chain[k];
+    const urdf::Joint& uj = *link->parent_joint;
+    if (isMoving(uj)) {
+      on_base = false;
+      placement.tip_body.clear();
+      const Joint joint = makeJoint(report, uj, rotor, placement.warnings);
+      const RigidInertia inertia = linkInertia(report, *link, on_base);
+      report.builder([&] { builder.addJoint(joint, link->name, inertia, uj.parent_link_name); });
+    } else {
+      const RigidInertia inertia = linkInertia(report, *link, on_base);
+      report.builder([&] { builder.addFixedFrame(link->name, uj.parent_link_name, placementOf(uj), inertia); });
+    }
+    placement.tip_body.push_back(link);
+    addWelded(report, builder, placement, link, on_base);
+  }
+}
+
+// ᶜX_p of a joint locked at position q (revolute and continuous turn about the
+// axis, prismatic slides along it; other types stay at their origin).
+Transform lockedPlacement(const Reporter& report, const urdf::Joint& uj, double q) {
+  if (q == 0.0 || (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS &&
+                   uj.type != urdf::Joint::PRISMATIC))
+    return placementOf(uj);
+  std::vector<ModelWarning> ignored;
+  const Joint joint = makeJoint(report, uj, {}, ignored);
+  return joint.transform(q);
+}
+
+// Links behind moving joints below the tip body: the joint that leads to each
+// and the links, parents before children.
+struct BeyondTip {
+  std::vector<std::pair<urdf::JointConstSharedPtr, LinkPtr>> links;
+  double mass = 0.0;
+};
+
+BeyondTip findBeyondTip(const Placement& placement) {
+  BeyondTip beyond;
+  std::vector<std::pair<urdf::JointConstSharedPtr, LinkPtr>> queue;
+  for (const LinkPtr& link : placement.tip_body)
+    for (std::size_t k = 0; k < link->child_joints.size(); ++k)
+      if (isMoving(*link->child_joints[k]) && !placement.placed.count(link->child_links[k]->name))
+        queue.emplace_back(link->child_joints[k], link->child_links[k]);
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const LinkPtr link = queue[head].second;
+    beyond.links.push_back(queue[head]);
+    if (link->inertial && std::isfinite(link->inertial->mass)) beyond.mass += link->inertial->mass;
+    for (std::size_t k = 0; k < link->child_joints.size(); ++k) queue.emplace_back(link->child_joints[k], link->child_links[k]);
+  }
+  return beyond;
+}
+
+// Report the mass beyond the tip, or weld it to the tip body as a payload.
+void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& placement, const std::string& tip,
+                     const UrdfOptions& options) {
+  const BeyondTip beyond = findBeyondTip(placement);
+  std::vector<std::string> links, joints;
+  for (const auto& [joint, link] : beyond.links) {
+    links.push_back(link->name);
+    if (isMoving(*joint)) joints.push_back(joint->name);
+  }
+  for (const auto& entry : options.locked_positions)
+    if (std::find(joints.begin(), joints.end(), entry.first) == joints.end() || !std::isfinite(entry.second))
+      report.fail("locked position for joint '" + entry.first + "' (" + fmt(entry.second) +
+                  "): not a finite position of a moving joint beyond the tip (those joints: " +
+                  (joints.empty() ? std::string("none") : nameList(joints)) + ")");
+  if (beyond.links.empty() || (beyond.mass <= 0.0 && !options.attach_beyond_tip)) return;
+  const std::string what = std::to_string(links.size()) + " link" + (links.size() == 1 ? "" : "s") + " (" +
+                           nameList(links) + ", " + fmt(beyond.mass) + " kg in all) behind moving joint" +
+                           (joints.size() == 1 ? " " : "s ") + nameList(joints) + " beyond the tip '" + tip + "'";
+  if (!options.attach_beyond_tip) {
+    const char* verb = links.size() == 1 ? " is" : " are";
+    placement.warnings.push_back({WarningCode::MassBeyondTip, what + verb + " not on the chain: their mass is ignored (set " +
+                                                                  options.names.attach_beyond_tip +
+                                                                  " to carry them as a payload of the tip body)"});
+    return;
+  }
+  for (const auto& [joint, link] : beyond.links) {
+    const auto locked = options.locked_positions.find(joint->name);
+    const Transform X = lockedPlacement(report, *joint, locked == options.locked_positions.end() ? 0.0 : locked->second);
+    const RigidInertia inertia = linkInertia(report, *link, false);
+    report.builder([&] { builder.addFixedFrame(link->name, joint->parent_link_name, X, inertia); });
+  }
+  placement.warnings.push_back({WarningCode::PayloadAttached, what + (links.size() == 1 ? " is" : " are") +
+                                                                  " welded to the tip body as a payload, those joints locked"});
+}
+
+// Strict mode: every warning about the data is an error. PayloadAttached only
+// reports what attach_beyond_tip was asked to do, so it does not count.
+void refuseWarnings(const Reporter& report, const Model& model) {
+  std::string all;
+  std::size_t count = 0;
+  for (const ModelWarning& w : model.warnings()) {
+    if (w.code == WarningCode::PayloadAttached) continue;
+    all += (all.empty() ? "" : "; ") + w.message.substr(report.source().size() + 2);  // without the "<source>: " prefix
+    ++count;
+  }
+  if (count > 0)
+    report.fail("refused in strict mode (" + std::to_string(count) + " warning" + (count == 1 ? "" : "s") + "): " + all);
+}
+
+Model load(const Reporter& report, const std::string& xml, const UrdfOptions& options) {
+  TiXmlDocument doc;
+  const TiXmlElement* robot = parseXml(report, xml, doc);
+  checkAllNumbers(report, robot);  // every number finite, anywhere
+
+  Placement placement;
+  const urdf::ModelInterfaceSharedPtr urdf_model = parseWithUrdfdom(report, xml, placement.warnings);
+  if (!urdf_model->getRoot()) report.fail("the URDF has no root link");
+  requireMovingJoint(report, *urdf_model);
+  const std::map<std::string, double> rotor = rotorInertias(report, robot, *urdf_model, options);
+
   const LinkPtr root = options.root.empty() ? urdf_model->getRoot() : urdf_model->getLink(options.root);
   if (!root)
-    report.fail("root link '" + options.root + "' not found (links: " + nameList(allLinkNames(*urdf_model), 50) + ")");
+    report.fail("root link '" + options.root + "' not found (links: " + nameList(allLinkNames(*urdf_model)) + ")");
   if (!options.tip.empty() && !urdf_model->getLink(options.tip))
-    report.fail("tip link '" + options.tip + "' not found (links: " + nameList(allLinkNames(*urdf_model), 50) + ")");
-  const std::vector<LinkPtr> chain = chainLinks(report, *urdf_model, root, options.tip);
+    report.fail("tip link '" + options.tip + "' not found (links: " + nameList(allLinkNames(*urdf_model)) + ")");
+  const std::vector<LinkPtr> chain = chainLinks(report, *urdf_model, root, options.tip, options.names.tip);
   const std::string tip_name = chain.back()->name;
 
   std::vector<std::string> moving;  // moving joints of the chain
@@ -514,57 +703,20 @@ Model load(const Reporter& report, const std::string& xml, const UrdfOptions& op
     report.fail("the chain from root link '" + root->name + "' to tip link '" + tip_name + "' has no moving joint");
   for (const auto& entry : options.rotor_inertia) {
     if (std::find(moving.begin(), moving.end(), entry.first) != moving.end()) continue;
-    report.fail("UrdfOptions::rotor_inertia names joint '" + entry.first + "', which is not a moving joint of the chain " +
-                "from '" + root->name + "' to '" + tip_name + "' (chain joints: " + nameList(moving) + ")" +
+    report.fail(options.names.rotor_inertia + " names joint '" + entry.first +
+                "', which is not a moving joint of the chain from '" + root->name + "' to '" + tip_name +
+                "' (chain joints: " + nameList(moving) + ")" +
                 (urdf_model->getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
   }
 
-  // Build: chain links in order; after each, the links welded to it.
   ModelBuilder builder(urdf_model->getName(), root->name);
-  std::set<std::string> placed;
-  for (const LinkPtr& link : chain) placed.insert(link->name);
-
-  auto addWelded = [&](const LinkPtr& anchor) {
-    std::vector<LinkPtr> queue{anchor};
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const LinkPtr from = queue[head];
-      for (std::size_t k = 0; k < from->child_joints.size(); ++k) {
-        const auto& joint = from->child_joints[k];
-        const LinkPtr child = from->child_links[k];
-        if (isMoving(*joint) || placed.count(child->name)) continue;
-        const RigidInertia inertia = linkInertia(report, *child);
-        report.builder([&] { builder.addFixedFrame(child->name, from->name, placementOf(*joint), inertia); });
-        placed.insert(child->name);
-        queue.push_back(child);
-      }
-      // Upwards: a parent welded to this link (only ever off the root).
-      const LinkPtr parent = from->getParent();
-      if (parent && from->parent_joint && !isMoving(*from->parent_joint) && !placed.count(parent->name)) {
-        const RigidInertia inertia = linkInertia(report, *parent);
-        const Transform placement = placementOf(*from->parent_joint).inverse();  // ᵖX_from
-        report.builder([&] { builder.addFixedFrame(parent->name, from->name, placement, inertia); });
-        placed.insert(parent->name);
-        queue.push_back(parent);
-      }
-    }
-  };
-
-  addWelded(chain.front());
-  for (std::size_t k = 1; k < chain.size(); ++k) {
-    const LinkPtr& link = chain[k];
-    const urdf::Joint& uj = *link->parent_joint;
-    const RigidInertia inertia = linkInertia(report, *link);
-    if (isMoving(uj)) {
-      const Joint joint = makeJoint(report, uj, rotor);
-      report.builder([&] { builder.addJoint(joint, link->name, inertia, uj.parent_link_name); });
-    } else {
-      report.builder([&] { builder.addFixedFrame(link->name, uj.parent_link_name, placementOf(uj), inertia); });
-    }
-    addWelded(link);
-  }
-
+  addChain(report, builder, placement, chain, rotor);
+  handleBeyondTip(report, builder, placement, tip_name, options);
+  for (const ModelWarning& w : placement.warnings) builder.addWarning(w.code, w.message);
+  builder.prefixWarnings(report.source() + ": ");
   Model model;
   report.builder([&] { model = builder.build(); });
+  if (options.strict) refuseWarnings(report, model);
   return model;
 }
 

@@ -106,3 +106,22 @@ TEST_CASE("building a task with an unknown frame or a bad matrix throws a ModelE
   CHECK_THROWS_WITH(model.frameIndex("nope"), Contains("no frame 'nope'") && Contains("panda_link3"));
   CHECK_THROWS_WITH(model.jointIndex("nope"), Contains("no moving joint 'nope'") && Contains("panda_joint7"));
 }
+
+TEST_CASE("q outside the joint limits: solved as given, the solution says which joint") {
+  const Model model = loadUrdfFile(ZWANG_MODELS_DIR "/panda.urdf");
+  Task task(model);
+  Workspace ws(model, task);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(7), zero = Eigen::VectorXd::Zero(7);
+  REQUIRE(solveHybridDynamics(model, task, q, zero, zero, ws));
+  CHECK(ws.solution.joints_outside_limits == 1);  // panda_joint4's range is [-3.0718, -0.0698]: 0 is outside
+  CHECK(ws.solution.first_joint_outside_limits == 3);
+  q[3] = -1.5;
+  q[5] = 5.0;  // panda_joint6: [-0.0175, 3.7525]
+  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws));
+  CHECK(ws.solution.joints_outside_limits == 1);
+  CHECK(ws.solution.first_joint_outside_limits == 5);
+  q[5] = 1.0;
+  REQUIRE(solveHybridDynamics(model, task, q, zero, zero, ws));
+  CHECK(ws.solution.joints_outside_limits == 0);
+  CHECK(ws.solution.first_joint_outside_limits == -1);
+}

@@ -192,10 +192,12 @@ TEST_CASE("errors: ModelBuilder and model lookups", "[errors]") {
   skew(0, 1) = 0.5;
   CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), skew)),
              Contains("inertia is not symmetric"));
-  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Vec3(1, 1, 0).asDiagonal())),
-             Contains("inertia is not positive definite (principal moments"));
-  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Vec3(1, 1, 3).asDiagonal())),
-             Contains("inertia violates the triangle inequality"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Vec3(1, 1, -0.5).asDiagonal())),
+             Contains("link 'link1': inertia is not positive semi-definite: principal moment -0.5 kg·m² is negative"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(2e300, Vec3::Zero(), Mat3::Identity())),
+             Contains("link 'link1': mass 2e+300 kg is above 1e+12 kg"));
+  CHECK_THAT(addJoint(j, RigidInertia::fromMassComInertia(1.0, Vec3::Zero(), Mat3::Identity() * 1e13)),
+             Contains("link 'link1': inertia entry 1e+13 kg·m² is above 1e+12 kg·m²"));
 
   CHECK_THAT(addJoint(revolute(""), box(1.0)), Contains("a moving joint needs a name"));
   CHECK_THAT(modelError([] {

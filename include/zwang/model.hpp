@@ -76,6 +76,27 @@ inline Transform Joint::transform(double q) const {
   return X;
 }
 
+/// Something in the model data that is physically doubtful but usable: the
+/// model loads and the dynamics uses the data as given (docs/errors.md,
+/// "Model warnings"). UrdfOptions::strict turns every warning into a ModelError.
+enum class WarningCode {
+  PointMass,           ///< a moving link with mass but zero rotational inertia
+  PlaceholderInertia,  ///< rotational inertia too small for the mass (a body denser than osmium)
+  TriangleInequality,  ///< principal moments with a + b < c (no real body has them)
+  PlaceholderLimits,   ///< <limit lower == upper, effort == velocity == 0>: read as "no limits"
+  MassBeyondTip,       ///< links behind a moving joint below the tip carry mass the chain ignores
+  PayloadAttached,     ///< that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
+  Urdfdom,             ///< urdfdom's own warning, passed on once
+};
+/// "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.
+const char* toString(WarningCode code);
+
+/// A warning recorded while building a model (Model::warnings()).
+struct ModelWarning {
+  WarningCode code;     ///< what kind of doubt
+  std::string message;  ///< one line naming the source, the link or joint and the figures
+};
+
 /// A named frame (a URDF link) rigidly attached to a body of the chain.
 struct Frame {
   std::string name;     ///< the URDF link name, unique among the frames
@@ -112,6 +133,9 @@ class Model {
   bool hasFrame(const std::string& name) const;
   /// The frame of body b (the link the moving joint b−1 ends in; b = 0: the base link).
   int bodyFrame(int b) const { return body_frames_.at(static_cast<std::size_t>(b)); }
+  /// What was doubtful in the data the model was built from (each once, in the
+  /// order found); empty for clean data.
+  const std::vector<ModelWarning>& warnings() const { return warnings_; }
 
  private:
   friend class ModelBuilder;
@@ -120,6 +144,7 @@ class Model {
   std::vector<RigidInertia> inertias_;  // bodyCount() entries
   std::vector<Frame> frames_;
   std::vector<int> body_frames_;
+  std::vector<ModelWarning> warnings_;
 };
 
 /// Builds a Model link by link (the URDF loader and the test generators use it).
@@ -144,25 +169,46 @@ class ModelBuilder {
 
   /// Set the reflected rotor inertia d_j of a joint (finite, ≥ 0).
   ModelBuilder& setRotorInertia(const std::string& joint, double value);
+  /// Record a warning on the model (kept once: an identical message is dropped).
+  ModelBuilder& addWarning(WarningCode code, const std::string& message);
+  /// Prefix every message (e.g. with the URDF's file name), for the loader.
+  ModelBuilder& prefixWarnings(const std::string& prefix);
   /// Set a joint's breakaway friction f_j, Coulomb friction f_c,j and viscous damping b_j (finite, ≥ 0).
   ModelBuilder& setFriction(const std::string& joint, double breakaway, double kinetic, double damping);
 
-  /// Checks the whole chain (every moving joint must carry some inertia) and
+  /// Checks the whole chain (every moving joint must carry some inertia, every
+  /// moving body's merged inertia is positive semi-definite to rounding) and
   /// returns the immutable model.
   Model build() const;
 
  private:
   Model model_;
   Joint& jointNamed(const std::string& name);
+  void checkLinkInertia(const std::string& link, int body, const RigidInertia& inertia);
 };
 
 /// Validation helpers shared by the builder and the URDF loader.
 namespace validate {
-/// Throws `ModelError("<where>: <what>")` when the inertia is not physical:
-/// negative mass, non-finite values, a rotational inertia at the COM that is not
-/// symmetric positive definite (a massless link may have zero inertia) or breaks
-/// the triangle inequality.
-void rigidInertia(const std::string& where, double mass, const Vec3& com, const Mat3& I_com);
+/// The heaviest link and the largest moment of inertia zwang accepts [kg, kg·m²].
+constexpr double kMaxMass = 1e12;
+constexpr double kMaxMoment = 1e12;  ///< the largest moment of inertia [kg·m²]
+
+/// Throws `ModelError("<where>: <what>")` when the inertia cannot be a body's:
+/// negative or non-finite mass, a mass above kMaxMass, non-finite or huge
+/// values, an asymmetric matrix or a principal moment at the COM that is
+/// negative beyond rounding. `rounding_scale` is the size of the numbers the
+/// COM inertia was computed from (kg·m²): moments within
+/// roundingTolerance(rounding_scale) of zero count as zero, so point masses,
+/// thin rods and inertias recovered from the origin form (I_c = Ī + m·c×c×)
+/// pass. Returns the warnings (triangle inequality, point mass, placeholder
+/// inertia) for the caller to record.
+std::vector<ModelWarning> rigidInertia(const std::string& where, double mass, const Vec3& com, const Mat3& I_com,
+                                       double rounding_scale = 0.0);
+/// The same for an inertia in origin form (m, h, Ī), as the builder holds it.
+std::vector<ModelWarning> rigidInertia(const std::string& where, const RigidInertia& inertia);
+/// How far from zero a moment computed from numbers of size `scale` may land
+/// by rounding alone.
+double roundingTolerance(double scale);
 }  // namespace validate
 
 }  // namespace zwang

@@ -70,6 +70,11 @@ struct Solution {
   Eigen::VectorXd tau_control;     ///< τ + τ_c, what is sent to the motors
   double gauss = 0.0;              ///< Z(q̈), the Gauss function (acceleration energy) at the solution
   BalanceReport balance;           ///< how the balance went: rank, condition, damping, residual, consistent
+  /// A warning, not an error: joints whose q lies outside [lower, upper]
+  /// (solved as given; the limits act only on stuck joints at a stop, in
+  /// solveWithFriction). The count, and the first such joint (−1: none).
+  int joints_outside_limits = 0;
+  int first_joint_outside_limits = -1;  ///< the first joint outside its limits, −1 when none
   // The true classical acceleration of any frame (a body's own frame:
   // model.bodyFrame(b)) is computed on demand from the sweep by
   // frameAcceleration() (kinematics.hpp), so a solve does not pay for it.

@@ -55,9 +55,13 @@ struct Arguments {
 Arguments parseArguments(const std::string& command, int argc, char** argv, int first,
                          const std::vector<std::string>& flags, const std::vector<std::string>& with_value);
 
-// One printable line: control bytes and non-ASCII bytes as \xNN, at most
-// `max_length` characters (the rest elided with "...").
+// One printable line: control bytes and bytes that are not valid UTF-8 as
+// \xNN (valid UTF-8 passes through), at most `max_length` bytes, cut between
+// characters (the rest elided with "...").
 std::string printable(const std::string& text, std::size_t max_length = 200);
+
+// Each of the model's warnings once on stderr: "zwang: warning: <message>".
+void printWarnings(const Model& model);
 
 // Read a whole file; CliError "<path>: cannot read the file (<reason>)" on failure.
 // Files larger than max_bytes are refused.

@@ -32,14 +32,18 @@ const char* usageText(const std::string& command) {
            "3 infeasible task (the solution is still written, status.infeasible = true).\n"
            "The problem and solution schemas are in docs/cli.md.\n";
   if (command == "info")
-    return "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--json]\n"
+    return "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--strict] [--attach-beyond-tip] [--json]\n"
            "\n"
            "Print the chain loaded from MODEL.urdf: joints (type, axis, limits, friction,\n"
-           "damping, rotor inertia, effort limit), frames and total mass.\n"
+           "damping, rotor inertia, effort limit), frames, moving and base mass, and the\n"
+           "model's warnings (also on stderr as \"zwang: warning: ...\").\n"
            "\n"
-           "  --root LINK  the chain starts at LINK (default: the URDF's root link)\n"
-           "  --tip LINK   the chain ends at LINK (default: the unique leaf)\n"
-           "  --json       print JSON instead of a table\n";
+           "  --root LINK           the chain starts at LINK (default: the URDF's root link)\n"
+           "  --tip LINK            the chain ends at LINK (default: the unique leaf)\n"
+           "  --strict              refuse doubtful data (every warning becomes an error)\n"
+           "  --attach-beyond-tip   weld links behind moving joints below the tip to the tip\n"
+           "                        body as a payload (those joints locked at 0)\n"
+           "  --json                print JSON instead of a table\n";
   if (command == "scenarios")
     return "usage: zwang scenarios [--out DIR] [--models DIR] [--no-plots]\n"
            "\n"
@@ -139,24 +143,49 @@ Arguments parseArguments(const std::string& command, int argc, char** argv, int 
   return args;
 }
 
+namespace {
+
+// Length of the valid UTF-8 sequence starting at text[at], 0 if it is not one
+// (a stray continuation byte, an overlong or truncated sequence).
+std::size_t utf8Length(const std::string& text, std::size_t at) {
+  const auto lead = static_cast<unsigned char>(text[at]);
+  const std::size_t length = lead >= 0xF0 && lead <= 0xF4 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC2 && lead < 0xE0 ? 2 : 0;
+  if (length == 0 || at + length > text.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k)
+    if ((static_cast<unsigned char>(text[at + k]) & 0xC0) != 0x80) return 0;
+  return length;
+}
+
+}  // namespace
+
 std::string printable(const std::string& text, std::size_t max_length) {
   std::string out;
-  for (const char ch : text) {
-    const auto c = static_cast<unsigned char>(ch);
+  for (std::size_t at = 0; at < text.size();) {
+    const auto c = static_cast<unsigned char>(text[at]);
+    std::string piece;
+    std::size_t used = 1;
     if (c >= 0x20 && c < 0x7f) {
-      out += ch;
+      piece = text.substr(at, 1);
+    } else if (const std::size_t n = c >= 0x80 ? utf8Length(text, at) : 0; n > 0) {
+      piece = text.substr(at, n);  // UTF-8 (names, "…", "·") passes through whole
+      used = n;
     } else {
       char buffer[8];
       std::snprintf(buffer, sizeof buffer, "\\x%02X", static_cast<unsigned>(c));
-      out += buffer;
+      piece = buffer;
     }
-    if (out.size() > max_length) {
-      out.resize(max_length);
+    if (out.size() + piece.size() > max_length) {  // cut between characters, never inside one
       out += "...";
       break;
     }
+    out += piece;
+    at += used;
   }
   return out;
+}
+
+void printWarnings(const Model& model) {
+  for (const ModelWarning& w : model.warnings()) std::fprintf(stderr, "zwang: warning: %s\n", printable(w.message, 4000).c_str());
 }
 
 std::string readFile(const std::string& path, std::size_t max_bytes) {

@@ -26,20 +26,28 @@ std::string cell(double x) {
   return buffer;
 }
 
+// Display width of UTF-8 text (link and joint names may hold any letters):
+// the bytes that start a character.
+std::size_t displayWidth(const std::string& text) {
+  std::size_t n = 0;
+  for (const char c : text) n += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+  return n;
+}
+
 // Left-aligned text columns, right-aligned numbers (cells starting with a digit, '-' or '.').
 void printTable(const std::vector<std::vector<std::string>>& rows) {
   std::vector<std::size_t> width;
   for (const auto& row : rows)
     for (std::size_t c = 0; c < row.size(); ++c) {
       if (width.size() <= c) width.push_back(0);
-      width[c] = std::max(width[c], row[c].size());
+      width[c] = std::max(width[c], displayWidth(row[c]));
     }
   for (std::size_t r = 0; r < rows.size(); ++r) {
     std::string line = "";
     for (std::size_t c = 0; c < rows[r].size(); ++c) {
       const std::string& text = rows[r][c];
       const bool numeric = r > 0 && !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '-');
-      const std::string pad(width[c] - text.size(), ' ');
+      const std::string pad(width[c] - displayWidth(text), ' ');
       line += "  " + (numeric ? pad + text : text + pad);
     }
     while (!line.empty() && line.back() == ' ') line.pop_back();
@@ -47,57 +55,49 @@ void printTable(const std::vector<std::vector<std::string>>& rows) {
   }
 }
 
-}  // namespace
-
-int commandInfo(int argc, char** argv) {
-  const Arguments args = parseArguments("info", argc, argv, 2, {"--json"}, {"--root", "--tip"});
-  if (args.help) {
-    std::fputs(usageText("info"), stdout);
-    return kExitOk;
+// The base (body 0: the root and every link welded to it) never moves: its
+// mass does not enter the dynamics, so it is shown apart.
+struct Masses {
+  double moving = 0.0, base = 0.0;
+  explicit Masses(const Model& model) : base(model.inertia(0).mass) {
+    for (int b = 1; b < model.bodyCount(); ++b) moving += model.inertia(b).mass;
   }
-  if (args.positional.size() != 1)
-    throw UsageError("info", args.positional.empty() ? "no URDF file given" : "more than one URDF file given");
-  const std::string path = args.positional[0];
-  UrdfOptions options;
-  options.root = args.value("--root");
-  options.tip = args.value("--tip");
-  Model model;
-  try {
-    model = loadUrdfFile(path, options);
-  } catch (const ModelError& e) {
-    throw CliError(kExitError, e.what());
-  }
+};
 
-  double total_mass = 0.0, moving_mass = 0.0;
-  for (int b = 0; b < model.bodyCount(); ++b) {
-    total_mass += model.inertia(b).mass;
-    if (b > 0) moving_mass += model.inertia(b).mass;
-  }
-  auto bodyName = [&](int b) { return model.frame(model.bodyFrame(b)).name; };
+std::string bodyLink(const Model& model, int body) { return model.frame(model.bodyFrame(body)).name; }
 
-  if (args.has("--json")) {
-    Json joints = Json::array();
-    for (const Joint& j : model.joints())
-      joints.push_back({{"name", j.name},
-                        {"type", toString(j.type)},
-                        {"axis", {j.axis.x(), j.axis.y(), j.axis.z()}},
-                        {"lower", finiteOrNull(j.lower)},
-                        {"upper", finiteOrNull(j.upper)},
-                        {"effort_limit", finiteOrNull(j.effort_limit)},
-                        {"velocity_limit", finiteOrNull(j.velocity_limit)},
-                        {"breakaway_friction", j.breakaway_friction},
-                        {"kinetic_friction", j.kinetic_friction},
-                        {"damping", j.damping},
-                        {"rotor_inertia", j.rotor_inertia}});
-    Json frames = Json::array();
-    for (const Frame& f : model.frames()) frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyName(f.body)}});
-    const Json out = {{"file", path},          {"model", model.name()},   {"dof", model.dof()},
-                      {"joints", std::move(joints)}, {"frames", std::move(frames)},
-                      {"total_mass", total_mass}, {"moving_mass", moving_mass}};
-    writeOutput("", prettyDump(out) + "\n");
-    return kExitOk;
-  }
+Json infoJson(const Model& model, const std::string& path) {
+  Json joints = Json::array();
+  for (const Joint& j : model.joints())
+    joints.push_back({{"name", j.name},
+                      {"type", toString(j.type)},
+                      {"axis", {j.axis.x(), j.axis.y(), j.axis.z()}},
+                      {"lower", finiteOrNull(j.lower)},
+                      {"upper", finiteOrNull(j.upper)},
+                      {"effort_limit", finiteOrNull(j.effort_limit)},
+                      {"velocity_limit", finiteOrNull(j.velocity_limit)},
+                      {"breakaway_friction", j.breakaway_friction},
+                      {"kinetic_friction", j.kinetic_friction},
+                      {"damping", j.damping},
+                      {"rotor_inertia", j.rotor_inertia}});
+  Json frames = Json::array();
+  for (const Frame& f : model.frames())
+    frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyLink(model, f.body)}});
+  Json warnings = Json::array();
+  for (const ModelWarning& w : model.warnings()) warnings.push_back({{"code", toString(w.code)}, {"message", w.message}});
+  const Masses mass(model);
+  return {{"file", path},
+          {"model", model.name()},
+          {"dof", model.dof()},
+          {"joints", std::move(joints)},
+          {"frames", std::move(frames)},
+          {"moving_mass", mass.moving},
+          {"base_mass", mass.base},
+          {"total_mass", mass.moving + mass.base},
+          {"warnings", std::move(warnings)}};
+}
 
+void printInfoTable(const Model& model, const std::string& path) {
   std::printf("%s: %d moving joint%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
               model.dof() == 1 ? "" : "s", model.frames().size(), path.c_str());
   std::vector<std::vector<std::string>> rows{{"#", "name", "type", "axis", "lower", "upper", "effort", "velocity",
@@ -113,10 +113,45 @@ int commandInfo(int argc, char** argv) {
   printTable(rows);
   std::printf("\nframes\n");
   rows = {{"name", "body", "body link"}};
-  for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyName(f.body)});
+  for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyLink(model, f.body)});
   printTable(rows);
-  std::printf("\ntotal mass %s kg (moving bodies %s kg)\n", cell(total_mass).c_str(), cell(moving_mass).c_str());
+  const Masses mass(model);
+  std::printf("\nmoving mass %s kg (bodies 1-%d), base mass %s kg (welded to the fixed base, not in the dynamics)\n",
+              cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
+  const std::size_t warnings = model.warnings().size();
+  if (warnings > 0) std::printf("%zu warning%s (on stderr)\n", warnings, warnings == 1 ? "" : "s");
   std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (damping), kg·m² or kg (rotor inertia)\n");
+}
+
+}  // namespace
+
+int commandInfo(int argc, char** argv) {
+  const Arguments args =
+      parseArguments("info", argc, argv, 2, {"--json", "--strict", "--attach-beyond-tip"}, {"--root", "--tip"});
+  if (args.help) {
+    std::fputs(usageText("info"), stdout);
+    return kExitOk;
+  }
+  if (args.positional.size() != 1)
+    throw UsageError("info", args.positional.empty() ? "no URDF file given" : "more than one URDF file given");
+  const std::string path = args.positional[0];
+  UrdfOptions options;
+  options.root = args.value("--root");
+  options.tip = args.value("--tip");
+  options.strict = args.has("--strict");
+  options.attach_beyond_tip = args.has("--attach-beyond-tip");
+  options.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip"};
+  Model model;
+  try {
+    model = loadUrdfFile(path, options);
+  } catch (const ModelError& e) {
+    throw CliError(kExitError, e.what());
+  }
+  printWarnings(model);
+  if (args.has("--json"))
+    writeOutput("", prettyDump(infoJson(model, path)) + "\n");
+  else
+    printInfoTable(model, path);
   return kExitOk;
 }
 

@@ -49,7 +49,8 @@ int main(int argc, char** argv) {
                  usage.substr(0, usage.find('\n') + 1).c_str(), e.command().c_str());
     return e.exitCode();
   } catch (const CliError& e) {
-    std::fprintf(stderr, "zwang: %s\n", printable(e.what(), 400).c_str());
+    // Our own messages: whole (a name list is already limited by its maker).
+    std::fprintf(stderr, "zwang: %s\n", printable(e.what(), std::string::npos - 4).c_str());
     return e.exitCode();
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "zwang: out of memory\n");

@@ -127,8 +127,8 @@ Problem readProblem(const std::string& file) {
   const JsonReader in(file);
   if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
   in.object(doc, "",
-            {"model", "root", "tip", "gravity", "q", "qd", "tau", "rotor_inertia", "breakaway", "wrenches",
-             "constraints", "friction", "balance"});
+            {"model", "root", "tip", "strict", "attach_beyond_tip", "gravity", "q", "qd", "tau", "rotor_inertia",
+             "breakaway", "wrenches", "constraints", "friction", "balance"});
 
   Problem p;
   p.file = file;
@@ -140,6 +140,8 @@ Problem readProblem(const std::string& file) {
 
   if (doc.contains("root")) p.root = in.string(doc["root"], "root");
   if (doc.contains("tip")) p.tip = in.string(doc["tip"], "tip");
+  if (doc.contains("strict")) p.strict = in.boolean(doc["strict"], "strict");
+  if (doc.contains("attach_beyond_tip")) p.attach_beyond_tip = in.boolean(doc["attach_beyond_tip"], "attach_beyond_tip");
   if (doc.contains("gravity")) p.gravity = Vec3(in.numbers(doc["gravity"], "gravity", 3, "gx, gy, gz"));
   for (const char* key : {"q", "qd", "tau"})
     if (doc.contains(key)) {
@@ -169,6 +171,9 @@ BoundProblem bindProblem(const Problem& p) {
   UrdfOptions urdf;
   urdf.root = p.root;
   urdf.tip = p.tip;
+  urdf.strict = p.strict;
+  urdf.attach_beyond_tip = p.attach_beyond_tip;
+  urdf.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\""};
   Model model;
   try {
     model = loadUrdfFile(p.model_path, urdf);

@@ -37,6 +37,8 @@ struct Problem {
   std::string file;        // the problem file, as given on the command line
   std::string model_path;  // resolved against the problem file's directory
   std::string root, tip;
+  bool strict = false;             // "strict": refuse the model's warnings
+  bool attach_beyond_tip = false;  // "attach_beyond_tip": weld the links beyond the tip as a payload
   std::optional<Vec3> gravity;
   std::optional<Eigen::VectorXd> q, qd, tau, rotor_inertia, breakaway;
   std::vector<WrenchSpec> wrenches;

@@ -1,4 +1,5 @@
 // `zwang solve PROBLEM.json [-o FILE] [--pretty]`.
+#include <cmath>
 #include <cstdio>
 
 #include "cli.hpp"
@@ -6,6 +7,21 @@
 #include "solution_writer.hpp"
 
 namespace zwang::cli {
+
+namespace {
+
+// A configuration outside the joint limits is solved as given (the limits
+// matter to the friction solver only at a stop); it is said once per joint.
+void warnOutsideLimits(const std::string& file, const Model& model, const Eigen::VectorXd& q) {
+  for (int j = 0; j < model.dof(); ++j) {
+    const Joint& joint = model.joint(j);
+    if (std::isnan(q[j]) || (q[j] >= joint.lower && q[j] <= joint.upper)) continue;  // NaN: the solve refuses it
+    std::fprintf(stderr, "zwang: warning: %s: q[%d] = %g puts joint '%s' outside its limits [%g, %g]\n", file.c_str(), j,
+                 q[j], printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
+  }
+}
+
+}  // namespace
 
 int commandSolve(int argc, char** argv) {
   const Arguments args = parseArguments("solve", argc, argv, 2, {"--pretty"}, {"-o", "--output"});
@@ -19,6 +35,8 @@ int commandSolve(int argc, char** argv) {
 
   const Problem problem = readProblem(args.positional[0]);
   BoundProblem bound = bindProblem(problem);
+  printWarnings(bound.model);
+  warnOutsideLimits(problem.file, bound.model, bound.q);
   Workspace ws(bound.model, *bound.task);
   const Status status =
       bound.with_friction

@@ -51,6 +51,9 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
                        Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
                        Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da);
 
+// The joints whose q lies outside their limits, into the solution (a warning).
+void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out);
+
 // After the final accelerations (ws.a): ‖Aᵀ Ẍ − b‖ and whether every row is
 // met, into ws.solution.balance.
 void taskResidual(const Task& task, Workspace& ws);

@@ -24,8 +24,9 @@ namespace py = pybind11;
 
 // ---- errors (module.cpp) ---------------------------------------------------
 // zwang.Error, zwang.ModelError, zwang.SolveError, zwang.InfeasibleError, zwang.StaleResultError.
+// zwang.ModelWarning (a UserWarning) for the model's warnings.
 struct Exceptions {
-  py::handle error, model_error, solve_error, infeasible_error, stale_error;
+  py::handle error, model_error, solve_error, infeasible_error, stale_error, model_warning;
 };
 const Exceptions& exceptions();
 const char* codeName(StatusCode code);

@@ -15,10 +15,14 @@ std::string pathArg(py::handle path) {
   return fs.cast<std::string>();
 }
 
-UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia) {
+UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia,
+                        bool strict, bool attach_beyond_tip) {
   UrdfOptions options;
   options.root = root;
   options.tip = tip;
+  options.strict = strict;
+  options.attach_beyond_tip = attach_beyond_tip;
+  options.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True"};
   if (!rotor_inertia.is_none()) {
     if (!py::isinstance<py::dict>(rotor_inertia))
       raise(PyExc_TypeError, "rotor_inertia: expected a dict {joint name: inertia}");
@@ -63,6 +67,14 @@ py::array transformMatrix(const Eigen::Matrix3d& R, const Vec3& p) {
 
 std::string jointRepr(const Joint& j) {
   return "<zwang.Joint '" + j.name + "' " + toString(j.type) + ">";
+}
+
+// Each of the model's warnings through Python's warnings machinery (so filters
+// apply: "error" turns one into an exception, "ignore" silences it).
+std::shared_ptr<Model> issueWarnings(std::shared_ptr<Model> model) {
+  for (const ModelWarning& w : model->warnings())
+    if (PyErr_WarnEx(exceptions().model_warning.ptr(), w.message.c_str(), 2) != 0) throw py::error_already_set();
+  return model;
 }
 
 }  // namespace
@@ -132,6 +144,13 @@ void bindModel(py::module_& m) {
       .def_property_readonly("damping", [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.damping; }); })
       .def_property_readonly("rotor_inertia",
                              [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.rotor_inertia; }); })
+      .def_property_readonly("warnings", [](const Model& model) {
+        py::list out;
+        for (const ModelWarning& w : model.warnings()) out.append(py::make_tuple(toString(w.code), w.message));
+        return out;
+      }, "list of (code, message): what was doubtful in the data ('point_mass', 'placeholder_inertia', ...)")
+      .def_property_readonly("base_mass", [](const Model& model) { return model.inertia(0).mass; },
+                             "mass welded to the fixed base (not in the dynamics) [kg]")
       .def_property_readonly("mass", [](const Model& model) {
         double mass = 0.0;
         for (int b = 1; b < model.bodyCount(); ++b) mass += model.inertia(b).mass;
@@ -159,15 +178,23 @@ void bindModel(py::module_& m) {
                "), " + std::to_string(model.frames().size()) + " frames>";
       });
 
-  m.def("load_urdf", [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor) {
-    return std::make_shared<Model>(loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor)));
+  m.def("load_urdf", [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor,
+                        bool strict, bool attach_beyond_tip) {
+    return issueWarnings(std::make_shared<Model>(
+        loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip))));
   }, py::arg("path"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(),
+        py::kw_only(), py::arg("strict") = false, py::arg("attach_beyond_tip") = false,
         "Load the chain from link `root` (default: the URDF's root) to link `tip` (default: the unique leaf).\n"
-        "rotor_inertia: optional {joint name: reflected inertia} overriding the URDF. Raises ModelError.");
+        "rotor_inertia: optional {joint name: reflected inertia} overriding the URDF.\n"
+        "Doubtful data loads with a zwang.ModelWarning per warning (also in Model.warnings);\n"
+        "strict=True raises ModelError instead. attach_beyond_tip=True welds links behind moving joints\n"
+        "below the tip to the tip body (joints locked at 0). Raises ModelError.");
   m.def("load_urdf_string", [](const std::string& xml, const std::string& root, const std::string& tip,
-                               const py::object& rotor) {
-    return std::make_shared<Model>(loadUrdfString(xml, urdfOptions(root, tip, rotor)));
+                               const py::object& rotor, bool strict, bool attach_beyond_tip) {
+    return issueWarnings(
+        std::make_shared<Model>(loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip))));
   }, py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(),
+        py::kw_only(), py::arg("strict") = false, py::arg("attach_beyond_tip") = false,
         "load_urdf from a string holding the URDF XML.");
 }
 

@@ -81,6 +81,11 @@ PYBIND11_MODULE(zwang, m) {
                                "A live Result was read after its workspace was used again; use Result.copy() "
                                "to keep results.");
 
+  e.model_warning = newException(m, "ModelWarning", py::make_tuple(py::handle(PyExc_UserWarning)),
+                                 "Doubtful but usable model data (a point mass, a placeholder inertia or limit, "
+                                 "mass beyond the tip, ...), issued once per warning by load_urdf. "
+                                 "load_urdf(..., strict=True) raises ModelError instead.");
+
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "bindings.hpp"
 
@@ -198,6 +199,22 @@ Eigen::VectorXd optionalOverride(const char* name, py::handle value) {
 }
 
 py::object overrideArray(const Eigen::VectorXd& v) { return v.size() ? py::object(vectorCopy(v)) : py::none(); }
+
+// A configuration outside the joint limits is solved as given; say so (a
+// zwang.ModelWarning; Python's filters show each distinct message once). Kept
+// out of the C++ solve, which must not allocate.
+void warnOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q) {
+  for (int j = 0; j < model.dof(); ++j) {
+    const Joint& joint = model.joint(j);
+    if (q[j] >= joint.lower && q[j] <= joint.upper) continue;
+    char figures[120];
+    std::snprintf(figures, sizeof figures, "%g puts joint '", q[j]);
+    char limits[80];
+    std::snprintf(limits, sizeof limits, "' outside its limits [%g, %g]", joint.lower, joint.upper);
+    const std::string text = "q[" + std::to_string(j) + "] = " + figures + joint.name + limits;
+    if (PyErr_WarnEx(exceptions().model_warning.ptr(), text.c_str(), 1) != 0) throw py::error_already_set();
+  }
+}
 
 Vec6 frameAccelerationOf(const Result& r, int frame, Expressed e) {
   if (r.data) return (e == Expressed::Local ? r.data->frame_acc_local : r.data->frame_acc_world).row(frame).transpose();
@@ -532,6 +549,7 @@ void bindSolve(py::module_& m) {
                                   : solveHybridDynamics(*model, task, qv, qdv, tauv, *pw.ws);
     const bool infeasible = status.code == StatusCode::Infeasible;
     if (!status && !infeasible) raiseStatus(status, "solve");
+    warnOutsideLimits(*model, qv);
     Result r;
     r.model = std::move(model);
     r.owner = std::move(ws_obj);

@@ -551,7 +551,7 @@ TEST_CASE("info: table and JSON", "[info]") {
     const Run r = run({"info", arm});
     CHECK(r.exit_code == 0);
     for (const char* part : {"one_dof_arm: 1 moving joint, 3 frames", "joint1", "revolute", "(0, 0, 1)", "breakaway",
-                             "rotor_inertia", "link1", "tip", "total mass 1 kg"})
+                             "rotor_inertia", "link1", "tip", "moving mass 1 kg (bodies 1-1), base mass 0 kg"})
       CHECK(contains(r.out, part));
   }
   SECTION("json") {
@@ -568,6 +568,10 @@ TEST_CASE("info: table and JSON", "[info]") {
     CHECK(j["joints"][0]["upper"].get<double>() == Approx(M_PI).margin(1e-15));
     CHECK(j["joints"][0]["effort_limit"].get<double>() == 100.0);
     CHECK(j["total_mass"].get<double>() == Approx(1.0).margin(1e-15));
+    CHECK(j["moving_mass"].get<double>() == Approx(1.0).margin(1e-15));
+    CHECK(j["base_mass"].get<double>() == 0.0);
+    CHECK(j["warnings"].empty());
+    CHECK(r.err.empty());
     std::vector<std::string> frames;
     for (const Json& f : j["frames"]) frames.push_back(f["name"]);
     CHECK(frames == std::vector<std::string>{"base", "link1", "tip"});
@@ -579,6 +583,12 @@ TEST_CASE("info: table and JSON", "[info]") {
     const Json j = parse(r.out);
     CHECK(j["dof"] == 4);
     CHECK(j["joints"][3]["name"] == "panda_joint4");
+    // The links beyond panda_link4 are cut off with their mass: said once.
+    REQUIRE(j["warnings"].size() == 1);
+    CHECK(j["warnings"][0]["code"] == "mass_beyond_tip");
+    CHECK(contains(r.err, "zwang: warning: "));
+    CHECK(contains(r.err, "set --attach-beyond-tip"));
+    CHECK(r.err.find('\n') == r.err.size() - 1);
   }
 }
 
@@ -822,5 +832,101 @@ TEST_CASE("the docs link only to files that exist", "[docs]") {
       INFO(target);
       CHECK(std::filesystem::exists(std::filesystem::path(docs) / target));
     }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Model warnings: on stderr once each, --strict / "strict" refuses them; the
+// hints name the CLI's own options; UTF-8 in messages passes through.
+
+namespace {
+
+// base -j1-> l1 with a point mass and placeholder limits.
+const char* kDoubtfulArm = R"(<robot name="doubtful"><link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="0" effort="0" velocity="0"/></joint>
+  <link name="l1"><inertial><origin xyz="0.5 0 0"/><mass value="2"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link></robot>)";
+
+// base -j0-> hub, then 15 revolute branches hub -jk-> leaf_k: no unique tip.
+std::string fifteenBranches() {
+  std::string xml = R"(<robot name="star"><link name="base"/>
+    <joint name="j0" type="continuous"><parent link="base"/><child link="hub"/></joint>
+    <link name="hub"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>)";
+  for (int k = 0; k < 15; ++k) {
+    const std::string n = std::to_string(k);
+    xml += "<joint name=\"j" + n + "_\" type=\"continuous\"><parent link=\"hub\"/><child link=\"leaf_" + n +
+           "\"/></joint><link name=\"leaf_" + n + "\"/>";
+  }
+  return xml + "</robot>";
+}
+
+int countOf(const std::string& text, const std::string& part) {
+  int n = 0;
+  for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8", "[warnings]") {
+  const std::string dir = cli_test::scratchDir();
+  const std::string arm = dir + "/doubtful.urdf";
+  cli_test::writeText(arm, kDoubtfulArm);
+
+  SECTION("info: each warning once, the model still loads; --strict refuses") {
+    const Run r = run({"info", arm});
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 0);
+    CHECK(countOf(r.err, "zwang: warning: " + arm + ": link 'l1': a point mass") == 1);
+    CHECK(countOf(r.err, "zwang: warning: " + arm + ": joint 'j1': placeholder <limit") == 1);
+    CHECK(countOf(r.err, "\n") == 2);
+    CHECK(contains(r.out, "2 warnings (on stderr)"));
+    const Run strict = run({"info", arm, "--strict"});
+    checkOneLineError(strict, 1);
+    CHECK(contains(strict.err, "refused in strict mode (2 warnings)"));
+  }
+  SECTION("solve: warnings before the solution, q outside the limits, \"strict\": true") {
+    const std::string file = dir + "/doubtful.json";
+    cli_test::writeText(file, R"({"model": "doubtful.urdf", "q": [0.5]})");
+    const Run r = run({"solve", file});
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 0);
+    CHECK(countOf(r.err, "zwang: warning: ") == 2);  // placeholder limits are no limits: q = 0.5 is inside
+    std::string limited = kDoubtfulArm;
+    const std::string placeholder = R"(lower="0" upper="0" effort="0")";
+    limited.replace(limited.find(placeholder), placeholder.size(), R"(lower="-0.2" upper="0.2" effort="5")");
+    cli_test::writeText(dir + "/limited.urdf", limited);
+    cli_test::writeText(file, R"({"model": "limited.urdf", "q": [0.5]})");
+    const Run outside = run({"solve", file});
+    INFO("stderr: " << outside.err);
+    CHECK(outside.exit_code == 0);
+    CHECK(contains(outside.err, "zwang: warning: " + file + ": q[0] = 0.5 puts joint 'j1' outside its limits [-0.2, 0.2]"));
+    cli_test::writeText(file, R"({"model": "doubtful.urdf", "strict": true})");
+    const Run strict = run({"solve", file});
+    checkOneLineError(strict, 1);
+    CHECK(contains(strict.err, "model: "));
+    CHECK(contains(strict.err, "refused in strict mode"));
+  }
+  SECTION("no unique tip: the hint names --tip or \"tip\", the list is cut between names, … is UTF-8") {
+    const std::string star = dir + "/star.urdf";
+    cli_test::writeText(star, fifteenBranches());
+    const Run info = run({"info", star});
+    checkOneLineError(info, 1);
+    CHECK(contains(info.err, "(set --tip)"));
+    CHECK_FALSE(contains(info.err, "UrdfOptions"));
+    CHECK(contains(info.err, ", \xE2\x80\xA6 (3 more)"));  // "…" as UTF-8, after 12 whole names
+    CHECK(countOf(info.err, "'leaf_") == 12);
+    CHECK_FALSE(contains(info.err, "\\x"));
+    const std::string file = dir + "/star.json";
+    cli_test::writeText(file, R"({"model": "star.urdf"})");
+    const Run solve = run({"solve", file});
+    checkOneLineError(solve, 1);
+    CHECK(contains(solve.err, "(set \"tip\")"));
+  }
+  SECTION("valid UTF-8 passes through, other bytes are escaped") {
+    const Run r = run({"info", "--\xC3\xA9t\xC3\xA9\xFF"});
+    CHECK(r.exit_code == 2);
+    CHECK(contains(r.err, "unknown option '--\xC3\xA9t\xC3\xA9\\xFF'"));
   }
 }

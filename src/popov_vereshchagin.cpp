@@ -3,7 +3,7 @@
 //  * base coordinates (src/internal/sweeps.hpp): every spatial quantity is in
 //    world axes at the world origin, so the report's ⁱX_{i−1} are identities
 //    and lines 16, 18, 19 and 29 sum instead of transforming;
-//  * sign of ν: SPEC fixes the constraint wrench on a body as +A ν (the report
+//  * sign of ν: the constraint wrench on a body is +A ν (docs/solver.md, "Sign of ν"; the report
 //    and KDL apply −A ν). So 𝓛 below is the report's −𝓛 (positive
 //    semi-definite) and line 28 has −A ν where the report has +A ν;
 //  * constraints may sit on any bodies (the report's section 4.4 extension):
@@ -52,9 +52,9 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
 namespace {
 
 // The task's constraints as unit forces on their bodies in base coordinates,
-// and the set points b as the sweep sees them (SPEC: b is the true classical
-// acceleration of the frame origin p; the sweep works with spatial
-// accelerations shifted by [−g; 0]):
+// and the set points b as the sweep sees them (b is the true classical
+// acceleration of the frame origin p: docs/conventions.md, "What a frame's
+// acceleration is"; the sweep works with spatial accelerations shifted by [−g; 0]):
 //   A_w = [f; n + p × f],  A_wᵀ Ẍ = b − f·(ω × v_p) − f·g.
 void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) {
   const std::vector<int>& user_row = task.solverRowToUserRow();
@@ -271,7 +271,7 @@ void taskResidual(const Task& task, Workspace& ws) {
 void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c) {
   // The wrenches A ν of each body's own constraints, summed inward and
-  // projected on each joint: the physical torque (SPEC §1, not eq. 4.4).
+  // projected on each joint: the physical torque (docs/solver.md, "Constraint torques: why not eq. 4.4").
   const int N = model.dof();
   if (task.constraintRows() == 0) {
     tau_c.setZero();

@@ -417,7 +417,7 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
     if (dyn.friction < 0.0) report.fail(who + ": <dynamics> friction " + fmt(dyn.friction) + " is negative");
     if (dyn.damping < 0.0) report.fail(who + ": <dynamics> damping " + fmt(dyn.damping) + " is negative");
     joint.breakaway_friction = dyn.friction;
-    joint.kinetic_friction = dyn.friction;  // SPEC default: f_c = f
+    joint.kinetic_friction = dyn.friction;  // default f_c = f: docs/friction.md, "The model of friction"
     joint.damping = dyn.damping;
   }
 

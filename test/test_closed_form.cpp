@@ -1,5 +1,5 @@
-// The solver against closed-form mechanics: the report's 1-DOF arm (SPEC
-// "Reference cases"), a pendulum and a prismatic joint under gravity.
+// The solver against closed-form mechanics: the report's 1-DOF arm (docs/theory.md,
+// "The reference cases"), a pendulum and a prismatic joint under gravity.
 #include <catch2/catch.hpp>
 #include <cmath>
 

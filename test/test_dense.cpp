@@ -54,8 +54,8 @@ TEST_CASE("hybrid dynamics matches the dense KKT solution on 500+ random chains"
       acc_err.add(relativeError(accelerationOf(model, ws, frame, Expressed::World), ref.acc_world[l]));
     }
 
-    // Closure (SPEC §1): the unconstrained arm driven by τ_ctrl and the same
-    // wrenches accelerates with exactly q̈.
+    // Closure (docs/solver.md, "Constraint torques: why not eq. 4.4"): the
+    // unconstrained arm driven by τ_ctrl and the same wrenches accelerates with exactly q̈.
     DynamicsInput free_input = in;
     free_input.constraints.clear();
     const Task free_task = taskFromInput(model, free_input);

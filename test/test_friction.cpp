@@ -1,7 +1,7 @@
-// Static friction (SPEC §2; issue 3) through the public API solveWithFriction,
+// Static friction (docs/friction.md; issue 3) through the public API solveWithFriction,
 // against independent references (support/friction_reference: dense KKT brute
 // force over all stick/slip patterns and the report's grid sampling) and the
-// closed forms of SPEC "Reference cases". Every friction solve is checked with
+// closed forms of docs/theory.md, "The reference cases". Every friction solve is checked with
 // checkMaximumDissipation (support/friction_check) and the closure property.
 #include <catch2/catch.hpp>
 #include <Eigen/Eigenvalues>
@@ -88,7 +88,7 @@ FrictionOptions randomOverrides(std::mt19937_64& rng, FrictionSetup& setup, int 
 
 }  // namespace
 
-TEST_CASE("the report's 1-DOF evaluation, exactly (SPEC reference cases)") {
+TEST_CASE("the report's 1-DOF evaluation, exactly (the reference cases)") {
   const Model model = oneDofArmModel();
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(1), qd = Eigen::VectorXd::Zero(1), tau = Eigen::VectorXd::Zero(1);
   for (FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {

@@ -1,5 +1,5 @@
 // Joint position limits as one-sided reactions combined with static friction
-// (SPEC §3; issue 3 item 5), through solveWithFriction, against closed forms on
+// (docs/friction.md, "Joint position limits"; issue 3 item 5), through solveWithFriction, against closed forms on
 // a 1-DOF arm and the brute-force enumeration (support/friction_reference) on
 // random chains with stuck joints resting exactly on a limit.
 #include <catch2/catch.hpp>
@@ -31,7 +31,7 @@ bool finiteOutputs(const Workspace& ws) {
          std::isfinite(r.gauss_dual) && std::isfinite(ws.solution.gauss);
 }
 
-// The report's arm (SPEC reference cases) with limits [−0.5, 1.0] and f = 2.
+// The report's arm (docs/theory.md, "The reference cases") with limits [−0.5, 1.0] and f = 2.
 struct LimitedArm {
   ChainSpec spec;
   Model model;
@@ -75,7 +75,7 @@ Case solveArm(const LimitedArm& arm, const Task& task, double q0, double qd0, co
 
 }  // namespace
 
-TEST_CASE("a 1-DOF arm on its limits under gravity (SPEC §3)") {
+TEST_CASE("a 1-DOF arm on its limits under gravity") {
   const LimitedArm arm;
   Task task(arm.model);
   // Gravity −y: torque −0.5·g·cos q about z (the link pulled towards negative q).

@@ -1,6 +1,6 @@
 // Self-tests of the independent friction references (support/friction_reference):
 // the brute-force pattern enumeration and the report's grid sampling agree with
-// each other, with the closed forms of SPEC "Reference cases", and the brute
+// each other, with the closed forms of docs/theory.md, "The reference cases", and the brute
 // force's μ* really maximises g over the box. No zwang friction code is used.
 #include <catch2/catch.hpp>
 #include <cstdio>
@@ -13,7 +13,7 @@ using namespace zwang::testing;
 
 namespace {
 
-// The report's 1-DOF arm (SPEC "Reference cases"), no gravity, stuck at q = 0.
+// The report's 1-DOF arm (docs/theory.md, "The reference cases"), no gravity, stuck at q = 0.
 DynamicsInput armInput() {
   DynamicsInput in;
   in.q = Eigen::VectorXd::Zero(1);
@@ -96,7 +96,7 @@ TEST_CASE("friction references reproduce the report's 1-DOF evaluation") {
   }
 }
 
-TEST_CASE("friction references: joint limits (SPEC §3)") {
+TEST_CASE("friction references: joint limits") {
   ChainSpec spec = oneDofArm();
   spec.joints[0].lower = -0.5;
   spec.joints[0].upper = 1.0;

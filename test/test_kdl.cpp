@@ -5,7 +5,7 @@
 //  * KDL's beta constrains the spatial acceleration including the −g base
 //    acceleration; ours constrains the true classical acceleration;
 //  * KDL's f_ext is in base orientation at the segment origin;
-//  * KDL applies −αν to the tip, SPEC +Aν: ν_ours = −ν_KDL;
+//  * KDL applies −αν to the tip, we +Aν (docs/solver.md, "Sign of ν"): ν_ours = −ν_KDL;
 //  * KDL's segment inertia is in the tip (child link) frame.
 #include <catch2/catch.hpp>
 #include <cstdio>

@@ -257,7 +257,7 @@ TEST_CASE("toUrdf: urdfdom reads back every field exactly", "[references][urdf]"
 }
 
 // --------------------------------------------------------------------------
-// Dense reference: closed forms (SPEC "Reference cases" and textbook cases)
+// Dense reference: closed forms (docs/theory.md, "The reference cases", and textbook cases)
 // --------------------------------------------------------------------------
 
 TEST_CASE("dense reference: the 1-DOF arm of the report", "[references][closed-form]") {
@@ -719,7 +719,7 @@ TEST_CASE("KDL conventions: the sign of ν and what constraint_torques are", "[r
     worst_sign = std::max(worst_sign, relErr(-kdl.nu_kdl, dense.nu));
     best_wrong_sign = std::min(best_wrong_sign, relErr(kdl.nu_kdl, dense.nu));
 
-    // KDL's constraint_torques: with W = A ν (SPEC sign) at the tip and J the
+    // KDL's constraint_torques: with W = A ν (our sign) at the tip and J the
     // tip Jacobian, entry j is the joint-j torque when the distal joints
     // f = j+1..n are free and unactuated:  J_jᵀW − H_jf H_ff⁻¹ J_fᵀ W.
     // Only the last entry is the physical torque (J ᵀ W)_n.
@@ -735,7 +735,8 @@ TEST_CASE("KDL conventions: the sign of ν and what constraint_torques are", "[r
     }
     worst_articulated = std::max(worst_articulated, relErr(kdl.constraint_torques_kdl, articulated));
 
-    // Closure (SPEC §1): the unconstrained arm driven by τ + τ_c replays q̈;
+    // Closure (docs/solver.md, "Constraint torques: why not eq. 4.4"): the
+    // unconstrained arm driven by τ + τ_c replays q̈;
     // driven by τ + KDL's constraint_torques it does not (except in special
     // draws where the tip wrench loads no distal joint, J_fᵀ W = 0).
     DynamicsInput free = in;

@@ -1,6 +1,6 @@
 // The spatial-algebra core against explicit 6×6 matrix formulas
 // (Featherstone, "Rigid Body Dynamics Algorithms", ch. 2, rewritten for the
-// linear-first ordering of SPEC).
+// linear-first ordering of docs/conventions.md).
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 #include <random>

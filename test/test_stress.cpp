@@ -15,7 +15,7 @@
 //               holds in the least-squares sense, test_singular);
 //   τ_c         ‖τ_c − Gᵀν‖∞ / (‖G‖∞‖ν‖∞ + ‖τ_c‖∞) (the constraint torques are the
 //               physical ones, in the range of Gᵀ);
-//   dissipation on the stuck joints (SPEC §2): |μ_j| ≤ f_j (excess relative to max(1, f));
+//   dissipation on the stuck joints (docs/friction.md): |μ_j| ≤ f_j (excess relative to max(1, f));
 //               |μ_j| < f_j ⇒ q̈_j = 0;
 //               μ_j = f_j ⇒ q̈_j ≥ 0; μ_j = −f_j ⇒ q̈_j ≤ 0, the q̈ violation relative
 //               to max(‖q̈(0)_Θ‖∞, ‖K_ΘΘ μ*‖∞) (the accelerations friction acts on);

@@ -8,7 +8,8 @@ The 1-DOF arm (models/one_dof_arm.urdf: 2.25 kg m^2 about the joint, breakaway f
 
 For each, the exact friction-aware solve gives mu*; the report's sampling of g(mu) on a grid
 (eq. 5.9: the plain solver with the friction reaction applied as the torque -mu) is drawn
-with it. Sign (SPEC): mu > 0 opposes positive motion; the report plots magnitudes.
+with it. Sign (docs/conventions.md, "Signs of the outputs"): mu > 0 opposes positive motion;
+the report plots magnitudes.
 
     PYTHONPATH=build/python python3 docs/python/scenarios.py [--out DIR]
 """
@@ -95,7 +96,7 @@ def main():
     fig.savefig(args.out / "scenarios.png", dpi=90)
     print(f"wrote {args.out / 'scenarios.png'}")
 
-    # The SPEC reference values (the script fails loudly if they are not met).
+    # The reference values of docs/theory.md, "The reference cases" (the script fails loudly if not met).
     (_, mu1, qdd1, tc1, st1, _, _), (_, mu2, qdd2, _, st2, _, _), (_, mu3, qdd3, tc3, st3, _, _) = rows
     assert st1 == "stick" and abs(mu1 + 5) < 1e-12 and abs(qdd1) < 1e-12 and abs(tc1) < 1e-12
     assert st2 == "slip-" and mu2 == -10 and abs(qdd2 + 1 / 2.25) < 1e-14

@@ -1,10 +1,11 @@
-// The robot model: a serial chain of 1-DOF joints with rigid bodies, immutable
-// once built and safe to share between threads. Scratch memory lives in a
-// Workspace (workspace.hpp); a Model never changes during a solve.
-//
-// Indexing: body 0 is the fixed base; joint j (0-based) moves body j+1 relative
-// to body j. Fixed URDF joints are merged into their parent body at load time,
-// but every link stays addressable as a Frame attached to a body.
+/// \file
+/// The robot model: a serial chain of 1-DOF joints with rigid bodies, immutable
+/// once built and safe to share between threads. Scratch memory lives in a
+/// Workspace (workspace.hpp); a Model never changes during a solve.
+///
+/// Indexing: body 0 is the fixed base; joint j (0-based) moves body j+1 relative
+/// to body j. Fixed URDF joints are merged into their parent body at load time,
+/// but every link stays addressable as a Frame attached to a body.
 #pragma once
 
 #include <cmath>
@@ -21,35 +22,41 @@ namespace zwang {
 using spatial::RigidInertia;
 using spatial::Transform;
 
-// Thrown by model construction and URDF loading (never by a solve).
+/// Thrown by model construction and URDF loading (never by a solve).
 class ModelError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
+/// The kinds of moving joint, as URDF names them.
 enum class JointType { Revolute, Continuous, Prismatic };
+/// The URDF name of a joint type: "revolute", "continuous" or "prismatic".
 const char* toString(JointType type);
 
+/// One moving joint of the chain: its axis and placement, drive (rotor inertia), friction and limits.
 struct Joint {
-  std::string name;
-  JointType type = JointType::Revolute;
-  Vec3 axis = Vec3::UnitZ();             // unit vector in the joint (= child body) frame
-  Transform placement;                   // ʲX_parent: parent body frame → joint frame at q = 0
-  double rotor_inertia = 0.0;            // d_j, reflected armature inertia [kg·m² or kg]
-  double breakaway_friction = 0.0;       // f_j ≥ 0, static friction bound
-  double kinetic_friction = 0.0;         // f_c,j ≥ 0, Coulomb friction while moving
-  double damping = 0.0;                  // b_j ≥ 0, viscous friction
-  double lower = -std::numeric_limits<double>::infinity();  // position limits
-  double upper = std::numeric_limits<double>::infinity();
+  std::string name;                      ///< unique among the model's joints
+  JointType type = JointType::Revolute;  ///< revolute, continuous (no position limits) or prismatic
+  Vec3 axis = Vec3::UnitZ();             ///< unit vector in the joint (= child body) frame
+  Transform placement;                   ///< ʲX_parent: parent body frame → joint frame at q = 0
+  double rotor_inertia = 0.0;            ///< d_j, reflected armature inertia [kg·m² or kg]
+  double breakaway_friction = 0.0;       ///< f_j ≥ 0, static friction bound
+  double kinetic_friction = 0.0;         ///< f_c,j ≥ 0, Coulomb friction while moving
+  double damping = 0.0;                  ///< b_j ≥ 0, viscous friction
+  double lower = -std::numeric_limits<double>::infinity();  ///< position limits: lower [rad or m]
+  double upper = std::numeric_limits<double>::infinity();   ///< position limits: upper [rad or m]
+  /// Largest torque [N·m] or force [N] (URDF `<limit effort>`).
   double effort_limit = std::numeric_limits<double>::infinity();
+  /// Largest speed [rad/s or m/s] (URDF `<limit velocity>`).
   double velocity_limit = std::numeric_limits<double>::infinity();
 
+  /// True for revolute and continuous joints.
   bool isRevolute() const { return type != JointType::Prismatic; }
-  // Motion subspace S (6-vector, linear first) in the child body frame.
+  /// Motion subspace S (6-vector, linear first) in the child body frame.
   Vec6 motionSubspace() const {
     return isRevolute() ? spatial::stack(Vec3::Zero(), axis) : spatial::stack(axis, Vec3::Zero());
   }
-  // ʲX_parent(q) = X_J(q) · X_T: the placement followed by the joint motion.
+  /// ʲX_parent(q) = X_J(q) · X_T: the placement followed by the joint motion.
   Transform transform(double q) const;
 };
 
@@ -69,53 +76,65 @@ inline Transform Joint::transform(double q) const {
   return X;
 }
 
-// Something in the model data that is physically doubtful but usable: the
-// model loads and the dynamics uses the data as given (docs/errors.md,
-// "Model warnings"). UrdfOptions::strict turns every warning into a ModelError.
+/// Something in the model data that is physically doubtful but usable: the
+/// model loads and the dynamics uses the data as given (docs/errors.md,
+/// "Model warnings"). UrdfOptions::strict turns every warning into a ModelError.
 enum class WarningCode {
-  PointMass,           // a moving link with mass but zero rotational inertia
-  PlaceholderInertia,  // rotational inertia too small for the mass (a body denser than osmium)
-  TriangleInequality,  // principal moments with a + b < c (no real body has them)
-  PlaceholderLimits,   // <limit lower == upper, effort == velocity == 0>: read as "no limits"
-  MassBeyondTip,       // links behind a moving joint below the tip carry mass the chain ignores
-  PayloadAttached,     // that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
-  Urdfdom,             // urdfdom's own warning, passed on once
+  PointMass,           ///< a moving link with mass but zero rotational inertia
+  PlaceholderInertia,  ///< rotational inertia too small for the mass (a body denser than osmium)
+  TriangleInequality,  ///< principal moments with a + b < c (no real body has them)
+  PlaceholderLimits,   ///< <limit lower == upper, effort == velocity == 0>: read as "no limits"
+  MassBeyondTip,       ///< links behind a moving joint below the tip carry mass the chain ignores
+  PayloadAttached,     ///< that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
+  Urdfdom,             ///< urdfdom's own warning, passed on once
 };
-// "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.
+/// "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.
 const char* toString(WarningCode code);
 
+/// A warning recorded while building a model (Model::warnings()).
 struct ModelWarning {
-  WarningCode code;
-  std::string message;  // one line naming the source, the link or joint and the figures
+  WarningCode code;     ///< what kind of doubt
+  std::string message;  ///< one line naming the source, the link or joint and the figures
 };
 
+/// A named frame (a URDF link) rigidly attached to a body of the chain.
 struct Frame {
-  std::string name;
-  int body = 0;         // the body it is rigidly attached to
-  Transform placement;  // ᶠX_body
+  std::string name;     ///< the URDF link name, unique among the frames
+  int body = 0;         ///< the body it is rigidly attached to
+  Transform placement;  ///< ᶠX_body
 };
 
+/// The robot: a chain of moving joints and rigid bodies, immutable once built (ModelBuilder, loadUrdfFile).
 class Model {
  public:
+  /// Number of moving joints n (the length of q, q̇, τ, q̈).
   int dof() const { return static_cast<int>(joints_.size()); }
+  /// Number of bodies, n + 1 with the fixed base.
   int bodyCount() const { return dof() + 1; }
+  /// The robot's name (URDF `<robot name>`).
   const std::string& name() const { return name_; }
 
+  /// The moving joints in chain order.
   const std::vector<Joint>& joints() const { return joints_; }
+  /// Joint j (0-based; throws std::out_of_range outside [0, dof())).
   const Joint& joint(int j) const { return joints_.at(static_cast<std::size_t>(j)); }
-  // Inertia of body b (b = 0 is the base, unused by the dynamics) in its own frame.
+  /// Inertia of body b (b = 0 is the base, unused by the dynamics) in its own frame.
   const RigidInertia& inertia(int b) const { return inertias_.at(static_cast<std::size_t>(b)); }
+  /// Every frame: the base, each body's link and the links on fixed joints.
   const std::vector<Frame>& frames() const { return frames_; }
+  /// Frame f (throws std::out_of_range outside [0, frames().size())).
   const Frame& frame(int f) const { return frames_.at(static_cast<std::size_t>(f)); }
 
-  // Index lookups; throw ModelError naming the unknown name and the known ones.
+  /// Index lookups; throw ModelError naming the unknown name and the known ones.
   int jointIndex(const std::string& name) const;
+  /// Index of the frame called `name`; throws ModelError naming the known frames.
   int frameIndex(const std::string& name) const;
+  /// True when a frame of that name exists.
   bool hasFrame(const std::string& name) const;
-  // The frame of body b (the link the moving joint b−1 ends in; b = 0: the base link).
+  /// The frame of body b (the link the moving joint b−1 ends in; b = 0: the base link).
   int bodyFrame(int b) const { return body_frames_.at(static_cast<std::size_t>(b)); }
-  // What was doubtful in the data the model was built from (each once, in the
-  // order found); empty for clean data.
+  /// What was doubtful in the data the model was built from (each once, in the
+  /// order found); empty for clean data.
   const std::vector<ModelWarning>& warnings() const { return warnings_; }
 
  private:
@@ -128,35 +147,38 @@ class Model {
   std::vector<ModelWarning> warnings_;
 };
 
-// Builds a Model link by link (the URDF loader and the test generators use it).
-// Checks every value as it arrives and throws ModelError naming the joint or
-// link and the field.
+/// Builds a Model link by link (the URDF loader and the test generators use it).
+/// Checks every value as it arrives and throws ModelError naming the joint or
+/// link and the field.
 class ModelBuilder {
  public:
+  /// An empty chain: only the fixed base, a frame called `base_frame`.
   explicit ModelBuilder(std::string robot_name = "robot", std::string base_frame = "base");
-  // Start from an existing model (e.g. to set rotor inertias after loading).
+  /// Start from an existing model (e.g. to set rotor inertias after loading).
   explicit ModelBuilder(const Model& model);
 
-  // Append a moving joint whose child link is `child_frame`, with the child's
-  // own inertia. The parent is the body of `parent_frame` (default: the last body
-  // added; only the chain's last body may be extended).
+  /// Append a moving joint whose child link is `child_frame`, with the child's
+  /// own inertia. The parent is the body of `parent_frame` (default: the last body
+  /// added; only the chain's last body may be extended).
   ModelBuilder& addJoint(const Joint& joint, const std::string& child_frame, const RigidInertia& child_inertia,
                          const std::string& parent_frame = "");
-  // Attach a frame rigidly to an existing frame (a fixed URDF joint); its
-  // inertia (given in the new frame) is merged into the parent body.
+  /// Attach a frame rigidly to an existing frame (a fixed URDF joint); its
+  /// inertia (given in the new frame) is merged into the parent body.
   ModelBuilder& addFixedFrame(const std::string& name, const std::string& parent_frame, const Transform& placement,
                               const RigidInertia& inertia = {});
 
+  /// Set the reflected rotor inertia d_j of a joint (finite, ≥ 0).
   ModelBuilder& setRotorInertia(const std::string& joint, double value);
-  // Record a warning on the model (kept once: an identical message is dropped).
+  /// Record a warning on the model (kept once: an identical message is dropped).
   ModelBuilder& addWarning(WarningCode code, const std::string& message);
-  // Prefix every message (e.g. with the URDF's file name), for the loader.
+  /// Prefix every message (e.g. with the URDF's file name), for the loader.
   ModelBuilder& prefixWarnings(const std::string& prefix);
+  /// Set a joint's breakaway friction f_j, Coulomb friction f_c,j and viscous damping b_j (finite, ≥ 0).
   ModelBuilder& setFriction(const std::string& joint, double breakaway, double kinetic, double damping);
 
-  // Checks the whole chain (every moving joint must carry some inertia, every
-  // moving body's merged inertia is positive semi-definite to rounding) and
-  // returns the immutable model.
+  /// Checks the whole chain (every moving joint must carry some inertia, every
+  /// moving body's merged inertia is positive semi-definite to rounding) and
+  /// returns the immutable model.
   Model build() const;
 
  private:
@@ -165,27 +187,27 @@ class ModelBuilder {
   void checkLinkInertia(const std::string& link, int body, const RigidInertia& inertia);
 };
 
-// Validation helpers shared by the builder and the URDF loader.
+/// Validation helpers shared by the builder and the URDF loader.
 namespace validate {
-// The heaviest link and the largest moment of inertia zwang accepts [kg, kg·m²].
+/// The heaviest link and the largest moment of inertia zwang accepts [kg, kg·m²].
 constexpr double kMaxMass = 1e12;
-constexpr double kMaxMoment = 1e12;
+constexpr double kMaxMoment = 1e12;  ///< the largest moment of inertia [kg·m²]
 
-// Throws ModelError("<where>: <what>") when the inertia cannot be a body's:
-// negative or non-finite mass, a mass above kMaxMass, non-finite or huge
-// values, an asymmetric matrix or a principal moment at the COM that is
-// negative beyond rounding. `rounding_scale` is the size of the numbers the
-// COM inertia was computed from (kg·m²): moments within
-// roundingTolerance(rounding_scale) of zero count as zero, so point masses,
-// thin rods and inertias recovered from the origin form (I_c = Ī + m·c×c×)
-// pass. Returns the warnings (triangle inequality, point mass, placeholder
-// inertia) for the caller to record.
+/// Throws `ModelError("<where>: <what>")` when the inertia cannot be a body's:
+/// negative or non-finite mass, a mass above kMaxMass, non-finite or huge
+/// values, an asymmetric matrix or a principal moment at the COM that is
+/// negative beyond rounding. `rounding_scale` is the size of the numbers the
+/// COM inertia was computed from (kg·m²): moments within
+/// roundingTolerance(rounding_scale) of zero count as zero, so point masses,
+/// thin rods and inertias recovered from the origin form (I_c = Ī + m·c×c×)
+/// pass. Returns the warnings (triangle inequality, point mass, placeholder
+/// inertia) for the caller to record.
 std::vector<ModelWarning> rigidInertia(const std::string& where, double mass, const Vec3& com, const Mat3& I_com,
                                        double rounding_scale = 0.0);
-// The same for an inertia in origin form (m, h, Ī), as the builder holds it.
+/// The same for an inertia in origin form (m, h, Ī), as the builder holds it.
 std::vector<ModelWarning> rigidInertia(const std::string& where, const RigidInertia& inertia);
-// How far from zero a moment computed from numbers of size `scale` may land
-// by rounding alone.
+/// How far from zero a moment computed from numbers of size `scale` may land
+/// by rounding alone.
 double roundingTolerance(double scale);
 }  // namespace validate
 

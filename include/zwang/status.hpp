@@ -1,29 +1,35 @@
-// Status of a hot-path call: no exception, no allocation; the message is held
-// in a fixed buffer inside the Status itself.
+/// \file
+/// Status of a hot-path call: no exception, no allocation; the message is held
+/// in a fixed buffer inside the Status itself.
 #pragma once
 
 #include <cstdio>
 
 namespace zwang {
 
+/// What went wrong in a hot-path call (docs/errors.md, "Solve statuses").
 enum class StatusCode {
-  Ok = 0,
-  SizeMismatch,      // an input vector has the wrong length
-  NonFinite,         // an input holds NaN or Inf
-  WorkspaceTooSmall, // the workspace was sized for fewer constraint rows
-  ModelMismatch,     // task or workspace built for another model
-  Degenerate,        // a joint has no inertia to move (D_j ≤ 0) in this configuration
-  BadOption,         // an option or per-solve override is out of range
-  Infeasible,        // the task drives a joint into its position limit (outputs finite, not physical)
+  Ok = 0,            ///< success
+  SizeMismatch,      ///< an input vector has the wrong length
+  NonFinite,         ///< an input holds NaN or Inf
+  WorkspaceTooSmall, ///< the workspace was sized for fewer constraint rows
+  ModelMismatch,     ///< task or workspace built for another model
+  Degenerate,        ///< a joint has no inertia to move (D_j ≤ 0) in this configuration
+  BadOption,         ///< an option or per-solve override is out of range
+  Infeasible,        ///< the task drives a joint into its position limit (outputs finite, not physical)
 };
 
+/// The result of a hot-path call: a code and, on error, a message naming the input at fault.
 struct Status {
-  StatusCode code = StatusCode::Ok;
-  char message[240] = {};
+  StatusCode code = StatusCode::Ok;  ///< Ok, or what went wrong
+  char message[240] = {};            ///< one line naming the input at fault; empty when ok
 
+  /// True when the call succeeded.
   bool ok() const { return code == StatusCode::Ok; }
+  /// The same as ok(): `if (!status) …`.
   explicit operator bool() const { return ok(); }
 
+  /// An error status whose message is printf-formatted into the fixed buffer (truncated if longer).
   template <class... Args>
   static Status error(StatusCode code, const char* format, Args... args) {
     Status s;

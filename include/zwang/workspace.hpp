@@ -1,9 +1,10 @@
-// All scratch memory of the algorithms, made once per model (and constraint
-// capacity); a solve writes here and allocates nothing. One workspace per
-// thread: the Model is shared, the Workspace is not.
-//
-// The members are named after the report's Algorithm 1 (chapter 4.2); index i
-// is a body (0 = the fixed base), joint i−1 moves body i.
+/// \file
+/// All scratch memory of the algorithms, made once per model (and constraint
+/// capacity); a solve writes here and allocates nothing. One workspace per
+/// thread: the Model is shared, the Workspace is not.
+///
+/// The members are named after the report's Algorithm 1 (chapter 4.2); index i
+/// is a body (0 = the fixed base), joint i−1 moves body i.
 #pragma once
 
 #include <memory>
@@ -41,104 +42,111 @@ struct BalanceReport {
   bool consistent = true;
 };
 
-// The factorisation of the last balance, kept so that further right-hand sides
-// (the friction extension's unit torques) reuse it (src/balance.cpp).
+/// The factorisation of the last balance, kept so that further right-hand sides
+/// (the friction extension's unit torques) reuse it (src/balance.cpp).
 struct BalanceFactorisation {
-  bool by_eigen = false;          // false: 𝓛 = C Cᵀ (certified regular); true: eigenpairs of 𝓛̃
-  Eigen::MatrixXd factor;         // C (lower), or the eigenvectors V of 𝓛̃ (by_eigen)
-  Eigen::VectorXd eigenvalues;    // σ̃_k (by_eigen)
-  Eigen::VectorXd gain;           // what each eigen-direction is multiplied by: 1/σ̃, damped, or 0
-  Eigen::VectorXd equilibration;  // E_ii = 1/√𝓛_ii (1 on a row nothing moves)
-  // Orthonormal basis of the directions E v_k with σ̃_k below singular_threshold
-  // (the first `near_null_count` columns), and the weight of each in the
-  // Euclidean projection: 1 at exact rank loss, falling to 0 at the threshold.
+  bool by_eigen = false;          ///< false: 𝓛 = C Cᵀ (certified regular); true: eigenpairs of 𝓛̃
+  Eigen::MatrixXd factor;         ///< C (lower), or the eigenvectors V of 𝓛̃ (by_eigen)
+  Eigen::VectorXd eigenvalues;    ///< σ̃_k (by_eigen)
+  Eigen::VectorXd gain;           ///< what each eigen-direction is multiplied by: 1/σ̃, damped, or 0
+  Eigen::VectorXd equilibration;  ///< E_ii = 1/√𝓛_ii (1 on a row nothing moves)
+  /// Orthonormal basis of the directions E v_k with σ̃_k below singular_threshold
+  /// (the first `near_null_count` columns), and the weight of each in the
+  /// Euclidean projection: 1 at exact rank loss, falling to 0 at the threshold.
   Eigen::MatrixXd near_null_basis;
-  Eigen::VectorXd near_null_weight;
-  int near_null_count = 0;
-  Eigen::VectorXd work;           // scratch of balanceApply (V's coordinates)
+  Eigen::VectorXd near_null_weight;  ///< the weight of each of those directions (see near_null_basis)
+  int near_null_count = 0;        ///< columns of near_null_basis in use
+  Eigen::VectorXd work;           ///< scratch of balanceApply (V's coordinates)
 };
 
+/// What a solve computes (Workspace::solution).
 struct Solution {
-  Eigen::VectorXd qdd;             // q̈
-  // ν, constraint magnitudes, in the task's row order. Sized to the task's
-  // rows; a solve resizes it only when the task's row count changed since the
-  // last solve (the one allocation a solve can make; none for a fixed task).
+  Eigen::VectorXd qdd;             ///< q̈
+  /// ν, constraint magnitudes, in the task's row order. Sized to the task's
+  /// rows; a solve resizes it only when the task's row count changed since the
+  /// last solve (the one allocation a solve can make; none for a fixed task).
   Eigen::VectorXd nu;
-  Eigen::VectorXd tau_constraint;  // τ_c = Σ J_iᵀ A_i ν_i, the joint torques of the constraint forces
-  Eigen::VectorXd tau_control;     // τ + τ_c, what is sent to the motors
-  double gauss = 0.0;              // Z(q̈), the Gauss function (acceleration energy) at the solution
-  BalanceReport balance;
-  // A warning, not an error: joints whose q lies outside [lower, upper]
-  // (solved as given; the limits act only on stuck joints at a stop, in
-  // solveWithFriction). The count, and the first such joint (−1: none).
+  Eigen::VectorXd tau_constraint;  ///< τ_c = Σ J_iᵀ A_i ν_i, the joint torques of the constraint forces
+  Eigen::VectorXd tau_control;     ///< τ + τ_c, what is sent to the motors
+  double gauss = 0.0;              ///< Z(q̈), the Gauss function (acceleration energy) at the solution
+  BalanceReport balance;           ///< how the balance went: rank, condition, damping, residual, consistent
+  /// A warning, not an error: joints whose q lies outside [lower, upper]
+  /// (solved as given; the limits act only on stuck joints at a stop, in
+  /// solveWithFriction). The count, and the first such joint (−1: none).
   int joints_outside_limits = 0;
-  int first_joint_outside_limits = -1;
+  int first_joint_outside_limits = -1;  ///< the first joint outside its limits, −1 when none
   // The true classical acceleration of any frame (a body's own frame:
   // model.bodyFrame(b)) is computed on demand from the sweep by
   // frameAcceleration() (kinematics.hpp), so a solve does not pay for it.
 };
 
+/// All scratch memory of the algorithms, and the results of the last call: see the file comment.
 class Workspace {
  public:
-  // Room for tasks with up to `max_constraint_rows` rows in all.
+  /// Room for tasks with up to `max_constraint_rows` rows in all.
   explicit Workspace(const Model& model, int max_constraint_rows = 6);
-  // Sized exactly for this task (solution.nu has its row count from the start).
+  /// Sized exactly for this task (solution.nu has its row count from the start).
   Workspace(const Model& model, const Task& task);
+  /// Frees the scratch memory.
   ~Workspace();
+  /// Movable, not copyable (one workspace per thread).
   Workspace(Workspace&&) noexcept;
+  /// Move assignment.
   Workspace& operator=(Workspace&&) noexcept;
 
+  /// Joint count of the model the workspace was made for.
   int dof() const { return dof_; }
+  /// The most constraint rows a task solved here may have.
   int constraintCapacity() const { return capacity_; }
 
-  Solution solution;
-  FrictionResult friction;  // filled by solveWithFriction
+  Solution solution;        ///< the results of the last solve
+  FrictionResult friction;  ///< filled by solveWithFriction
 
   // Every spatial quantity below is in BASE coordinates: world axes, referred
   // to the world origin (docs/solver.md, "Coordinates"). Algorithm 1's
   // transforms ⁱX_{i−1} between bodies are then identities.
 
   // --- outward sweep: poses, velocities, bias terms (Algorithm 1, lines 2–10)
-  std::vector<Transform> Xworld;     // ⁱX₀, world → body i
-  std::vector<Vec6> S;               // S_i, motion subspace
-  std::vector<RigidInertia> I;       // I_i, body inertia
-  std::vector<Vec6> v;               // Ẋ_i
-  std::vector<Vec6> c;               // Ẍ_bias,i = Ẋ_i × S_i q̇_i
-  std::vector<Vec6> Fbias;           // F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
+  std::vector<Transform> Xworld;     ///< ⁱX₀, world → body i
+  std::vector<Vec6> S;               ///< S_i, motion subspace
+  std::vector<RigidInertia> I;       ///< I_i, body inertia
+  std::vector<Vec6> v;               ///< Ẋ_i
+  std::vector<Vec6> c;               ///< Ẍ_bias,i = Ẋ_i × S_i q̇_i
+  std::vector<Vec6> Fbias;           ///< F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
 
   // --- inward sweep: articulated quantities (lines 11–22)
-  std::vector<Mat6> IA;              // I^A_i
-  std::vector<Vec6> FA;              // F^A_bias,i
-  std::vector<Vec6> IAS;             // I^A_i S_i
-  std::vector<double> D;             // D_i = d_i + S_iᵀ I^A_i S_i
-  std::vector<double> u;             // τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
-  Eigen::MatrixXd SA;                // column i: (S_iᵀ A_i)ᵀ, capacity × bodies
-  ConstraintMatrix Ahat;             // A_i (6 × capacity), updated in place from A_N down to A_0
-  // U_0, acceleration energy of bias forces and torques: the report's U (not
-  // Featherstone's or Pinocchio's U = I^A S, which is IAS here).
+  std::vector<Mat6> IA;              ///< I^A_i
+  std::vector<Vec6> FA;              ///< F^A_bias,i
+  std::vector<Vec6> IAS;             ///< I^A_i S_i
+  std::vector<double> D;             ///< D_i = d_i + S_iᵀ I^A_i S_i
+  std::vector<double> u;             ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
+  Eigen::MatrixXd SA;                ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
+  ConstraintMatrix Ahat;             ///< A_i (6 × capacity), updated in place from A_N down to A_0
+  /// U_0, acceleration energy of bias forces and torques: the report's U (not
+  /// Featherstone's or Pinocchio's U = I^A S, which is IAS here).
   Eigen::VectorXd U;
-  Eigen::VectorXd L_scale;           // Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
-  Eigen::MatrixXd L;                 // 𝓛_0, the balance matrix of line 25 (capacity², lower triangle)
+  Eigen::VectorXd L_scale;           ///< Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
+  Eigen::MatrixXd L;                 ///< 𝓛_0, the balance matrix of line 25 (capacity², lower triangle)
 
   // --- the task in sweep form, solver column order (see Task::groups)
-  ConstraintMatrix A_body;  // columns of each constraint, as unit forces on its body
-  Eigen::VectorXd b_body;   // set points as the sweep's (gravity-shifted, spatial) accelerations
+  ConstraintMatrix A_body;  ///< columns of each constraint, as unit forces on its body
+  Eigen::VectorXd b_body;   ///< set points as the sweep's (gravity-shifted, spatial) accelerations
 
   // --- balance (line 25), src/balance.cpp
-  BalanceFactorisation balance_factorisation;
-  Eigen::VectorXd rhs;      // b − A_0ᵀẌ_0 − U_0
-  Eigen::VectorXd nu;       // ν in solver order
+  BalanceFactorisation balance_factorisation;  ///< the last balance's factorisation
+  Eigen::VectorXd rhs;      ///< b − A_0ᵀẌ_0 − U_0
+  Eigen::VectorXd nu;       ///< ν in solver order
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
-  std::vector<Vec6> a;      // Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])
-  std::vector<Vec6> f;      // accumulated forces (RNEA)
+  std::vector<Vec6> a;      ///< Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])
+  std::vector<Vec6> f;      ///< accumulated forces (RNEA)
 
   // --- other algorithms
-  std::vector<Mat6> Ic;     // composite inertias (CRBA)
-  Eigen::MatrixXd H;        // joint-space inertia (CRBA)
-  Eigen::VectorXd tau;      // inverse dynamics result (RNEA)
+  std::vector<Mat6> Ic;     ///< composite inertias (CRBA)
+  Eigen::MatrixXd H;        ///< joint-space inertia (CRBA)
+  Eigen::VectorXd tau;      ///< inverse dynamics result (RNEA)
 
- // Scratch of the friction extension (src/friction.cpp).
+ /// Scratch of the friction extension (src/friction.cpp).
   internal::FrictionScratch& frictionScratch() { return *friction_scratch_; }
 
  private:

@@ -1,4 +1,5 @@
-// zwang: constrained hybrid dynamics (Popov–Vereshchagin) with static friction.
+/// \file
+/// zwang: constrained hybrid dynamics (Popov–Vereshchagin) with static friction.
 #pragma once
 
 #include "zwang/hybrid_dynamics.hpp"
@@ -10,3 +11,8 @@
 #include "zwang/urdf.hpp"
 #include "zwang/workspace.hpp"
 #include "zwang/friction.hpp"
+
+/// \namespace zwang
+/// Constrained hybrid dynamics (Popov–Vereshchagin) with static friction: Model,
+/// Task and Workspace, the solvers and the classic algorithms. The conventions
+/// (frames, linear-first spatial vectors, signs) are those of docs/conventions.md.

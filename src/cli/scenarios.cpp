@@ -7,7 +7,7 @@
 // joint torque, τ = τ₀ − μ, over 201 values of μ in [−f, f]. At each sample
 //   g(μ)          = Solution::gauss of that solve. Z(q̈) with the torque τ₀ − μ is
 //                   Z₀(q̈) + μ q̈, so its minimum over the task's q̈ is g(μ) of
-//                   eq. 5.9 (SPEC §2) exactly;
+//                   eq. 5.9 (docs/theory.md §3) exactly;
 //   qdd(μ)        = q̈(μ);
 //   tau_control(μ)= τ₀ + τ_c(μ), the motor command (τ_c the constraint torque);
 //   tau_net(μ)    = H q̈(μ) + C, the net joint torque that accelerates the arm
@@ -36,7 +36,7 @@ struct Scenario {
   double target;          // [rad/s²]
   // The report's result (its sign convention: magnitudes, Fig. 5.5 opposite sign)
   const char* report;
-  // Ours (SPEC "Reference cases"), for the self-check.
+  // Ours (docs/theory.md, "The reference cases"), for the self-check.
   double mu, qdd, tau_control;
   const char* state;
 };

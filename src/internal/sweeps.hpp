@@ -39,7 +39,7 @@ inline Vec6 wrenchInBase(const Model& model, const Workspace& ws, int frame, Exp
 // Subtract the task's external wrenches from Fbias (line 7: F_bias −= F_ext).
 void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws);
 
-// Gravity as the base acceleration Ẍ₀ = [−g; 0] (SPEC). In base coordinates it
+// Gravity as the base acceleration Ẍ₀ = [−g; 0] (docs/conventions.md, "Gravity"). In base coordinates it
 // is the same 6-vector for every body.
 inline Vec6 gravityAcceleration(const Vec3& gravity) {
   Vec6 out;

@@ -74,7 +74,8 @@ PYBIND11_MODULE(zwang, m) {
                                "A solve refused its input. Attributes: code (the C++ StatusCode name), "
                                "status_message (the C++ Status message), result (None).");
   e.infeasible_error = newException(m, "InfeasibleError", py::make_tuple(e.solve_error),
-                                    "The task drives a joint into its position limit (SPEC section 3). "
+                                    "The task drives a joint into its position limit "
+                                    "(docs/friction.md, 'Joint position limits'). "
                                     "The finite, non-physical solution is in the `result` attribute.");
   e.stale_error = newException(m, "StaleResultError", py::make_tuple(e.error, py::handle(PyExc_RuntimeError)),
                                "A live Result was read after its workspace was used again; use Result.copy() "

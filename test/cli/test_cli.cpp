@@ -59,7 +59,7 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 }  // namespace
 
 // ---------------------------------------------------------------------------
-// Golden tests: the SPEC's reference cases through the tool.
+// Golden tests: the reference cases (docs/theory.md, "The reference cases") through the tool.
 
 TEST_CASE("1-DOF arm, tip force -5 N: stick, mu* = -5, qdd = 0, tau_control = 0", "[golden]") {
   const Json s = solve(problem("arm_stick.json"));

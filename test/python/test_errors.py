@@ -171,7 +171,7 @@ def test_urdf_errors(tmp_path):
 
 
 def test_infeasible_raises_with_the_finite_result(arm):
-    """SPEC section 3: the arm on its upper limit, driven into it."""
+    """docs/friction.md, "Joint position limits": the arm on its upper limit, driven into it."""
     ws = arm.workspace()
     push = zwang.Constraint("link1", [0, 0, 0, 0, 0, 1], b=[5.0])
     with pytest.raises(zwang.InfeasibleError, match="upper limit") as e:

@@ -1,5 +1,5 @@
 """The examples of docs/python/ run (Agg backend, figures into a scratch directory) and
-check their own results (the SPEC reference values, the effort saving)."""
+check their own results (the reference values of docs/theory.md, the effort saving)."""
 import os
 import pathlib
 import subprocess

@@ -1,4 +1,4 @@
-"""The SPEC reference cases and closed forms, from Python (SPEC "Reference cases")."""
+"""The reference cases and closed forms, from Python (docs/theory.md, "The reference cases")."""
 import math
 
 import numpy as np
@@ -114,7 +114,9 @@ def test_closure_property_on_panda(panda):
 
 
 def test_panda_hold_pose_friction_carries_the_load(panda):
-    """SPEC section 2: holding still is statically indeterminate; the effort-minimising mu* lowers |tau|^2."""
+    """Holding still is statically indeterminate; the effort-minimising mu* lowers |tau|^2.
+
+    docs/friction.md, "When mu* is not unique"."""
     ws = panda.workspace()
     hold = zwang.Constraint("tool0", np.eye(6), expressed="world")
     plain = zwang.solve(panda, ws, READY, constraints=[hold]).copy()

@@ -60,7 +60,7 @@ ChainSpec oneDofArm() {
   link.name = "link1";
   link.mass = 1.0;
   link.com = Eigen::Vector3d(0.5, 0.0, 0.0);
-  // A slender bar along x: I_zz = 2 (SPEC), I_yy = 2, a small I_xx that keeps
+  // A slender bar along x: I_zz = 2 (docs/theory.md, "The reference cases"), I_yy = 2, a small I_xx that keeps
   // the triangle inequality I_xx + I_yy >= I_zz.
   link.inertia = Eigen::Vector3d(0.01, 2.0, 2.0).asDiagonal();
   LinkSpec tool;  // massless frame at the tip, where the report applies its force

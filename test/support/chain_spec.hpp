@@ -22,7 +22,7 @@ struct LinkSpec {
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
 };
 
-// One URDF <joint>. Semantics (URDF, SPEC "Conventions"):
+// One URDF <joint>. Semantics (URDF, docs/conventions.md, "Joints, links, frames"):
 //  - (xyz, rpy) is the pose of the joint frame in the parent link frame, with
 //    fixed-axis roll-pitch-yaw: R = Rz(yaw)·Ry(pitch)·Rx(roll);
 //  - the child link frame is the joint frame after the joint motion: a rotation
@@ -42,7 +42,7 @@ struct JointSpec {
 
   bool isFixed() const { return type == "fixed"; }
   bool isPrismatic() const { return type == "prismatic"; }
-  // rotor_inertia · gear_ratio² (SPEC "Conventions"); 0 for fixed joints.
+  // rotor_inertia · gear_ratio² (docs/conventions.md, "Joints, links, frames"); 0 for fixed joints.
   double reflectedInertia() const { return isFixed() ? 0.0 : rotor_inertia * gear_ratio * gear_ratio; }
 };
 
@@ -69,7 +69,7 @@ struct ChainSpec {
 // R = Rz(yaw)·Ry(pitch)·Rx(roll) for rpy = (roll, pitch, yaw) (URDF).
 Eigen::Matrix3d rpyToMatrix(const Eigen::Vector3d& rpy);
 
-// The single-joint arm of SPEC "Reference cases": revolute joint about z at the
+// The single-joint arm of docs/theory.md, "The reference cases": revolute joint about z at the
 // base origin, a 1 m link along x of mass 1 kg with its COM at 0.5 m and
 // I_zz = 2 kg·m² at the COM (2.25 kg·m² about the joint), breakaway friction 10 N·m.
 ChainSpec oneDofArm();

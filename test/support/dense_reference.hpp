@@ -1,9 +1,9 @@
-// Dense reference for constrained dynamics (SPEC §1 "Dense reference for
-// tests"), computed straight from a ChainSpec with the world pose of every link
+// Dense reference for constrained dynamics (docs/solver.md, "The dense
+// reference"), computed straight from a ChainSpec with the world pose of every link
 // — no recursive algorithm, no code shared with the library.
 //
 // Formulation: world-frame Plücker coordinates at the world origin, linear part
-// first (SPEC "Conventions"): motion [v; ω], force [f; n].
+// first (docs/conventions.md): motion [v; ω], force [f; n].
 //   J_i       6×n spatial Jacobian of link i, columns s_j = ⁰X_j S_j for the
 //             moving joints between the base and link i (zero otherwise);
 //   v_i       = J_i q̇ (spatial velocity);
@@ -17,7 +17,7 @@
 //   KKT       [H −Gᵀ; G 0] [q̈; ν] = [τ − C; γ]  (H q̈ + C = τ + Σ Jᵀ A ν).
 // A constraint column [l; r] (unit force l and moment r acting at the link
 // origin) constrains lᵀ p̈ + rᵀ ω̇ = b, p̈ the classical acceleration of the link
-// origin; the wrench A ν is applied to the link at its origin (SPEC sign).
+// origin; the wrench A ν is applied to the link at its origin (docs/solver.md, "Sign of ν").
 #pragma once
 
 #include <string>
@@ -36,7 +36,7 @@ using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 // Which axes the components of a link-attached quantity use. Either way it
 // refers to the link ORIGIN (a wrench acts there, an acceleration is that of the
-// origin); `World` is what SPEC also calls "aligned".
+// origin); `World` is what docs/conventions.md also calls "aligned".
 enum class Axes { Local, World };
 
 // A wrench [f; n] applied to `link` at its origin.
@@ -82,7 +82,7 @@ struct DenseResult {
   Eigen::VectorXd qdd;      // q̈
   Eigen::VectorXd nu;       // ν, rows in input order (constraint by constraint)
   Eigen::VectorXd tau_c;    // Σ J_iᵀ A_i ν_i = Gᵀ ν (physical constraint torques)
-  double gauss = 0.0;       // Z(q̈) of SPEC §1 at the solution
+  double gauss = 0.0;       // Z(q̈) of docs/theory.md §1 at the solution
   Eigen::MatrixXd G;        // m×n constraint rows: G q̈ = gamma
   Eigen::VectorXd gamma;
   std::vector<Eigen::Isometry3d> poses;  // ⁰T_link for every link
@@ -102,7 +102,7 @@ struct DenseResult {
 DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input);
 
 // Z(q̈) = Σ_i ½ a_iᵀ I_i a_i + (v_i ×* I_i v_i − f_ext,i − f_grav,i)ᵀ a_i
-//        + Σ_j ½ d_j q̈_j² − τ_j q̈_j    (SPEC §1; a_i true spatial accelerations),
+//        + Σ_j ½ d_j q̈_j² − τ_j q̈_j    (docs/solver.md, "The Gauss function value"; a_i true spatial accelerations),
 // for any q̈ (constraints are not applied). Frame-invariant.
 double gaussFunction(const ChainSpec& spec, const DynamicsInput& input, const Eigen::VectorXd& qdd);
 

@@ -2,7 +2,7 @@
 // checked from the outside (no code shared with the solver).
 //
 // checkMaximumDissipation verifies a FrictionResult + Solution against the
-// optimality conditions of SPEC §2–§3 (maximum dissipation), per joint:
+// optimality conditions of docs/friction.md (maximum dissipation), per joint:
 //   stuck set     = {j : |q̇_j| ≤ velocity_tolerance} (ascending), as expected;
 //   Stick         ⇒ q̈_j ≈ 0 and |μ_j| ≤ f_j;
 //   SlipPositive  ⇒ μ_j = f_j and q̈_j ≥ 0;
@@ -49,7 +49,7 @@ struct DissipationTolerances {
 std::string checkMaximumDissipation(const FrictionResult& result, const Solution& solution,
                                     const FrictionExpectation& expected, const DissipationTolerances& tolerances = {});
 
-// Closure (SPEC §1 with friction): the unconstrained arm (same gravity and
+// Closure with friction (docs/friction.md, "Outputs"): the unconstrained arm (same gravity and
 // wrenches) driven by τ_control + tau_friction accelerates with q̈*. Returns
 // relativeError(q̈_free, q̈*). Uses solveHybridDynamics only.
 double frictionClosureError(const Model& model, const Task& task, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,

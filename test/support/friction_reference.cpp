@@ -81,7 +81,7 @@ FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd
   for (int j = 0; j < n; ++j) {
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
     s.breakaway(j) = joint.friction;
-    s.kinetic(j) = joint.friction;  // SPEC default f_c = f
+    s.kinetic(j) = joint.friction;  // default f_c = f: docs/friction.md, "The model of friction"
     s.damping(j) = joint.damping;
     if (std::abs(qd(j)) <= velocity_tolerance) s.stuck.push_back(j);
   }
@@ -108,7 +108,7 @@ FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput&
   const int m = static_cast<int>(base.G.rows());
   const Eigen::MatrixXd Hinv = base.H.llt().solve(Eigen::MatrixXd::Identity(n, n));
 
-  // The choices of each stuck joint (SPEC §3 at a limit).
+  // The choices of each stuck joint (docs/friction.md, "Joint position limits").
   std::vector<std::vector<Choice>> choices(static_cast<std::size_t>(k));
   for (int s = 0; s < k; ++s) {
     const int side = limitSide(setup, setup.stuck[static_cast<std::size_t>(s)]);
@@ -163,7 +163,7 @@ FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput&
       const Eigen::VectorXd qdd = x.head(n);
       for (std::size_t s = 0; s < stick.size(); ++s) mu(stick[s]) = -x(n + m + static_cast<int>(s));
 
-      // Maximum dissipation (SPEC §2, §3).
+      // Maximum dissipation (docs/theory.md §5; docs/friction.md, "Joint position limits").
       const double t_tol = options.torque_tolerance * std::max(f_scale, mu.cwiseAbs().maxCoeff());
       const double a_tol = options.acceleration_tolerance * std::max(1.0, qdd.cwiseAbs().maxCoeff());
       bool valid = true;

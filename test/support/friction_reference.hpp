@@ -1,7 +1,7 @@
-// Independent references for static friction (SPEC §2–§3), built only on the
+// Independent references for static friction (docs/friction.md), built only on the
 // dense KKT reference (dense_reference.hpp) — no code of zwang's solver.
 //
-// Notation (SPEC §2): Θ₀ = the stuck joints (k of them), W the k×n selector of
+// Notation (docs/theory.md §3): Θ₀ = the stuck joints (k of them), W the k×n selector of
 // their rows, f_j the breakaway torques. A stuck joint feels the torque −μ_j
 // (τ_eff = τ − Wᵀμ, μ_j > 0 opposes positive motion); a moving joint the
 // kinetic torque −f_c,j sign(q̇_j) − b_j q̇_j, added to τ as a feed-forward.
@@ -29,7 +29,7 @@
 //    tests skip draws where it has not). Rank test: the eigenvalues of the
 //    augmented coupling matrix [G; E_S] H⁻¹ [G; E_S]ᵀ, singular below
 //    `singular_threshold`·λ_max.
-//    Joint limits (SPEC §3): a stuck joint resting on its lower limit has
+//    Joint limits (docs/friction.md, "Joint position limits"): a stuck joint resting on its lower limit has
 //    μ_j ∈ (−∞, f_j]: patterns stick (q̈_j = 0, μ_j ≤ f_j, no lower bound — a
 //    μ_j below −f_j is the limit pushing back, "at limit") and slip+ (μ_j = f_j,
 //    q̈_j ≥ 0); slip− (into the limit) does not exist. The upper limit mirrors

@@ -40,7 +40,7 @@ Eigen::Isometry3d toEigen(const KDL::Frame& F) {
 }
 
 // KDL Twist / Wrench store (vel, rot) / (force, torque): linear part first,
-// like SPEC, so the 6-vectors map one to one.
+// like docs/conventions.md, so the 6-vectors map one to one.
 Vector6d toEigen(const KDL::Twist& t) {
   Vector6d x;
   x << toEigen(t.vel), toEigen(t.rot);
@@ -226,7 +226,7 @@ KdlHybridResult kdlHybridDynamics(const ChainSpec& spec, const DynamicsInput& in
   for (const KDL::Twist& a : x_dotdot) out.x_dotdot_kdl.push_back(toEigen(a));
 
   // ν: KDL applies −E ν (its constraint_torques = −Sᵀ E ν), i.e. the wrench
-  // on the tip is −α ν_KDL; SPEC applies +A ν. Hence ν = −ν_KDL.
+  // on the tip is −α ν_KDL; we apply +A ν (docs/solver.md, "Sign of ν"). Hence ν = −ν_KDL.
   out.nu = m > 0 ? Eigen::VectorXd(-out.nu_kdl) : Eigen::VectorXd();
   if (m == 0) out.nu_kdl.resize(0);
 

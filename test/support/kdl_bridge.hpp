@@ -2,7 +2,7 @@
 //
 // Builds a KDL::Chain from a ChainSpec the way kdl_parser does, and wraps
 // KDL::ChainHdSolver_Vereshchagin and KDL::ChainIdSolver_RNE behind OUR
-// conventions (SPEC "Conventions"; the same DynamicsInput as the dense
+// conventions (docs/conventions.md; the same DynamicsInput as the dense
 // reference). Every conversion between the two is made, and explained, in
 // kdl_bridge.cpp; test_references.cpp establishes each one against the dense
 // reference.
@@ -36,7 +36,7 @@ std::vector<Eigen::Isometry3d> kdlLinkPoses(const ChainSpec& spec, const Eigen::
 struct KdlHybridResult {
   // --- In our conventions -------------------------------------------------
   Eigen::VectorXd qdd;
-  Eigen::VectorXd nu;     // SPEC sign: the wrench +A ν acts on the link (= −ν_KDL)
+  Eigen::VectorXd nu;     // our sign (docs/solver.md, "Sign of ν"): the wrench +A ν acts on the link (= −ν_KDL)
   Eigen::VectorXd tau_c;  // physical constraint torques J_tipᵀ (A ν), J from KDL
   std::vector<Vector6d> acc_world;  // classical [p̈; ω̇] of every link origin, world axes
   // --- KDL's own inputs and outputs, as passed / returned ---------------------

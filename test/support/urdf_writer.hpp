@@ -11,7 +11,7 @@ namespace zwang::testing {
 // parsing them back gives the same doubles. Every joint carries
 // <dynamics friction damping>; a moving joint with rotor_inertia > 0 gets a
 // <transmission> whose <actuator> holds <drake:rotor_inertia value/> and
-// <drake:gear_ratio value/> (SPEC "Conventions"; xmlns:drake is declared on
+// <drake:gear_ratio value/> (docs/conventions.md, "Joints, links, frames"; xmlns:drake is declared on
 // <robot>). A link with zero mass and zero inertia is written without <inertial>.
 std::string toUrdf(const ChainSpec& spec);
 

@@ -1,62 +1,71 @@
-// Plücker coordinate transforms between two frames, stored as a rotation and
-// a translation (never as a 6×6 matrix on the hot path).
-//
-// Transform X = ᴮX_A takes coordinates in frame A to coordinates in frame B:
-//   E : rotation with x_B = E x_A  (so E = ᴮR_A = (ᴬR_B)ᵀ),
-//   r : origin of B, expressed in A.
-// With linear-first vectors (SPEC):
-//   motion  [v; ω]_B = [E(v − r×ω); Eω]
-//   force   [f; n]_B = [E f; E(n − r×f)]
-// The force transform B → A is Xᵀ, which is what `inverseApplyForce` computes.
+/// \file
+/// Plücker coordinate transforms between two frames, stored as a rotation and
+/// a translation (never as a 6×6 matrix on the hot path).
+///
+/// Transform X = ᴮX_A takes coordinates in frame A to coordinates in frame B:
+///   E : rotation with x_B = E x_A  (so E = ᴮR_A = (ᴬR_B)ᵀ),
+///   r : origin of B, expressed in A.
+/// With linear-first vectors (docs/conventions.md, "Spatial vectors: linear part first"):
+///   motion  [v; ω]_B = [E(v − r×ω); Eω]
+///   force   [f; n]_B = [E f; E(n − r×f)]
+/// The force transform B → A is Xᵀ, which is what `inverseApplyForce` computes.
 #pragma once
 
 #include "zwang/spatial/types.hpp"
 
 namespace zwang::spatial {
 
+/// Plücker transform ᴮX_A, stored as the rotation E and the translation r of the file comment.
 struct Transform {
-  Mat3 E = Mat3::Identity();
-  Vec3 r = Vec3::Zero();
+  Mat3 E = Mat3::Identity();  ///< E = ᴮR_A: takes A's components to B's.
+  Vec3 r = Vec3::Zero();  ///< r: the origin of B, expressed in A.
 
+  /// The identity (B = A).
   static Transform identity() { return {}; }
-  // ᴮX_A for a frame B whose pose in A is (rotation ᴬR_B, origin p).
+  /// ᴮX_A for a frame B whose pose in A is (rotation ᴬR_B, origin p).
   static Transform fromPose(const Mat3& R_AB, const Vec3& p_AB) { return {R_AB.transpose(), p_AB}; }
+  /// ᴮX_A for a frame B with A's axes and its origin at p in A.
   static Transform translation(const Vec3& p) { return {Mat3::Identity(), p}; }
+  /// ᴮX_A for a frame B with A's origin, rotated by ᴬR_B.
   static Transform rotation(const Mat3& R_AB) { return {R_AB.transpose(), Vec3::Zero()}; }
 
-  // Pose of B in A (the inverse reading of the same data).
+  /// Pose of B in A (the inverse reading of the same data).
   Mat3 rotationOfTarget() const { return E.transpose(); }
+  /// Origin of B, expressed in A.
   const Vec3& originOfTarget() const { return r; }
 
-  // ᶜX_A = ᶜX_B · ᴮX_A  (this = ᶜX_B, rhs = ᴮX_A)
+  /// ᶜX_A = ᶜX_B · ᴮX_A  (this = ᶜX_B, rhs = ᴮX_A)
   Transform operator*(const Transform& rhs) const { return {E * rhs.E, rhs.r + rhs.E.transpose() * r}; }
 
-  // ᴬX_B
+  /// ᴬX_B
   Transform inverse() const { return {E.transpose(), -(E * r)}; }
 
+  /// X m: a motion vector given in A, expressed in B.
   Vec6 applyMotion(const Vec6& m) const {
     const Vec3 w = ang(m);
     return stack(E * (Vec3(lin(m)) - r.cross(w)), E * w);
   }
+  /// X⁻¹ m: a motion vector given in B, expressed in A.
   Vec6 inverseApplyMotion(const Vec6& m) const {
     const Vec3 w = E.transpose() * ang(m);
     return stack(E.transpose() * lin(m) + r.cross(w), w);
   }
+  /// X* f: a force given in A, expressed in B.
   Vec6 applyForce(const Vec6& f) const {
     const Vec3 fl = lin(f);
     return stack(E * fl, E * (Vec3(ang(f)) - r.cross(fl)));
   }
-  // Xᵀ f: a force given in B, expressed in A.
+  /// Xᵀ f: a force given in B, expressed in A.
   Vec6 inverseApplyForce(const Vec6& f) const {
     const Vec3 fl = E.transpose() * lin(f);
     return stack(fl, E.transpose() * ang(f) + r.cross(fl));
   }
 
-  // Xᵀ I X: a 6×6 symmetric (articulated) inertia given in B, expressed in A.
-  // With I = [M H; Hᵀ C] and X = blkdiag(E,E)·[1 −r×; 0 1]: rotate the blocks
-  // (M' = EᵀME, H' = EᵀHE, C' = EᵀCE), then shift:
-  //   Xᵀ I X = [M'  P; Pᵀ  C' + r×P − H'ᵀr×],  P = H' − M' r×.
-  // Only the lower triangle of I's diagonal blocks is read.
+  /// Xᵀ I X: a 6×6 symmetric (articulated) inertia given in B, expressed in A.
+  /// With I = [M H; Hᵀ C] and X = blkdiag(E,E)·[1 −r×; 0 1]: rotate the blocks
+  /// (M' = EᵀME, H' = EᵀHE, C' = EᵀCE), then shift:
+  ///   Xᵀ I X = [M'  P; Pᵀ  C' + r×P − H'ᵀr×],  P = H' − M' r×.
+  /// Only the lower triangle of I's diagonal blocks is read.
   Mat6 inverseApplyInertia(const Mat6& I) const {
     const Mat3 M = rotateSymmetric(I.topLeftCorner<3, 3>());
     const Mat3 C = rotateSymmetric(I.bottomRightCorner<3, 3>());
@@ -82,7 +91,7 @@ struct Transform {
     return out;
   }
 
-  // Eᵀ S E for a symmetric 3×3 S (lower triangle read), symmetric result.
+  /// Eᵀ S E for a symmetric 3×3 S (lower triangle read), symmetric result.
   template <class Sym>
   Mat3 rotateSymmetric(const Sym& S) const {
     Mat3 full;
@@ -97,7 +106,7 @@ struct Transform {
     return out;
   }
 
-  // The 6×6 motion transform matrix, for tests and debugging only.
+  /// The 6×6 motion transform matrix, for tests and debugging only.
   Mat6 motionMatrix() const {
     Mat6 X = Mat6::Zero();
     X.topLeftCorner<3, 3>() = E;

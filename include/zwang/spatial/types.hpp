@@ -1,6 +1,7 @@
-// Fixed-size Eigen types and the 3-D helpers the spatial algebra is built on.
-// Spatial vectors are 6-vectors in Plücker coordinates, LINEAR PART FIRST:
-// motion [v; ω], force [f; n] (SPEC "Conventions").
+/// \file
+/// Fixed-size Eigen types and the 3-D helpers the spatial algebra is built on.
+/// Spatial vectors are 6-vectors in Plücker coordinates, LINEAR PART FIRST:
+/// motion [v; ω], force [f; n] (docs/conventions.md, "Spatial vectors: linear part first").
 #pragma once
 
 #include <Eigen/Core>
@@ -8,24 +9,27 @@
 
 namespace zwang {
 
-using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
-using Vec6 = Eigen::Matrix<double, 6, 1>;
-using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Vec3 = Eigen::Vector3d;  ///< 3-vector: a position, or the linear or angular part of a spatial vector.
+using Mat3 = Eigen::Matrix3d;  ///< 3×3 matrix: a rotation or a rotational inertia.
+using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< Spatial vector, linear part first: motion [v; ω] or force [f; n].
+using Mat6 = Eigen::Matrix<double, 6, 6>;  ///< 6×6 spatial matrix: an inertia or a transform.
 
+/// Spatial (Plücker) algebra, linear part first; it does not depend on the model.
 namespace spatial {
 
-// The linear (first three) and angular (last three) parts of a spatial vector.
+/// The linear (first three) and angular (last three) parts of a spatial vector.
 template <class V> inline auto lin(V&& x) { return x.template head<3>(); }
+/// The angular part (last three) of a spatial vector.
 template <class V> inline auto ang(V&& x) { return x.template tail<3>(); }
 
+/// The spatial vector [linear; angular].
 inline Vec6 stack(const Vec3& linear, const Vec3& angular) {
   Vec6 out;
   out << linear, angular;
   return out;
 }
 
-// skew(a) b = a × b
+/// skew(a) b = a × b
 inline Mat3 skew(const Vec3& a) {
   Mat3 s;
   s << 0.0, -a.z(), a.y(),  //

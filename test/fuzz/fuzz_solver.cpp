@@ -11,6 +11,7 @@
 // the documented ones comes back.
 #include <fuzzer/FuzzedDataProvider.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -138,6 +139,7 @@ void checkSolution(const Workspace& ws, const char* where) {
   fuzz::requireFinite(ws.solution.tau_constraint, "tau_constraint", where);
   fuzz::requireFinite(ws.solution.tau_control, "tau_control", where);
   fuzz::requireFinite(ws.solution.gauss, "gauss", where);
+  fuzz::requireFinite(ws.solution.balance.residual, "balance residual", where);
   for (const Vec6& a : ws.a) fuzz::requireFinite(a, "body accelerations (ws.a)", where);
 }
 
@@ -195,8 +197,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     previous = &task.groups().back().A;
   }
   for (Eigen::Index r = 0; r < task.targets().size(); ++r) task.targets()[r] = signedLog(in, 1e-3, 1e3);
-  task.balance.singular_threshold = in.ConsumeBool() ? 1e-9 : logUniform(in, 1e-16, 1e-1);
-  task.balance.max_damping = in.ConsumeBool() ? 1e-5 : logUniform(in, 1e-12, 1.0, 0.2);
+  // The balance options anywhere in their valid ranges (0 < rank_tolerance < singular_threshold < 1).
+  task.balance.singular_threshold = in.ConsumeBool() ? 1e-6 : logUniform(in, 1e-16, 1e-1);
+  task.balance.rank_tolerance =
+      in.ConsumeBool() ? std::min(1e-11, 0.5 * task.balance.singular_threshold)
+                       : task.balance.singular_threshold * logUniform(in, 1e-8, 0.99);
+  task.balance.residual_tolerance = in.ConsumeBool() ? 1e-9 : logUniform(in, 1e-14, 1e-3);
 
   Eigen::VectorXd q(n), qd(n), tau(n);
   for (int j = 0; j < n; ++j) {

@@ -1,6 +1,6 @@
 #include "zwang/workspace.hpp"
 
-#include "internal/friction_scratch.hpp"
+#include "friction/friction_scratch.hpp"
 
 namespace zwang {
 

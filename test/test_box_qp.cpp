@@ -1,5 +1,5 @@
-// The friction maximiser's internals (src/internal/growing_cholesky.hpp,
-// src/internal/box_qp.hpp) against independent dense references computed
+// The friction maximiser's internals (src/linalg/growing_cholesky.hpp,
+// src/qp/box_qp.hpp) against independent dense references computed
 // with Eigen: LDLT for the Cholesky updates, eigen-decompositions and the SVD
 // for the near null space, and brute-force enumeration of every active set
 // (3^k patterns, each solved by a complete orthogonal decomposition) for the
@@ -17,8 +17,8 @@
 #include <random>
 #include <vector>
 
-#include "internal/box_qp.hpp"
-#include "internal/growing_cholesky.hpp"
+#include "qp/box_qp.hpp"
+#include "linalg/growing_cholesky.hpp"
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;

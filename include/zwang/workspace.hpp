@@ -43,7 +43,7 @@ struct BalanceReport {
 };
 
 /// The factorisation of the last balance, kept so that further right-hand sides
-/// (the friction extension's unit torques) reuse it (src/balance.cpp).
+/// (the friction extension's unit torques) reuse it (src/dynamics/balance.cpp).
 struct BalanceFactorisation {
   bool by_eigen = false;          ///< false: 𝓛 = C Cᵀ (certified regular); true: eigenpairs of 𝓛̃
   Eigen::MatrixXd factor;         ///< C (lower), or the eigenvectors V of 𝓛̃ (by_eigen)
@@ -132,7 +132,7 @@ class Workspace {
   ConstraintMatrix A_body;  ///< columns of each constraint, as unit forces on its body
   Eigen::VectorXd b_body;   ///< set points as the sweep's (gravity-shifted, spatial) accelerations
 
-  // --- balance (line 25), src/balance.cpp
+  // --- balance (line 25), src/dynamics/balance.cpp
   BalanceFactorisation balance_factorisation;  ///< the last balance's factorisation
   Eigen::VectorXd rhs;      ///< b − A_0ᵀẌ_0 − U_0
   Eigen::VectorXd nu;       ///< ν in solver order
@@ -146,7 +146,7 @@ class Workspace {
   Eigen::MatrixXd H;        ///< joint-space inertia (CRBA)
   Eigen::VectorXd tau;      ///< inverse dynamics result (RNEA)
 
- /// Scratch of the friction extension (src/friction.cpp).
+ /// Scratch of the friction extension (src/friction/friction.cpp).
   internal::FrictionScratch& frictionScratch() { return *friction_scratch_; }
 
  private:

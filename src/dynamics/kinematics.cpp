@@ -1,7 +1,7 @@
 #include "zwang/kinematics.hpp"
 
-#include "internal/checks.hpp"
-#include "internal/sweeps.hpp"
+#include "dynamics/checks.hpp"
+#include "dynamics/sweeps.hpp"
 
 namespace zwang {
 namespace internal {

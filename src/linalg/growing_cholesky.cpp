@@ -7,7 +7,7 @@
 //  * L is kept as U = Lᵀ so that the substitutions read contiguous columns;
 //  * removal shifts U's columns left and folds the sub-diagonal back with one
 //    Givens rotation per row (no refactorisation).
-#include "internal/growing_cholesky.hpp"
+#include "linalg/growing_cholesky.hpp"
 
 #include <cmath>
 #include <utility>

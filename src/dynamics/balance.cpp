@@ -15,13 +15,13 @@
 //    force can meet (dropped before the solve), and ν gets no component along
 //    null(𝓛) (removed after it); near-singular directions ramp between the
 //    two (bounded, and continuous in σ̃: factorByEigen).
-#include "internal/balance.hpp"
+#include "dynamics/balance.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "internal/dense_linalg.hpp"
+#include "linalg/dense_linalg.hpp"
 
 namespace zwang::internal {
 

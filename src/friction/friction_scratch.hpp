@@ -2,9 +2,9 @@
 // after docs/friction.md's sections; indices a run over Θ₀, the k stuck joints.
 #pragma once
 
-#include "internal/box_qp.hpp"
-#include "internal/friction_maximisers.hpp"
-#include "internal/popov_vereshchagin.hpp"
+#include "qp/box_qp.hpp"
+#include "friction/friction_maximisers.hpp"
+#include "dynamics/popov_vereshchagin.hpp"
 #include "zwang/workspace.hpp"
 
 namespace zwang::internal {

@@ -12,12 +12,12 @@
 //    (kktViolation), not a change in x;
 //  * a linear problem (P = 0 to rounding) goes straight to its vertex
 //    (linearVertex), and a variable running off along an infinite bound is
-//    reported unbounded (the reach rule, kReach in src/internal/box_qp.hpp).
+//    reported unbounded (the reach rule, kReach in src/qp/box_qp.hpp).
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "internal/box_qp.hpp"
+#include "qp/box_qp.hpp"
 
 namespace zwang::internal {
 

@@ -1,8 +1,8 @@
 // What the box-QP solvers share: their scratch, the scale of the reach rule
-// (kReach, src/internal/box_qp.hpp) and the optimality residual they report.
-// The solvers themselves: src/box_qp_active_set.cpp,
-// src/box_qp_projected_gradient.cpp, src/least_distance.cpp.
-#include "internal/box_qp.hpp"
+// (kReach, src/qp/box_qp.hpp) and the optimality residual they report.
+// The solvers themselves: src/qp/box_qp_active_set.cpp,
+// src/qp/box_qp_projected_gradient.cpp, src/qp/least_distance.cpp.
+#include "qp/box_qp.hpp"
 
 #include <algorithm>
 #include <cmath>

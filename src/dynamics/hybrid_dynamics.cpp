@@ -1,8 +1,8 @@
 // solveHybridDynamics: the stages of Algorithm 1 in order
-// (src/popov_vereshchagin.cpp holds each stage, next to the report's lines).
+// (src/dynamics/popov_vereshchagin.cpp holds each stage, next to the report's lines).
 #include "zwang/hybrid_dynamics.hpp"
 
-#include "internal/popov_vereshchagin.hpp"
+#include "dynamics/popov_vereshchagin.hpp"
 
 namespace zwang {
 

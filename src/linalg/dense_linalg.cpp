@@ -1,4 +1,4 @@
-#include "internal/dense_linalg.hpp"
+#include "linalg/dense_linalg.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

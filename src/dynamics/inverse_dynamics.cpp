@@ -1,5 +1,5 @@
-#include "internal/checks.hpp"
-#include "internal/sweeps.hpp"
+#include "dynamics/checks.hpp"
+#include "dynamics/sweeps.hpp"
 #include "zwang/inverse_dynamics.hpp"
 
 namespace zwang {
@@ -16,7 +16,7 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
   const int N = model.dof();
   auto at = [](int i) { return static_cast<std::size_t>(i); };
 
-  // In base coordinates (src/internal/sweeps.hpp): no transforms between bodies.
+  // In base coordinates (src/dynamics/sweeps.hpp): no transforms between bodies.
   internal::outwardKinematics(model, q, qd, ws, true);
   ws.a[0] = internal::gravityAcceleration(task.gravity);  // gravity as base acceleration
   for (int i = 1; i <= N; ++i) {

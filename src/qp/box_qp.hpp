@@ -1,16 +1,16 @@
 // Small dense convex QPs for the friction maximiser (no allocation: all
 // memory comes from a scratch sized once for n variables).
-//   src/box_qp.cpp                    shared: the reach rule, the KKT residual
-//   src/box_qp_active_set.cpp         boxQpActiveSet (the default maximiser)
-//   src/box_qp_projected_gradient.cpp boxQpProjectedGradient
-//   src/least_distance.cpp            leastDistanceQp, leastDistanceOnHyperplane
+//   src/qp/box_qp.cpp                    shared: the reach rule, the KKT residual
+//   src/qp/box_qp_active_set.cpp         boxQpActiveSet (the default maximiser)
+//   src/qp/box_qp_projected_gradient.cpp boxQpProjectedGradient
+//   src/qp/least_distance.cpp            leastDistanceQp, leastDistanceOnHyperplane
 #pragma once
 
 #include <cmath>
 
 #include <Eigen/Core>
 
-#include "internal/growing_cholesky.hpp"
+#include "linalg/growing_cholesky.hpp"
 
 namespace zwang::internal {
 

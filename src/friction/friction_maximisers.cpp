@@ -8,13 +8,13 @@
 // reference point inside it, then (b) the one with the least motor effort
 // within the margin box. With K_ΣΣ of rank one (a 7-joint arm holding a 6-D
 // pose, say) the set is a hyperplane and its dual is one scalar equation.
-#include "internal/friction_maximisers.hpp"
+#include "friction/friction_maximisers.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "internal/growing_cholesky.hpp"
+#include "linalg/growing_cholesky.hpp"
 
 namespace zwang::internal {
 

@@ -16,7 +16,7 @@
 //    a release takes every variable whose gradient points into its room
 //    (releaseVariables): few iterations even when the start is far;
 //  * a variable running off along an infinite bound is reported unbounded
-//    (the reach rule, kReach in src/internal/box_qp.hpp).
+//    (the reach rule, kReach in src/qp/box_qp.hpp).
 // Stages of one iteration (boxQpActiveSet): ∇φ; a Newton step on F unless F
 // is stationary (newtonStep); else release the fixed variable with the most
 // to gain (chooseRelease), or stop. Every test is relative to P's own
@@ -27,7 +27,7 @@
 #include <cmath>
 #include <limits>
 
-#include "internal/box_qp.hpp"
+#include "qp/box_qp.hpp"
 
 namespace zwang::internal {
 

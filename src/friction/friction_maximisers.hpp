@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "internal/box_qp.hpp"
+#include "qp/box_qp.hpp"
 
 namespace zwang::internal {
 

@@ -15,7 +15,7 @@
 #include <cmath>
 #include <limits>
 
-#include "internal/box_qp.hpp"
+#include "qp/box_qp.hpp"
 
 namespace zwang::internal {
 

@@ -1,6 +1,6 @@
 // Popov–Vereshchagin constrained hybrid dynamics, stage by stage. Read next to
 // Algorithm 1 of the report (chapter 4.2); "line N" refers to it. Differences:
-//  * base coordinates (src/internal/sweeps.hpp): every spatial quantity is in
+//  * base coordinates (src/dynamics/sweeps.hpp): every spatial quantity is in
 //    world axes at the world origin, so the report's ⁱX_{i−1} are identities
 //    and lines 16, 18, 19 and 29 sum instead of transforming;
 //  * sign of ν: the constraint wrench on a body is +A ν (docs/solver.md, "Sign of ν"; the report
@@ -9,14 +9,14 @@
 //  * constraints may sit on any bodies (the report's section 4.4 extension):
 //    A_i collects the unit constraint forces of every constraint on bodies
 //    i..N, and each body adds its own columns as the inward sweep reaches it.
-#include "internal/popov_vereshchagin.hpp"
+#include "dynamics/popov_vereshchagin.hpp"
 
 #include <cmath>
 #include <limits>
 
-#include "internal/checks.hpp"
-#include "internal/balance.hpp"
-#include "internal/sweeps.hpp"
+#include "dynamics/checks.hpp"
+#include "dynamics/balance.hpp"
+#include "dynamics/sweeps.hpp"
 
 namespace zwang::internal {
 

@@ -10,7 +10,7 @@
 //  * ∂q̈/∂μ for all k stuck joints comes from one extra pass of the sweeps
 //    with k right-hand sides (O(N·k)), not from k further solves;
 //  * where the maximiser is not unique, the one with the least motor effort
-//    is chosen (src/friction_maximisers.cpp);
+//    is chosen (src/friction/friction_maximisers.cpp);
 //  * joint position limits are one-sided reactions in the same box.
 //
 // solveWithFriction is the driver; each stage below is named after its
@@ -21,10 +21,10 @@
 #include <cmath>
 #include <limits>
 
-#include "internal/box_qp.hpp"
-#include "internal/checks.hpp"
-#include "internal/friction_scratch.hpp"
-#include "internal/popov_vereshchagin.hpp"
+#include "qp/box_qp.hpp"
+#include "dynamics/checks.hpp"
+#include "friction/friction_scratch.hpp"
+#include "dynamics/popov_vereshchagin.hpp"
 
 namespace zwang {
 

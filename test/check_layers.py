@@ -1,0 +1,32 @@
+#!/usr/bin/env python3
+"""The library's layers (docs/architecture.md): an internal header may be
+included only from its own folder or from a layer above it. Exits 1 naming
+every include that points the wrong way."""
+import pathlib
+import re
+import sys
+
+root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+# folder -> the folders whose internal headers it may include
+allowed = {
+    "linalg": {"linalg"},
+    "qp": {"linalg", "qp"},
+    "model": {"model"},
+    "dynamics": {"linalg", "dynamics"},
+    "friction": {"linalg", "qp", "dynamics", "friction"},
+}
+include = re.compile(r'#include\s+"(\w+)/[\w.]+\.hpp"')
+bad = []
+for folder, may in allowed.items():
+    for path in sorted((root / "src" / folder).glob("*.[ch]pp")):
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            m = include.search(line)
+            if m and m.group(1) != "zwang" and m.group(1) not in may:
+                bad.append(f"{path.relative_to(root)}:{number}: {folder} includes {m.group(1)}/ ({line.strip()})")
+for path in sorted((root / "include").rglob("*.hpp")):  # public headers: no internal header at all
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        m = include.search(line)
+        if m and m.group(1) != "zwang":
+            bad.append(f"{path.relative_to(root)}:{number}: a public header includes {m.group(1)}/")
+print("\n".join(bad) if bad else f"layers: every include points one way ({', '.join(allowed)})")
+sys.exit(1 if bad else 0)

@@ -407,7 +407,7 @@ FrictionSetupOurs frictionSetup(const Problem& p, int k) {
   s.tau_eff = p.tau;
   for (int j = 0; j < p.n; ++j) {
     const Joint& joint = p.model.joint(j);
-    if (s.qd[j] != 0.0) s.tau_eff[j] += -joint.kinetic_friction * (s.qd[j] > 0 ? 1.0 : -1.0) - joint.damping * s.qd[j];
+    if (s.qd[j] != 0.0) s.tau_eff[j] += -joint.kinetic_friction * (s.qd[j] > 0 ? 1.0 : -1.0) - joint.viscous_friction * s.qd[j];
   }
   s.f.resize(k);
   for (int a = 0; a < k; ++a) s.f[a] = p.model.joint(s.stuck[static_cast<std::size_t>(a)]).breakaway_friction;

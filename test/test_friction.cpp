@@ -78,10 +78,10 @@ FrictionOptions randomOverrides(std::mt19937_64& rng, FrictionSetup& setup, int 
   if (uniform01(rng) < 0.35) {
     o.breakaway = randomVector(rng, n, 1.0).cwiseAbs() * 8.0;
     o.kinetic = randomVector(rng, n, 1.0).cwiseAbs() * 4.0;
-    o.damping = randomVector(rng, n, 1.0).cwiseAbs();
+    o.viscous = randomVector(rng, n, 1.0).cwiseAbs();
     setup.breakaway = o.breakaway;
     setup.kinetic = o.kinetic;
-    setup.damping = o.damping;
+    setup.viscous = o.viscous;
   }
   return o;
 }
@@ -437,8 +437,8 @@ TEST_CASE("bad friction options are refused with BadOption") {
   o.kinetic = Eigen::VectorXd::Ones(3);
   refused(o, "kinetic");
   o = {};
-  o.damping = Eigen::VectorXd::Ones(2);
-  refused(o, "damping");
+  o.viscous = Eigen::VectorXd::Ones(2);
+  refused(o, "viscous");
   o = {};
   o.breakaway = Eigen::VectorXd::Constant(1, -1.0);
   refused(o, "breakaway");
@@ -446,8 +446,8 @@ TEST_CASE("bad friction options are refused with BadOption") {
   o.kinetic = Eigen::VectorXd::Constant(1, -0.5);
   refused(o, "kinetic");
   o = {};
-  o.damping = Eigen::VectorXd::Constant(1, std::numeric_limits<double>::quiet_NaN());
-  refused(o, "damping");
+  o.viscous = Eigen::VectorXd::Constant(1, std::numeric_limits<double>::quiet_NaN());
+  refused(o, "viscous");
   o = {};
   o.velocity_tolerance = -1e-6;
   refused(o, "velocity_tolerance");

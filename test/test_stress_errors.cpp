@@ -219,8 +219,8 @@ TEST_CASE("errors: ModelBuilder and model lookups", "[errors]") {
   j.placement = Transform::translation(Vec3(kNaN, 0, 0));
   CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': origin is not finite"));
   j = revolute("j1");
-  j.damping = kInf;
-  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': damping is not finite"));
+  j.viscous_friction = kInf;
+  CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': viscous friction is not finite"));
   j = revolute("j1");
   j.rotor_inertia = -0.5;
   CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': rotor inertia -0.500000 is negative"));
@@ -247,7 +247,7 @@ TEST_CASE("errors: ModelBuilder and model lookups", "[errors]") {
   CHECK_THAT(modelError([&] { ModelBuilder(model).setRotorInertia("panda_joint1", -1.0); }),
              Contains("joint 'panda_joint1': rotor inertia must be finite and non-negative"));
   CHECK_THAT(modelError([&] { ModelBuilder(model).setFriction("panda_joint2", 1.0, kNaN, 0.0); }),
-             Contains("joint 'panda_joint2': friction and damping must be finite and non-negative"));
+             Contains("joint 'panda_joint2': breakaway, kinetic and viscous friction must be finite and non-negative"));
   CHECK_THAT(modelError([] { ModelBuilder("m", "base").addJoint(revolute("j1"), "link1", RigidInertia{}).build(); }),
              Contains("link 'link1': zero mass on a moving body with nothing beyond it (joint 'j1'"));
 }

@@ -107,7 +107,7 @@ TEST_CASE("one_dof_arm.urdf is the report's chapter 6 arm", "[urdf]") {
   CHECK(near(j.placement.r, Vec3::Zero()));
   CHECK(j.breakaway_friction == 10.0);
   CHECK(j.kinetic_friction == 10.0);
-  CHECK(j.damping == 0.0);
+  CHECK(j.viscous_friction == 0.0);
   CHECK(j.rotor_inertia == 0.0);
 
   const zwang::RigidInertia& I = m.inertia(1);
@@ -151,13 +151,13 @@ TEST_CASE("panda.urdf carries the figures of panda_arm.urdf", "[urdf]") {
   CHECK(j1.velocity_limit == 2.1750);
   CHECK(j1.breakaway_friction == 5.0);
   CHECK(j1.kinetic_friction == 5.0);
-  CHECK(j1.damping == 10.0);
+  CHECK(j1.viscous_friction == 10.0);
   CHECK(near(j1.placement.r, Vec3(0, 0, 0.333)));
   CHECK(m.joint(3).lower == -3.0718);
   CHECK(m.joint(3).upper == -0.0698);
   CHECK(m.joint(4).effort_limit == 12.0);
   CHECK(m.joint(6).breakaway_friction == 0.5);
-  CHECK(m.joint(6).damping == 1.0);
+  CHECK(m.joint(6).viscous_friction == 1.0);
   // panda_joint2: rpy (-π/2, 0, 0) → ʲX_parent has E = Rx(-π/2)ᵀ.
   CHECK(near(m.joint(1).placement.E, rotX(-1.57079632679).transpose()));
   CHECK(near(m.joint(2).placement.r, Vec3(0, -0.316, 0)));

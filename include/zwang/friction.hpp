@@ -42,7 +42,7 @@ struct FrictionOptions {
   double kkt_tolerance = 1e-12;  ///< relative to the largest |q̈(0)| on Θ₀
   ///@{
   /// Per-solve overrides of the model's values (empty: use the model's).
-  Eigen::VectorXd breakaway, kinetic, damping;
+  Eigen::VectorXd breakaway, kinetic, viscous;
   ///@}
 };
 

@@ -42,7 +42,7 @@ struct Joint {
   double rotor_inertia = 0.0;            ///< d_j, reflected armature inertia [kg·m² or kg]
   double breakaway_friction = 0.0;       ///< f_j ≥ 0, static friction bound
   double kinetic_friction = 0.0;         ///< f_c,j ≥ 0, Coulomb friction while moving
-  double damping = 0.0;                  ///< b_j ≥ 0, viscous friction
+  double viscous_friction = 0.0;         ///< b_j ≥ 0, viscous friction coefficient (URDF <dynamics damping>)
   double lower = -std::numeric_limits<double>::infinity();  ///< position limits: lower [rad or m]
   double upper = std::numeric_limits<double>::infinity();   ///< position limits: upper [rad or m]
   /// Largest torque [N·m] or force [N] (URDF `<limit effort>`).
@@ -173,8 +173,8 @@ class ModelBuilder {
   ModelBuilder& addWarning(WarningCode code, const std::string& message);
   /// Prefix every message (e.g. with the URDF's file name), for the loader.
   ModelBuilder& prefixWarnings(const std::string& prefix);
-  /// Set a joint's breakaway friction f_j, Coulomb friction f_c,j and viscous damping b_j (finite, ≥ 0).
-  ModelBuilder& setFriction(const std::string& joint, double breakaway, double kinetic, double damping);
+  /// Set a joint's breakaway friction f_j, kinetic (Coulomb) friction f_c,j and viscous friction b_j (finite, ≥ 0).
+  ModelBuilder& setFriction(const std::string& joint, double breakaway, double kinetic, double viscous);
 
   /// Checks the whole chain (every moving joint must carry some inertia, every
   /// moving body's merged inertia is positive semi-definite to rounding) and

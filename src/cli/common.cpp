@@ -35,7 +35,7 @@ const char* usageText(const std::string& command) {
     return "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--strict] [--attach-beyond-tip] [--json]\n"
            "\n"
            "Print the chain loaded from MODEL.urdf: joints (type, axis, limits, friction,\n"
-           "damping, rotor inertia, effort limit), frames, moving and base mass, and the\n"
+           "viscous, rotor inertia, effort limit), frames, moving and base mass, and the\n"
            "model's warnings (also on stderr as \"zwang: warning: ...\").\n"
            "\n"
            "  --root LINK           the chain starts at LINK (default: the URDF's root link)\n"

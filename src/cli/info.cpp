@@ -78,7 +78,7 @@ Json infoJson(const Model& model, const std::string& path) {
                       {"velocity_limit", finiteOrNull(j.velocity_limit)},
                       {"breakaway_friction", j.breakaway_friction},
                       {"kinetic_friction", j.kinetic_friction},
-                      {"damping", j.damping},
+                      {"viscous_friction", j.viscous_friction},
                       {"rotor_inertia", j.rotor_inertia}});
   Json frames = Json::array();
   for (const Frame& f : model.frames())
@@ -101,13 +101,13 @@ void printInfoTable(const Model& model, const std::string& path) {
   std::printf("%s: %d moving joint%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
               model.dof() == 1 ? "" : "s", model.frames().size(), path.c_str());
   std::vector<std::vector<std::string>> rows{{"#", "name", "type", "axis", "lower", "upper", "effort", "velocity",
-                                              "breakaway", "kinetic", "damping", "rotor_inertia"}};
+                                              "breakaway", "kinetic", "viscous", "rotor_inertia"}};
   for (int k = 0; k < model.dof(); ++k) {
     const Joint& j = model.joint(k);
     char axis[64];
     std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
     rows.push_back({std::to_string(k), j.name, toString(j.type), axis, cell(j.lower), cell(j.upper), cell(j.effort_limit),
-                    cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction), cell(j.damping),
+                    cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction), cell(j.viscous_friction),
                     cell(j.rotor_inertia)});
   }
   printTable(rows);
@@ -120,7 +120,7 @@ void printInfoTable(const Model& model, const std::string& path) {
               cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
   const std::size_t warnings = model.warnings().size();
   if (warnings > 0) std::printf("%zu warning%s (on stderr)\n", warnings, warnings == 1 ? "" : "s");
-  std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (damping), kg·m² or kg (rotor inertia)\n");
+  std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (viscous), kg·m² or kg (rotor inertia)\n");
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ Status checkOptions(const Model& model, const FrictionOptions& o) {
   const struct {
     const char* name;
     const Eigen::VectorXd& v;
-  } overrides[] = {{"breakaway", o.breakaway}, {"kinetic", o.kinetic}, {"damping", o.damping}};
+  } overrides[] = {{"breakaway", o.breakaway}, {"kinetic", o.kinetic}, {"viscous", o.viscous}};
   for (const auto& ov : overrides) {
     if (ov.v.size() != 0 && ov.v.size() != n)
       return Status::error(StatusCode::BadOption, "friction override '%s' has %ld entries, the model has %d joints",
@@ -81,7 +81,7 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
     const Joint& joint = model.joint(j);
     fs.breakaway[j] = options.breakaway.size() ? options.breakaway[j] : joint.breakaway_friction;
     fs.kinetic[j] = options.kinetic.size() ? options.kinetic[j] : joint.kinetic_friction;
-    fs.viscous[j] = options.damping.size() ? options.damping[j] : joint.damping;
+    fs.viscous[j] = options.viscous.size() ? options.viscous[j] : joint.viscous_friction;
   }
   fr.stuck.clear();
   fr.limit_impact = false;

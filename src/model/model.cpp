@@ -179,7 +179,7 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
   } non_negative[] = {{"rotor inertia", joint.rotor_inertia},
                       {"friction", joint.breakaway_friction},
                       {"kinetic friction", joint.kinetic_friction},
-                      {"damping", joint.damping}};
+                      {"viscous friction", joint.viscous_friction}};
   for (const auto& p : non_negative) {
     if (!std::isfinite(p.value)) throw ModelError(where + ": " + p.field + " is not finite");
     if (p.value < 0.0) throw ModelError(where + ": " + p.field + " " + std::to_string(p.value) + " is negative");
@@ -249,14 +249,14 @@ ModelBuilder& ModelBuilder::setRotorInertia(const std::string& joint, double val
   return *this;
 }
 
-ModelBuilder& ModelBuilder::setFriction(const std::string& joint, double breakaway, double kinetic, double damping) {
-  for (double v : {breakaway, kinetic, damping})
+ModelBuilder& ModelBuilder::setFriction(const std::string& joint, double breakaway, double kinetic, double viscous) {
+  for (double v : {breakaway, kinetic, viscous})
     if (!std::isfinite(v) || v < 0.0)
-      throw ModelError("joint '" + joint + "': friction and damping must be finite and non-negative");
+      throw ModelError("joint '" + joint + "': breakaway, kinetic and viscous friction must be finite and non-negative");
   Joint& j = jointNamed(joint);
   j.breakaway_friction = breakaway;
   j.kinetic_friction = kinetic;
-  j.damping = damping;
+  j.viscous_friction = viscous;
   return *this;
 }
 

@@ -418,7 +418,7 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
     if (dyn.damping < 0.0) report.fail(who + ": <dynamics> damping " + fmt(dyn.damping) + " is negative");
     joint.breakaway_friction = dyn.friction;
     joint.kinetic_friction = dyn.friction;  // default f_c = f: docs/friction.md, "The model of friction"
-    joint.damping = dyn.damping;
+    joint.viscous_friction = dyn.damping;  // URDF calls the viscous coefficient "damping"
   }
 
   const auto r = rotor.find(uj.name);

@@ -93,7 +93,7 @@ void bindModel(py::module_& m) {
       .def_property_readonly("breakaway_friction", [](const Joint& j) { return j.breakaway_friction; },
                              "f_j >= 0, the static friction bound (URDF <dynamics friction>)")
       .def_property_readonly("kinetic_friction", [](const Joint& j) { return j.kinetic_friction; })
-      .def_property_readonly("damping", [](const Joint& j) { return j.damping; })
+      .def_property_readonly("viscous_friction", [](const Joint& j) { return j.viscous_friction; })
       .def_property_readonly("rotor_inertia", [](const Joint& j) { return j.rotor_inertia; })
       .def_property_readonly("placement", [](const Joint& j) {
         return transformMatrix(j.placement.rotationOfTarget(), j.placement.originOfTarget());
@@ -141,7 +141,7 @@ void bindModel(py::module_& m) {
       .def_property_readonly("kinetic_friction", [](const Model& model) {
         return perJoint(model, [](const Joint& j) { return j.kinetic_friction; });
       })
-      .def_property_readonly("damping", [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.damping; }); })
+      .def_property_readonly("viscous_friction", [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.viscous_friction; }); })
       .def_property_readonly("rotor_inertia",
                              [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.rotor_inertia; }); })
       .def_property_readonly("warnings", [](const Model& model) {
@@ -162,17 +162,17 @@ void bindModel(py::module_& m) {
         for (int j = 0; j < model.dof(); ++j) builder.setRotorInertia(model.joint(j).name, v[j]);
         return std::make_shared<Model>(builder.build());
       }, py::arg("rotor_inertia"), "a copy with these reflected rotor inertias, one per joint")
-      .def("with_friction", [](const Model& model, py::handle breakaway, py::handle kinetic, py::handle damping) {
+      .def("with_friction", [](const Model& model, py::handle breakaway, py::handle kinetic, py::handle viscous) {
         const Eigen::VectorXd f = perJointArg(model, "breakaway", breakaway);
         const Eigen::VectorXd fc = kinetic.is_none() ? f : perJointArg(model, "kinetic", kinetic);
         Eigen::VectorXd b(model.dof());
-        for (int j = 0; j < model.dof(); ++j) b[j] = model.joint(j).damping;
-        if (!damping.is_none()) b = perJointArg(model, "damping", damping);
+        for (int j = 0; j < model.dof(); ++j) b[j] = model.joint(j).viscous_friction;
+        if (!viscous.is_none()) b = perJointArg(model, "viscous", viscous);
         ModelBuilder builder(model);
         for (int j = 0; j < model.dof(); ++j) builder.setFriction(model.joint(j).name, f[j], fc[j], b[j]);
         return std::make_shared<Model>(builder.build());
-      }, py::arg("breakaway"), py::arg("kinetic") = py::none(), py::arg("damping") = py::none(),
-         "a copy with these friction parameters, one per joint (kinetic defaults to breakaway, damping to the model's)")
+      }, py::arg("breakaway"), py::arg("kinetic") = py::none(), py::arg("viscous") = py::none(),
+         "a copy with these friction parameters, one per joint (kinetic defaults to breakaway, viscous to the model's)")
       .def("__repr__", [](const Model& model) {
         return "<zwang.Model '" + model.name() + "': " + std::to_string(model.dof()) + " joints (" + jointNames(model) +
                "), " + std::to_string(model.frames().size()) + " frames>";

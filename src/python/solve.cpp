@@ -376,11 +376,11 @@ void bindSolve(py::module_& m) {
   // ---- Friction ------------------------------------------------------------
   py::class_<Friction>(m, "Friction",
                        "Options of the friction-aware solve (zwang::FrictionOptions). margin: when mu* is not\n"
-                       "unique, the effort-minimising choice uses at most margin*f_j. breakaway/kinetic/damping:\n"
+                       "unique, the effort-minimising choice uses at most margin*f_j. breakaway/kinetic/viscous:\n"
                        "optional per-joint overrides of the model's values.")
       .def(py::init([](double margin, double velocity_tolerance, double limit_tolerance, bool joint_limits,
                        const std::string& method, int max_iterations, double kkt_tolerance, py::handle breakaway,
-                       py::handle kinetic, py::handle damping) {
+                       py::handle kinetic, py::handle viscous) {
              Friction f;
              f.options.margin = margin;
              f.options.velocity_tolerance = velocity_tolerance;
@@ -396,13 +396,13 @@ void bindSolve(py::module_& m) {
              f.options.kkt_tolerance = kkt_tolerance;
              f.options.breakaway = optionalOverride("breakaway", breakaway);
              f.options.kinetic = optionalOverride("kinetic", kinetic);
-             f.options.damping = optionalOverride("damping", damping);
+             f.options.viscous = optionalOverride("viscous", viscous);
              return f;
            }),
            py::kw_only(), py::arg("margin") = 1.0, py::arg("velocity_tolerance") = 1e-6,
            py::arg("limit_tolerance") = 1e-9, py::arg("joint_limits") = true, py::arg("method") = "active_set",
            py::arg("max_iterations") = 500, py::arg("kkt_tolerance") = 1e-12, py::arg("breakaway") = py::none(),
-           py::arg("kinetic") = py::none(), py::arg("damping") = py::none())
+           py::arg("kinetic") = py::none(), py::arg("viscous") = py::none())
       .def_property_readonly("margin", [](const Friction& f) { return f.options.margin; })
       .def_property_readonly("velocity_tolerance", [](const Friction& f) { return f.options.velocity_tolerance; })
       .def_property_readonly("limit_tolerance", [](const Friction& f) { return f.options.limit_tolerance; })
@@ -414,7 +414,7 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("kkt_tolerance", [](const Friction& f) { return f.options.kkt_tolerance; })
       .def_property_readonly("breakaway", [](const Friction& f) { return overrideArray(f.options.breakaway); })
       .def_property_readonly("kinetic", [](const Friction& f) { return overrideArray(f.options.kinetic); })
-      .def_property_readonly("damping", [](const Friction& f) { return overrideArray(f.options.damping); })
+      .def_property_readonly("viscous", [](const Friction& f) { return overrideArray(f.options.viscous); })
       .def("__repr__", [](const Friction& f) {
         return "<zwang.Friction margin=" + std::string(py::str(py::float_(f.options.margin))) + ">";
       });

@@ -564,7 +564,7 @@ TEST_CASE("info: table and JSON", "[info]") {
     CHECK(j["joints"][0]["type"] == "revolute");
     CHECK(numbers(j["joints"][0]["axis"]) == std::vector<double>{0, 0, 1});
     CHECK(j["joints"][0]["breakaway_friction"].get<double>() == 10.0);
-    CHECK(j["joints"][0]["damping"].get<double>() == 0.0);
+    CHECK(j["joints"][0]["viscous_friction"].get<double>() == 0.0);
     CHECK(j["joints"][0]["upper"].get<double>() == Approx(M_PI).margin(1e-15));
     CHECK(j["joints"][0]["effort_limit"].get<double>() == 100.0);
     CHECK(j["total_mass"].get<double>() == Approx(1.0).margin(1e-15));

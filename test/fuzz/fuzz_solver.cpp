@@ -92,7 +92,7 @@ bool buildChain(FuzzedDataProvider& in, Chain& out) {
       joint.rotor_inertia = logUniform(in, 1e-6, 1e3, 0.4);
       joint.breakaway_friction = logUniform(in, 1e-3, 1e4, 0.2);
       joint.kinetic_friction = in.ConsumeBool() ? joint.breakaway_friction : logUniform(in, 1e-3, 1e4, 0.3);
-      joint.damping = logUniform(in, 1e-3, 1e3, 0.3);
+      joint.viscous_friction = logUniform(in, 1e-3, 1e3, 0.3);
       if (joint.type != JointType::Continuous && in.ConsumeBool()) {
         joint.lower = -logUniform(in, 1e-3, 3.0, 0.1);
         joint.upper = logUniform(in, 1e-3, 3.0, 0.1);

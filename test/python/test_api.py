@@ -19,7 +19,7 @@ def test_introspection(panda):
     assert j4.type == "revolute" and j4.lower < j4.upper and j4.breakaway_friction > 0
     assert panda.joint_index("panda_joint4") == 3 and panda.frame_index("tool0") == len(panda.frames) - 1
     for field in ["lower", "upper", "effort_limit", "velocity_limit", "breakaway_friction", "kinetic_friction",
-                  "damping", "rotor_inertia"]:
+                  "viscous_friction", "rotor_inertia"]:
         values = getattr(panda, field)
         assert values.shape == (7,) and values.dtype == np.float64
         assert list(values) == [getattr(j, field) for j in panda.joints]

@@ -20,9 +20,9 @@ std::vector<BadFrictionOption> badFrictionOptions() {
       [](FrictionOptions& o) { o.kinetic = Eigen::VectorXd::Zero(3); });
   add("friction override 'breakaway' for joint 'panda_joint1' is -1 (must be finite and >= 0)",
       [](FrictionOptions& o) { o.breakaway = Eigen::VectorXd::Constant(7, -1.0); });
-  add("friction override 'damping' for joint 'panda_joint2' is -2 (must be finite and >= 0)", [](FrictionOptions& o) {
-    o.damping = Eigen::VectorXd::Zero(7);
-    o.damping[1] = -2.0;
+  add("friction override 'viscous' for joint 'panda_joint2' is -2 (must be finite and >= 0)", [](FrictionOptions& o) {
+    o.viscous = Eigen::VectorXd::Zero(7);
+    o.viscous[1] = -2.0;
   });
   add("velocity_tolerance nan must be finite and >= 0", [&](FrictionOptions& o) { o.velocity_tolerance = nan; });
   add("velocity_tolerance -1 must be finite and >= 0", [](FrictionOptions& o) { o.velocity_tolerance = -1.0; });

@@ -21,7 +21,7 @@ FrictionExpectation expectFriction(const Model& model, const Eigen::VectorXd& q,
   FrictionExpectation e;
   e.breakaway.resize(n);
   e.kinetic.resize(n);
-  e.damping.resize(n);
+  e.viscous.resize(n);
   e.tau_kinetic = Eigen::VectorXd::Zero(n);
   e.limit_side = Eigen::VectorXi::Zero(n);
   e.tau = tau;
@@ -29,7 +29,7 @@ FrictionExpectation expectFriction(const Model& model, const Eigen::VectorXd& q,
     const Joint& joint = model.joint(j);
     e.breakaway(j) = options.breakaway.size() == n ? options.breakaway(j) : joint.breakaway_friction;
     e.kinetic(j) = options.kinetic.size() == n ? options.kinetic(j) : joint.kinetic_friction;
-    e.damping(j) = options.damping.size() == n ? options.damping(j) : joint.damping;
+    e.viscous(j) = options.viscous.size() == n ? options.viscous(j) : joint.viscous_friction;
     if (std::abs(qd(j)) <= options.velocity_tolerance) {
       e.stuck.push_back(j);
       if (options.joint_limits) {
@@ -40,7 +40,7 @@ FrictionExpectation expectFriction(const Model& model, const Eigen::VectorXd& q,
       }
     } else {
       const double sign = qd(j) > 0.0 ? 1.0 : -1.0;
-      e.tau_kinetic(j) = -e.kinetic(j) * sign - e.damping(j) * qd(j);
+      e.tau_kinetic(j) = -e.kinetic(j) * sign - e.viscous(j) * qd(j);
     }
   }
   return e;

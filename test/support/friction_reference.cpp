@@ -24,8 +24,8 @@ void checkSetup(const ChainSpec& spec, const DynamicsInput& input, const Frictio
   const auto n = static_cast<Eigen::Index>(spec.dof());
   if (input.q.size() != n || input.qd.size() != n || input.tau.size() != n)
     throw std::invalid_argument("friction reference: q, qd, tau must have spec.dof() entries");
-  if (setup.breakaway.size() != n || setup.kinetic.size() != n || setup.damping.size() != n)
-    throw std::invalid_argument("friction reference: breakaway, kinetic, damping must have spec.dof() entries");
+  if (setup.breakaway.size() != n || setup.kinetic.size() != n || setup.viscous.size() != n)
+    throw std::invalid_argument("friction reference: breakaway, kinetic, viscous must have spec.dof() entries");
   if (setup.limit_side.size() != 0 && setup.limit_side.size() != n)
     throw std::invalid_argument("friction reference: limit_side must be empty or have spec.dof() entries");
   for (std::size_t s = 0; s < setup.stuck.size(); ++s) {
@@ -76,13 +76,13 @@ FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd
   FrictionSetup s;
   s.breakaway.resize(n);
   s.kinetic.resize(n);
-  s.damping.resize(n);
+  s.viscous.resize(n);
   const std::vector<int> moving = spec.movingJoints();
   for (int j = 0; j < n; ++j) {
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
     s.breakaway(j) = joint.friction;
     s.kinetic(j) = joint.friction;  // default f_c = f: docs/friction.md, "The model of friction"
-    s.damping(j) = joint.damping;
+    s.viscous(j) = joint.damping;  // URDF <dynamics damping>
     if (std::abs(qd(j)) <= velocity_tolerance) s.stuck.push_back(j);
   }
   return s;
@@ -93,7 +93,7 @@ Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd&
   for (Eigen::Index j = 0; j < qd.size(); ++j) {
     if (std::find(setup.stuck.begin(), setup.stuck.end(), static_cast<int>(j)) != setup.stuck.end()) continue;
     const double sign = qd(j) > 0.0 ? 1.0 : (qd(j) < 0.0 ? -1.0 : 0.0);
-    t(j) = -setup.kinetic(j) * sign - setup.damping(j) * qd(j);
+    t(j) = -setup.kinetic(j) * sign - setup.viscous(j) * qd(j);
   }
   return t;
 }

@@ -56,7 +56,7 @@ struct FrictionSetup {
   std::vector<int> stuck;      // Θ₀, dof indices, ascending
   Eigen::VectorXd breakaway;   // f_j ≥ 0
   Eigen::VectorXd kinetic;     // f_c,j ≥ 0 (moving joints)
-  Eigen::VectorXd damping;     // b_j ≥ 0 (moving joints)
+  Eigen::VectorXd viscous;     // b_j ≥ 0 (moving joints)
   // −1: stuck on its lower limit, +1: on its upper limit, 0: free. Empty = all free.
   Eigen::VectorXi limit_side;
 };

@@ -36,13 +36,13 @@
 #include <string>
 #include <vector>
 
+#include <urdf_parser/urdf_parser.h>
 #include <kdl/chain.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/frames.hpp>
 #include <kdl/jacobian.hpp>
 #include <kdl/jntarray.hpp>
-#include <urdf_parser/urdf_parser.h>
 
 #include "support/kdl_bridge.hpp"
 #include "support/random_chain.hpp"
@@ -60,8 +60,8 @@ using namespace zwang::testing;
 struct Problem {
   std::string label;  // "N=7" or "panda"
   int n = 0;
-  ChainSpec spec;     // the same chain as a plain description, for KDL
-  Model model;        // ours
+  ChainSpec spec;                   // the same chain as a plain description, for KDL
+  Model model;                      // ours
   Eigen::VectorXd q, qd, qdd, tau;  // every joint moving: 0.1 ≤ |q̇_j| ≤ 2
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};
   std::string tip, middle;  // link names: the last one, and one half way
@@ -197,19 +197,16 @@ DynamicsInput makeInput(const Problem& p, TaskKind kind, const Eigen::VectorXd& 
     return c;
   };
   switch (kind) {
-    case TaskKind::None:
-      break;
+    case TaskKind::None: break;
     case TaskKind::Ee1: {  // one unit force along world z on the end effector
       Matrix6Xd A = Matrix6Xd::Zero(6, 1);
       A(2, 0) = 1.0;
       in.constraints.push_back(constraint(p.tip, A));
       break;
     }
-    case TaskKind::Ee6:
-      in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6)));
-      break;
+    case TaskKind::Ee6: in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6))); break;
     case TaskKind::Split6:
-      in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6).leftCols(3)));    // position
+      in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6).leftCols(3)));      // position
       in.constraints.push_back(constraint(p.middle, Matrix6Xd::Identity(6, 6).rightCols(3)));  // orientation
       break;
   }
@@ -407,7 +404,8 @@ FrictionSetupOurs frictionSetup(const Problem& p, int k) {
   s.tau_eff = p.tau;
   for (int j = 0; j < p.n; ++j) {
     const Joint& joint = p.model.joint(j);
-    if (s.qd[j] != 0.0) s.tau_eff[j] += -joint.kinetic_friction * (s.qd[j] > 0 ? 1.0 : -1.0) - joint.viscous_friction * s.qd[j];
+    if (s.qd[j] != 0.0)
+      s.tau_eff[j] += -joint.kinetic_friction * (s.qd[j] > 0 ? 1.0 : -1.0) - joint.viscous_friction * s.qd[j];
   }
   s.f.resize(k);
   for (int a = 0; a < k; ++a) s.f[a] = p.model.joint(s.stuck[static_cast<std::size_t>(a)]).breakaway_friction;
@@ -621,8 +619,8 @@ int main(int argc, char** argv) {
           if (kn == "kall" && p->n == 1) continue;               // = k1
           reg(std::string("fric_") + method_name + "_" + task_name + "_" + kn, *p,
               [q = p.get(), kind = kind, k, method = method](benchmark::State& s) {
-                benchFriction(s, q, kind, k, method);
-              });
+            benchFriction(s, q, kind, k, method);
+          });
         }
 
   for (const auto& [kind, task_name] : fric_tasks)
@@ -644,8 +642,9 @@ int main(int argc, char** argv) {
   for (const auto& p : problems)
     if (p->label == "panda")
       for (const auto& [kind, task_name] : fric_tasks)
-        benchmark::RegisterBenchmark((std::string("worst_as_") + task_name + "_kall/" + p->label).c_str(),
-                                     [q = p.get(), kind = kind](benchmark::State& s) { benchWorstCase(s, q, kind, 1000000); })
+        benchmark::RegisterBenchmark(
+            (std::string("worst_as_") + task_name + "_kall/" + p->label).c_str(),
+            [q = p.get(), kind = kind](benchmark::State& s) { benchWorstCase(s, q, kind, 1000000); })
             ->Iterations(1)
             ->Unit(benchmark::kMillisecond);
 

@@ -17,8 +17,8 @@
 #include <random>
 #include <vector>
 
-#include "qp/box_qp.hpp"
 #include "linalg/growing_cholesky.hpp"
+#include "qp/box_qp.hpp"
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
@@ -129,9 +129,7 @@ VectorXd logUniformDiagonal(Rng& rng, int k, double lo_exp, double hi_exp) {
   return D;
 }
 
-MatrixXd scaled(const MatrixXd& A, const VectorXd& D) {
-  return symmetrised(D.asDiagonal() * A * D.asDiagonal());
-}
+MatrixXd scaled(const MatrixXd& A, const VectorXd& D) { return symmetrised(D.asDiagonal() * A * D.asDiagonal()); }
 
 // Equilibration D = sqrt(diag P) (1 where the diagonal is zero: P's row is then zero).
 VectorXd equilibration(const MatrixXd& P) {
@@ -235,7 +233,8 @@ TEST_CASE("GrowingCholesky: Schur pivots, null directions and solves against den
         std::vector<int> Fj = F;
         Fj.push_back(j);
         VectorXd v(Fj.size());
-        for (size_t a = 0; a < F.size(); ++a) v[static_cast<Eigen::Index>(a)] = d[static_cast<Eigen::Index>(a)] * D[F[a]] / D[j];
+        for (size_t a = 0; a < F.size(); ++a)
+          v[static_cast<Eigen::Index>(a)] = d[static_cast<Eigen::Index>(a)] * D[F[a]] / D[j];
         v[v.size() - 1] = 1.0;
         VectorXd residual = submatrix(S, Fj, Fj) * v;
         residual[residual.size() - 1] -= pivot / P(j, j);
@@ -348,9 +347,10 @@ TEST_CASE("nearNullSpace: nullity, orthonormal basis and curvature bound against
         REQUIRE(curvature <= static_cast<double>(res.nullity) * floor);
       }
     }
-    std::printf("nearNullSpace, rank-deficient B Bᵀ: %d draws; worst |NᵀN − I| %.3g (limit %.3g), |A N|/|A| %.3g "
-                "(limit %.3g), |U_rᵀ N| %.3g\n",
-                kDraws, orthonormal.value, kOrthonormalTol, residual.value, kNullResidualTol, angle.value);
+    std::printf(
+        "nearNullSpace, rank-deficient B Bᵀ: %d draws; worst |NᵀN − I| %.3g (limit %.3g), |A N|/|A| %.3g "
+        "(limit %.3g), |U_rᵀ N| %.3g\n",
+        kDraws, orthonormal.value, kOrthonormalTol, residual.value, kNullResidualTol, angle.value);
   }
 
   SECTION("full rank: nullity 0 whenever the floor is below λ_min (Schur diagonals are ≥ λ_min)") {
@@ -382,7 +382,9 @@ TEST_CASE("nearNullSpace: nullity, orthonormal basis and curvature bound against
       const int m = draw == 0 ? 2 : uniformInt(rng, 1, n - 1);
       VectorXd lambda(n);
       for (int i = 0; i < n; ++i)
-        lambda[i] = draw == 0 ? (i < n - m ? 1.0 : 1e-9) : i < n - m ? uniform(rng, 1.0, 10.0) : uniform(rng, 0.0, 1e-9);
+        lambda[i] = draw == 0   ? (i < n - m ? 1.0 : 1e-9)
+                    : i < n - m ? uniform(rng, 1.0, 10.0)
+                                : uniform(rng, 0.0, 1e-9);
       const MatrixXd Q = randomOrthogonal(rng, n);
       const MatrixXd A = symmetrised(Q * lambda.asDiagonal() * Q.transpose());
       const double floor = 1e-6;
@@ -465,8 +467,9 @@ double bruteForceMinimum(const BoxQp& q, int* candidates) {
         const double y = yt[a] / D[a];
         const double width = q.hi[i] - q.lo[i];
         const double slack =
-            kFeasibleSlack * (std::isfinite(width) ? width : 1.0 + std::max(std::isfinite(q.lo[i]) ? -q.lo[i] : 0.0,
-                                                                           std::isfinite(q.hi[i]) ? q.hi[i] : 0.0));
+            kFeasibleSlack * (std::isfinite(width) ? width
+                                                   : 1.0 + std::max(std::isfinite(q.lo[i]) ? -q.lo[i] : 0.0,
+                                                                    std::isfinite(q.hi[i]) ? q.hi[i] : 0.0));
         if (!(y >= q.lo[i] - slack && y <= q.hi[i] + slack)) feasible = false;
         x[i] = std::min(q.hi[i], std::max(q.lo[i], y));
       }
@@ -491,8 +494,10 @@ void randomBox(Rng& rng, BoxQp& q, const VectorXd* D) {
     const double s = D ? 1.0 / (*D)[j] : 1.0;
     q.lo[j] = -uniform(rng, 0.05, 2.0) * s;
     q.hi[j] = uniform(rng, 0.05, 2.0) * s;
-    if (uniform(rng, 0, 1) < 0.1) q.lo[j] = 0.0;  // one-sided
-    else if (uniform(rng, 0, 1) < 0.1) q.hi[j] = 0.0;
+    if (uniform(rng, 0, 1) < 0.1)
+      q.lo[j] = 0.0;  // one-sided
+    else if (uniform(rng, 0, 1) < 0.1)
+      q.hi[j] = 0.0;
   }
 }
 
@@ -505,10 +510,14 @@ double kktViolationRatio(const BoxQp& q, const VectorXd& x) {
   for (Eigen::Index j = 0; j < x.size(); ++j) {
     const double scale = q.P.row(j).cwiseAbs().sum() * x_max + std::abs(q.c[j]) + DBL_MIN;
     double violation = 0.0;
-    if (q.lo[j] == q.hi[j]) violation = 0.0;
-    else if (x[j] <= q.lo[j]) violation = std::max(0.0, -g[j]);
-    else if (x[j] >= q.hi[j]) violation = std::max(0.0, g[j]);
-    else violation = std::abs(g[j]);
+    if (q.lo[j] == q.hi[j])
+      violation = 0.0;
+    else if (x[j] <= q.lo[j])
+      violation = std::max(0.0, -g[j]);
+    else if (x[j] >= q.hi[j])
+      violation = std::max(0.0, g[j]);
+    else
+      violation = std::abs(g[j]);
     worst = std::max(worst, violation / scale);
   }
   return worst;
@@ -527,9 +536,8 @@ TEST_CASE("boxQpActiveSet: minimum against brute-force enumeration of all 3^k ac
   Rng rng(0x626f'7871'7062'7275ULL);
   constexpr int kDraws = 3000;
   constexpr int kKinds = 8;
-  const char* kind_names[kKinds] = {"full rank",        "rank-deficient",      "scaled (equivalent)",
-                                    "scaled (raw c, box)", "zero row/col",     "well-conditioned",
-                                    "PD, infinite bounds", "nearly dependent"};
+  const char* kind_names[kKinds] = {"full rank",    "rank-deficient",   "scaled (equivalent)", "scaled (raw c, box)",
+                                    "zero row/col", "well-conditioned", "PD, infinite bounds", "nearly dependent"};
   Worst phi_gap[kKinds], kkt_ratio[kKinds], pg_gap;
   int max_iterations_seen[kKinds] = {}, count[kKinds] = {};
   int pg_converged = 0, pg_runs = 0, pg_max_iterations = 0;
@@ -540,12 +548,8 @@ TEST_CASE("boxQpActiveSet: minimum against brute-force enumeration of all 3^k ac
     VectorXd D;
     bool equivalent_scaling = false;
     switch (kind) {
-      case 0:
-        q.P = gram(rng, k, k);
-        break;
-      case 1:
-        q.P = gram(rng, k, uniformInt(rng, 0, k - 1));
-        break;
+      case 0: q.P = gram(rng, k, k); break;
+      case 1: q.P = gram(rng, k, uniformInt(rng, 0, k - 1)); break;
       case 2:
       case 3: {
         const MatrixXd A = uniform(rng, 0, 1) < 0.5 ? gram(rng, k, k) : gram(rng, k, uniformInt(rng, 0, k));
@@ -561,9 +565,7 @@ TEST_CASE("boxQpActiveSet: minimum against brute-force enumeration of all 3^k ac
         q.P.col(z).setZero();
         break;
       }
-      case 5:
-        q.P = wellConditioned(rng, k, 1.0, 10.0);
-        break;
+      case 5: q.P = wellConditioned(rng, k, 1.0, 10.0); break;
       case 6:  // positive definite: bounded whatever the box
         q.P = gram(rng, k, k);
         q.P += (0.1 * q.P.trace() / k) * MatrixXd::Identity(k, k);
@@ -577,7 +579,9 @@ TEST_CASE("boxQpActiveSet: minimum against brute-force enumeration of all 3^k ac
       }
     }
     // c: a few times P's scale so that some bounds are active and some not.
-    const double c_scale = 1.5 * std::max(1.0, (equivalent_scaling ? (q.P.diagonal().array() / D.array().square()).sum() : q.P.trace()) / k);
+    const double c_scale =
+        1.5 *
+        std::max(1.0, (equivalent_scaling ? (q.P.diagonal().array() / D.array().square()).sum() : q.P.trace()) / k);
     q.c = gaussian(rng, k, 1) * c_scale;
     if (equivalent_scaling) q.c = D.asDiagonal() * q.c;
     randomBox(rng, q, equivalent_scaling ? &D : nullptr);
@@ -621,7 +625,8 @@ TEST_CASE("boxQpActiveSet: minimum against brute-force enumeration of all 3^k ac
     // The report's residual is boxQpKktResidual's, small relative to c's scale
     // (in the units of ∇φ; for the raw-scaled draws P's scale enters through Px).
     double grad_scale = q.c.lpNorm<Eigen::Infinity>();
-    for (int j = 0; j < k; ++j) grad_scale = std::max(grad_scale, q.P.row(j).cwiseAbs().sum() * x.lpNorm<Eigen::Infinity>());
+    for (int j = 0; j < k; ++j)
+      grad_scale = std::max(grad_scale, q.P.row(j).cwiseAbs().sum() * x.lpNorm<Eigen::Infinity>());
     REQUIRE(report.kkt_residual == boxQpKktResidual(q.P, q.c, q.lo, q.hi, x));
     REQUIRE(report.kkt_residual <= kKktTol * (grad_scale + DBL_MIN));
     max_iterations_seen[kind] = std::max(max_iterations_seen[kind], report.iterations);
@@ -646,10 +651,11 @@ TEST_CASE("boxQpActiveSet: minimum against brute-force enumeration of all 3^k ac
   REQUIRE(pg_converged == pg_runs);
   std::printf("boxQpActiveSet vs brute force, %d draws (k = 1..6):\n", kDraws);
   for (int kind = 0; kind < kKinds; ++kind)
-    std::printf("  %-20s %4d draws: worst |φ − φ_brute|/(1+|φ|) %.3g (limit %.3g), KKT/scale %.3g (limit %.3g), "
-                "max iterations %d\n",
-                kind_names[kind], count[kind], phi_gap[kind].value, kPhiTol, kkt_ratio[kind].value, kKktTol,
-                max_iterations_seen[kind]);
+    std::printf(
+        "  %-20s %4d draws: worst |φ − φ_brute|/(1+|φ|) %.3g (limit %.3g), KKT/scale %.3g (limit %.3g), "
+        "max iterations %d\n",
+        kind_names[kind], count[kind], phi_gap[kind].value, kPhiTol, kkt_ratio[kind].value, kKktTol,
+        max_iterations_seen[kind]);
   std::printf("  projected gradient: %d/%d converged, worst φ gap %.3g (limit %.3g), max iterations %d\n", pg_converged,
               pg_runs, pg_gap.value, kPgPhiTol, pg_max_iterations);
 }
@@ -689,8 +695,8 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
       CAPTURE(draw, k, j, q.P, q.c.transpose(), q.lo.transpose(), q.hi.transpose());
       QpScratch scratch(k);
       VectorXd x = VectorXd::Zero(k);
-      const QpReport report =
-          boxQpActiveSet(q.P, q.c, q.lo, q.hi, x, scratch, kMaxIterations, 1e-12 * (1.0 + q.c.lpNorm<Eigen::Infinity>()));
+      const QpReport report = boxQpActiveSet(q.P, q.c, q.lo, q.hi, x, scratch, kMaxIterations,
+                                             1e-12 * (1.0 + q.c.lpNorm<Eigen::Infinity>()));
       CAPTURE(report.iterations, report.unbounded_index, x.transpose());
       REQUIRE(report.unbounded);
       REQUIRE_FALSE(report.converged);
@@ -750,9 +756,9 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
     // and projected gradient agree.
     for (const bool active_set : {true, false}) {
       x1.setZero();
-      const QpReport rounding = active_set
-                                    ? boxQpActiveSet(P1, c1, lo1, hi1, x1, scratch1, kMaxIterations, 1e-12, 1.0)
-                                    : boxQpProjectedGradient(P1, c1, lo1, hi1, x1, scratch1, kPgMaxIterations, 1e-12, 1.0);
+      const QpReport rounding =
+          active_set ? boxQpActiveSet(P1, c1, lo1, hi1, x1, scratch1, kMaxIterations, 1e-12, 1.0)
+                     : boxQpProjectedGradient(P1, c1, lo1, hi1, x1, scratch1, kPgMaxIterations, 1e-12, 1.0);
       CAPTURE(active_set, rounding.iterations, x1[0]);
       REQUIRE(rounding.unbounded);
       REQUIRE(rounding.unbounded_index == 0);
@@ -777,8 +783,8 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
       CAPTURE(draw, k, r, q.P, q.c.transpose(), q.lo.transpose(), q.hi.transpose());
       QpScratch scratch(k);
       VectorXd x = VectorXd::Zero(k);
-      const QpReport report =
-          boxQpActiveSet(q.P, q.c, q.lo, q.hi, x, scratch, kMaxIterations, 1e-12 * (1.0 + q.c.lpNorm<Eigen::Infinity>()));
+      const QpReport report = boxQpActiveSet(q.P, q.c, q.lo, q.hi, x, scratch, kMaxIterations,
+                                             1e-12 * (1.0 + q.c.lpNorm<Eigen::Infinity>()));
       CAPTURE(report.iterations, report.unbounded_index, x.transpose());
       REQUIRE(report.converged);
       REQUIRE_FALSE(report.unbounded);
@@ -791,9 +797,10 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
       const double unconstrained = -0.5 * q.c.dot(q.P.completeOrthogonalDecomposition().solve(q.c));
       REQUIRE(phi(q.P, q.c, x) >= unconstrained - kPhiTol * (1.0 + std::abs(unconstrained)));
     }
-    std::printf("rank-deficient, consistent c, mixed infinite bounds: 300 draws, worst KKT/scale %.3g (limit %.3g), "
-                "max iterations %d\n",
-                kkt.value, kKktTol, max_iterations);
+    std::printf(
+        "rank-deficient, consistent c, mixed infinite bounds: 300 draws, worst KKT/scale %.3g (limit %.3g), "
+        "max iterations %d\n",
+        kkt.value, kKktTol, max_iterations);
   }
   SECTION("every bound infinite, rank-deficient P: unbounded iff c has a component in null(P)") {
     Worst kkt;
@@ -815,8 +822,8 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
       CAPTURE(draw, k, r, consistent, q.P, q.c.transpose());
       QpScratch scratch(k);
       VectorXd x = VectorXd::Zero(k);
-      const QpReport report =
-          boxQpActiveSet(q.P, q.c, q.lo, q.hi, x, scratch, kMaxIterations, 1e-12 * (1.0 + q.c.lpNorm<Eigen::Infinity>()));
+      const QpReport report = boxQpActiveSet(q.P, q.c, q.lo, q.hi, x, scratch, kMaxIterations,
+                                             1e-12 * (1.0 + q.c.lpNorm<Eigen::Infinity>()));
       CAPTURE(report.iterations, report.unbounded_index, x.transpose());
       if (consistent) {
         REQUIRE(report.converged);
@@ -886,11 +893,12 @@ TEST_CASE("boxQpActiveSet: k = 40, 80 satisfies the KKT conditions in few iterat
         REQUIRE(report.iterations <= (rank_deficient ? kLargeRankDeficientIterations : kLargeIterationFraction) * k);
         max_iterations = std::max(max_iterations, report.iterations);
       }
-      std::printf("large k = %d (%s): %d draws, %.1f variables on a bound on average, worst KKT/scale %.3g "
-                  "(limit %.3g), max iterations %d (cap %d, required ≤ %.0f)\n",
-                  k, rank_deficient ? "rank k/2" : "well-conditioned", draws,
-                  static_cast<double>(bound_total) / draws, kkt.value, kKktTol, max_iterations, kLargeCap,
-                  (rank_deficient ? kLargeRankDeficientIterations : kLargeIterationFraction) * k);
+      std::printf(
+          "large k = %d (%s): %d draws, %.1f variables on a bound on average, worst KKT/scale %.3g "
+          "(limit %.3g), max iterations %d (cap %d, required ≤ %.0f)\n",
+          k, rank_deficient ? "rank k/2" : "well-conditioned", draws, static_cast<double>(bound_total) / draws,
+          kkt.value, kKktTol, max_iterations, kLargeCap,
+          (rank_deficient ? kLargeRankDeficientIterations : kLargeIterationFraction) * k);
     }
   }
 }
@@ -902,7 +910,8 @@ TEST_CASE("boxQpActiveSet: k = 40, 80 satisfies the KKT conditions in few iterat
 // was solved. The scale now includes ‖c‖∞/L (L ≥ λ_max(P)), as the projected
 // gradient method's does; the P_jj = 1e-30 case above (a curvature 1e-30 next
 // to O(1) ones) is still unbounded.
-TEST_CASE("boxQpActiveSet: a large but finite minimiser on an infinite bound is not unbounded", "[box_qp][active_set][unbounded]") {
+TEST_CASE("boxQpActiveSet: a large but finite minimiser on an infinite bound is not unbounded",
+          "[box_qp][active_set][unbounded]") {
   const MatrixXd P = MatrixXd::Identity(2, 2);
   VectorXd c(2), lo(2), hi(2);
   c << 1e13, 0.5;
@@ -959,9 +968,12 @@ double bruteForceSlice(const SliceProblem& p, VectorXd& best) {
     std::vector<int> free_set;
     bool finite = true;
     for (int i = 0, c = code; i < n; ++i, c /= 3) {
-      if (c % 3 == 0) mu[i] = p.lo[i];
-      else if (c % 3 == 1) mu[i] = p.hi[i];
-      else free_set.push_back(i);
+      if (c % 3 == 0)
+        mu[i] = p.lo[i];
+      else if (c % 3 == 1)
+        mu[i] = p.hi[i];
+      else
+        free_set.push_back(i);
       if (c % 3 != 2 && !std::isfinite(mu[i])) finite = false;
     }
     if (!finite) continue;
@@ -1009,18 +1021,23 @@ SliceProblem randomSlice(Rng& rng, int n, int r) {
     p.lo[i] = -uniform(rng, 0.0, 2.0);
     p.hi[i] = uniform(rng, 0.0, 2.0);
     const double u = uniform(rng, 0, 1);
-    if (u < 0.1) p.lo[i] = p.hi[i] = 0.0;  // a point box
-    else if (u < 0.2) p.lo[i] = -kInf;      // a limit stop
-    else if (u < 0.3) p.hi[i] = kInf;
+    if (u < 0.1)
+      p.lo[i] = p.hi[i] = 0.0;  // a point box
+    else if (u < 0.2)
+      p.lo[i] = -kInf;  // a limit stop
+    else if (u < 0.3)
+      p.hi[i] = kInf;
     p.x[i] = uniform(rng, std::max(p.lo[i], -3.0), std::min(p.hi[i], 3.0));
-    if (uniform(rng, 0, 1) < 0.2) p.x[i] = uniform(rng, 0, 1) < 0.5 && std::isfinite(p.lo[i]) ? p.lo[i] : std::isfinite(p.hi[i]) ? p.hi[i] : p.x[i];
+    if (uniform(rng, 0, 1) < 0.2)
+      p.x[i] = uniform(rng, 0, 1) < 0.5 && std::isfinite(p.lo[i]) ? p.lo[i] : std::isfinite(p.hi[i]) ? p.hi[i] : p.x[i];
   }
   return p;
 }
 
 }  // namespace
 
-TEST_CASE("least-distance problems on a slice of the box: primal and dual against brute force", "[box_qp][least_distance]") {
+TEST_CASE("least-distance problems on a slice of the box: primal and dual against brute force",
+          "[box_qp][least_distance]") {
   Rng rng(0x736c'6963'6521'0001ULL);
   double worst_primal = 0.0, worst_dual = 0.0, worst_plane = 0.0, worst_agreement = 0.0;
   int draws = 0;
@@ -1077,7 +1094,8 @@ TEST_CASE("least-distance problems on a slice of the box: primal and dual agains
     REQUIRE(agreement <= 1e-8);
     worst_agreement = std::max(worst_agreement, agreement);
   }
-  std::printf("least distance on a slice, %d draws (n ≤ 6, r = 1 and 2..n): objective above brute force / scale²: "
-              "primal %.3g, dual %.3g (limit 1e-10); dual |vᵀμ − b|/scale %.3g; |dual − primal|/scale %.3g\n",
-              draws, worst_primal, worst_dual, worst_plane, worst_agreement);
+  std::printf(
+      "least distance on a slice, %d draws (n ≤ 6, r = 1 and 2..n): objective above brute force / scale²: "
+      "primal %.3g, dual %.3g (limit 1e-10); dual |vᵀμ − b|/scale %.3g; |dual − primal|/scale %.3g\n",
+      draws, worst_primal, worst_dual, worst_plane, worst_agreement);
 }

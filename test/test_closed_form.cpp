@@ -149,10 +149,10 @@ TEST_CASE("prismatic joint under gravity: q̈ = (τ − m g)/(m + d), held with 
   j.type = JointType::Prismatic;
   j.axis = Vec3::UnitZ();
   j.rotor_inertia = d;
-  const Model model = ModelBuilder("lift", "world")
-                          .addJoint(j, "carriage",
-                                    RigidInertia::fromMassComInertia(m, Vec3(0.1, 0.2, 0.3), Mat3::Identity() * 0.1))
-                          .build();
+  const Model model =
+      ModelBuilder("lift", "world")
+          .addJoint(j, "carriage", RigidInertia::fromMassComInertia(m, Vec3(0.1, 0.2, 0.3), Mat3::Identity() * 0.1))
+          .build();
   Task task(model);
   Workspace ws(model, 6);
   REQUIRE(solveHybridDynamics(model, task, vec({0.2}), vec({1.0}), vec({40.0}), ws));

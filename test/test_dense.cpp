@@ -63,10 +63,11 @@ TEST_CASE("hybrid dynamics matches the dense KKT solution on 500+ random chains"
     REQUIRE(solveHybridDynamics(model, free_task, in.q, in.qd, tau_control, ws));
     closure_err.add(relativeError(ws.solution.qdd, qdd));
   }
-  std::printf("dense reference, %d chains (%d constrained, %d on 2-3 frames, %d draws skipped as ill-conditioned):\n"
-              "  max rel. error  qdd %.2e  nu %.2e  tau_c %.2e  Z %.2e  frame acc %.2e  closure %.2e\n",
-              accepted, constrained, multi_frame, attempts - accepted, qdd_err.value, nu_err.value, tauc_err.value,
-              gauss_err.value, acc_err.value, closure_err.value);
+  std::printf(
+      "dense reference, %d chains (%d constrained, %d on 2-3 frames, %d draws skipped as ill-conditioned):\n"
+      "  max rel. error  qdd %.2e  nu %.2e  tau_c %.2e  Z %.2e  frame acc %.2e  closure %.2e\n",
+      accepted, constrained, multi_frame, attempts - accepted, qdd_err.value, nu_err.value, tauc_err.value,
+      gauss_err.value, acc_err.value, closure_err.value);
   CHECK(constrained > 300);
   CHECK(multi_frame > 100);
   CHECK(qdd_err.value < 1e-9);
@@ -107,8 +108,9 @@ TEST_CASE("RNEA, CRBA, Jacobians and poses match the dense reference") {
       pose_err.add((T.matrix() - kin.poses[l].matrix()).cwiseAbs().maxCoeff());
     }
   }
-  std::printf("dense reference, 200 chains: max rel. error RNEA %.2e  CRBA %.2e; max abs. error Jacobian %.2e  pose %.2e\n",
-              rnea_err.value, crba_err.value, jac_err.value, pose_err.value);
+  std::printf(
+      "dense reference, 200 chains: max rel. error RNEA %.2e  CRBA %.2e; max abs. error Jacobian %.2e  pose %.2e\n",
+      rnea_err.value, crba_err.value, jac_err.value, pose_err.value);
   CHECK(rnea_err.value < 1e-10);
   CHECK(crba_err.value < 1e-10);
   CHECK(jac_err.value < 1e-10);

@@ -166,8 +166,8 @@ TEST_CASE("bit-identical outputs across runs (the test runs itself again as a ch
   const std::uint64_t here = hashOfEverything();
   CHECK(here == hashOfEverything());  // and twice in this process
   // The child runs only the hidden "[child]" test case below, which prints its hash.
-  const std::string command = "ZWANG_DETERMINISM_CHILD=1 /proc/" + std::to_string(static_cast<long>(getpid())) +
-                              "/exe \"[child]\" 2>&1";
+  const std::string command =
+      "ZWANG_DETERMINISM_CHILD=1 /proc/" + std::to_string(static_cast<long>(getpid())) + "/exe \"[child]\" 2>&1";
   std::FILE* pipe = popen(command.c_str(), "r");
   REQUIRE(pipe != nullptr);
   std::string output;
@@ -180,9 +180,10 @@ TEST_CASE("bit-identical outputs across runs (the test runs itself again as a ch
   REQUIRE(at != std::string::npos);
   const std::uint64_t child = std::strtoull(output.c_str() + at + std::strlen("determinism hash "), nullptr, 16);
   CHECK(child == here);
-  std::printf("determinism: 61 problems x (hybrid, friction x2, RNEA, CRBA, Jacobian): hash %016llx here and in a child"
-              " process\n",
-              static_cast<unsigned long long>(here));
+  std::printf(
+      "determinism: 61 problems x (hybrid, friction x2, RNEA, CRBA, Jacobian): hash %016llx here and in a child"
+      " process\n",
+      static_cast<unsigned long long>(here));
 }
 
 TEST_CASE("determinism child: prints the hash of every output", "[.][child]") {

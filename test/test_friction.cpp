@@ -3,9 +3,9 @@
 // force over all stick/slip patterns and the report's grid sampling) and the
 // closed forms of docs/theory.md, "The reference cases". Every friction solve is checked with
 // checkMaximumDissipation (support/friction_check) and the closure property.
-#include <catch2/catch.hpp>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -22,7 +22,9 @@ using namespace zwang::testing;
 
 namespace {
 
-const char* methodName(FrictionMethod m) { return m == FrictionMethod::ActiveSet ? "active set" : "projected gradient"; }
+const char* methodName(FrictionMethod m) {
+  return m == FrictionMethod::ActiveSet ? "active set" : "projected gradient";
+}
 
 // One friction solve, checked: status as expected, maximum dissipation, closure.
 struct Solved {
@@ -42,19 +44,20 @@ Solved solveChecked(const Model& model, const Task& task, const Eigen::VectorXd&
   s.friction = ws.friction;
   s.solution = ws.solution;
   if (s.status.ok()) {
-    s.violation = checkMaximumDissipation(ws.friction, ws.solution, expectFriction(model, q, qd, tau, options), tolerances);
+    s.violation =
+        checkMaximumDissipation(ws.friction, ws.solution, expectFriction(model, q, qd, tau, options), tolerances);
     s.closure = frictionClosureError(model, task, q, qd, ws.friction, ws.solution);
   }
   return s;
 }
 
-#define REQUIRE_SOLVED(s)                                  \
-  do {                                                     \
-    INFO("status message: " << (s).status.message);        \
-    REQUIRE((s).status.ok());                              \
-    INFO("maximum dissipation: " << (s).violation);        \
-    CHECK((s).violation.empty());                          \
-    CHECK((s).closure < 1e-9);                             \
+#define REQUIRE_SOLVED(s)                           \
+  do {                                              \
+    INFO("status message: " << (s).status.message); \
+    REQUIRE((s).status.ok());                       \
+    INFO("maximum dissipation: " << (s).violation); \
+    CHECK((s).violation.empty());                   \
+    CHECK((s).closure < 1e-9);                      \
   } while (false)
 
 Model oneDofArmModel() { return loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf"); }
@@ -187,14 +190,15 @@ TEST_CASE("friction matches the brute-force enumeration of stick/slip patterns (
     kkt_max = std::max(kkt_max, s.friction.kkt_residual);
     closure_max = std::max(closure_max, s.closure);
   }
-  std::printf("friction vs brute force, %d random chains (%d ill-posed draws skipped, %d with per-solve overrides;"
-              " k = 1..5 stuck: %d %d %d %d %d):\n"
-              "  max rel. error qdd %.2e, g(mu*) %.2e, mu %.2e (%d with unique mu*), closure %.2e\n"
-              "  joint states: moving %d, stick %d, slip+ %d, slip- %d, at-limit %d\n"
-              "  maximiser iterations median %.1f, max %d; max KKT residual %.2e\n",
-              accepted, ill_posed, overridden, by_k[1], by_k[2], by_k[3], by_k[4], by_k[5], qdd_err, g_err, mu_err,
-              mu_compared, closure_max, states[0], states[1], states[2], states[3], states[4], median(iterations),
-              *std::max_element(iterations.begin(), iterations.end()), kkt_max);
+  std::printf(
+      "friction vs brute force, %d random chains (%d ill-posed draws skipped, %d with per-solve overrides;"
+      " k = 1..5 stuck: %d %d %d %d %d):\n"
+      "  max rel. error qdd %.2e, g(mu*) %.2e, mu %.2e (%d with unique mu*), closure %.2e\n"
+      "  joint states: moving %d, stick %d, slip+ %d, slip- %d, at-limit %d\n"
+      "  maximiser iterations median %.1f, max %d; max KKT residual %.2e\n",
+      accepted, ill_posed, overridden, by_k[1], by_k[2], by_k[3], by_k[4], by_k[5], qdd_err, g_err, mu_err, mu_compared,
+      closure_max, states[0], states[1], states[2], states[3], states[4], median(iterations),
+      *std::max_element(iterations.begin(), iterations.end()), kkt_max);
   CHECK(states[1] > 50);  // both sticking and slipping joints are exercised
   CHECK(states[2] + states[3] > 50);
 }
@@ -244,16 +248,18 @@ TEST_CASE("the report's sampling method agrees within the grid resolution (k = 1
       // maximiser lies within sqrt(2 gap / λ_min) (k = 1 and interior: h/2).
       if (ev(0) > 1e-6 * std::max(1e-12, ev(k - 1))) {
         ++mu_checked;
-        const double radius = std::sqrt(2.0 * std::max(gap, 0.0) / ev(0)) + 1e-7 * std::max(1.0, mu_z.cwiseAbs().maxCoeff());
+        const double radius =
+            std::sqrt(2.0 * std::max(gap, 0.0) / ev(0)) + 1e-7 * std::max(1.0, mu_z.cwiseAbs().maxCoeff());
         const double dist = (mu_g - mu_z).norm();
         CHECK(dist <= radius);
         if (k == 1) CHECK(dist <= 0.5 * h * (1.0 + 1e-6) + 1e-9);
         worst_mu = std::max(worst_mu, h > 0.0 ? dist / h : 0.0);
       }
     }
-    std::printf("grid sampling, k = %d: %d problems (%d draws skipped), gap/bound max %.2f, |mu_grid - mu*|/h max %.2f"
-                " (%d compared)\n",
-                k, accepted, attempts - accepted, worst_gap, worst_mu, mu_checked);
+    std::printf(
+        "grid sampling, k = %d: %d problems (%d draws skipped), gap/bound max %.2f, |mu_grid - mu*|/h max %.2f"
+        " (%d compared)\n",
+        k, accepted, attempts - accepted, worst_gap, worst_mu, mu_checked);
   }
 }
 
@@ -298,13 +304,15 @@ TEST_CASE("dqdd/dmu from the sweeps matches finite differences; K_ThTh is symmet
     const double as = (Ktt - Ktt.transpose()).cwiseAbs().maxCoeff() / scale;
     CHECK(as < 1e-9);
     asym = std::max(asym, as);
-    const double lo = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(0.5 * (Ktt + Ktt.transpose())).eigenvalues()(0) / scale;
+    const double lo =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(0.5 * (Ktt + Ktt.transpose())).eigenvalues()(0) / scale;
     CHECK(lo > -1e-9);
     min_eig = std::min(min_eig, lo);
   }
-  std::printf("dqdd/dmu on %d random problems (%d skipped): max rel. error vs central differences %.1e, vs dense K %.1e;"
-              " K_ThTh asymmetry %.1e, smallest eigenvalue %.1e\n",
-              accepted, attempts - accepted, fd_err, dense_err, asym, min_eig);
+  std::printf(
+      "dqdd/dmu on %d random problems (%d skipped): max rel. error vs central differences %.1e, vs dense K %.1e;"
+      " K_ThTh asymmetry %.1e, smallest eigenvalue %.1e\n",
+      accepted, attempts - accepted, fd_err, dense_err, asym, min_eig);
   CHECK(dense_err < 1e-8);
 }
 
@@ -338,17 +346,18 @@ TEST_CASE("active-set and projected-gradient maximisers give the same motion") {
     it_as.push_back(a.friction.iterations);
     it_pg.push_back(p.friction.iterations);
   }
-  std::printf("active set vs projected gradient on %d problems: max rel. difference qdd %.1e, g %.1e;"
-              " iterations median/max: active set %.1f/%d, projected gradient %.1f/%d\n",
-              accepted, qdd_diff, g_diff, median(it_as), *std::max_element(it_as.begin(), it_as.end()), median(it_pg),
-              *std::max_element(it_pg.begin(), it_pg.end()));
+  std::printf(
+      "active set vs projected gradient on %d problems: max rel. difference qdd %.1e, g %.1e;"
+      " iterations median/max: active set %.1f/%d, projected gradient %.1f/%d\n",
+      accepted, qdd_diff, g_diff, median(it_as), *std::max_element(it_as.begin(), it_as.end()), median(it_pg),
+      *std::max_element(it_pg.begin(), it_pg.end()));
   CHECK(g_diff < 1e-8);
 }
 
 TEST_CASE("indeterminate hold-still on the Panda: friction carries load, effort drops") {
   const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
   REQUIRE(model.dof() == 7);
-  Task task(model);  // default gravity
+  Task task(model);                                                                 // default gravity
   task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::Local);  // tool0 held still
   task.addConstraint("panda_link1", angularZ(), Expressed::Local);                  // and the elbow's self-motion
   const double pi = 3.14159265358979323846;
@@ -385,8 +394,10 @@ TEST_CASE("indeterminate hold-still on the Panda: friction carries load, effort 
         CHECK(std::abs(s.solution.tau_control(j)) == Approx(expected).margin(1e-8));
         if (expected > 1e-6) CHECK(s.solution.tau_control(j) * G(j) > 0.0);
       }
-      if (margin > 0.0) CHECK(s.solution.tau_control.norm() < G.norm() - 1e-3);
-      else CHECK(s.solution.tau_control.norm() == Approx(G.norm()).epsilon(1e-9));
+      if (margin > 0.0)
+        CHECK(s.solution.tau_control.norm() < G.norm() - 1e-3);
+      else
+        CHECK(s.solution.tau_control.norm() == Approx(G.norm()).epsilon(1e-9));
       std::printf("panda hold-still, margin %.1f: |tau_ctrl| %.3f N·m without friction, %.3f with\n", margin, G.norm(),
                   s.solution.tau_control.norm());
     }

@@ -64,13 +64,13 @@ Case solveArm(const LimitedArm& arm, const Task& task, double q0, double qd0, co
   return c;
 }
 
-#define REQUIRE_SOLVED(c)                                 \
-  do {                                                    \
-    INFO("status message: " << (c).status.message);       \
-    REQUIRE((c).status.ok());                             \
-    INFO("maximum dissipation: " << (c).violation);       \
-    CHECK((c).violation.empty());                         \
-    CHECK((c).closure < 1e-9);                            \
+#define REQUIRE_SOLVED(c)                           \
+  do {                                              \
+    INFO("status message: " << (c).status.message); \
+    REQUIRE((c).status.ok());                       \
+    INFO("maximum dissipation: " << (c).violation); \
+    CHECK((c).violation.empty());                   \
+    CHECK((c).closure < 1e-9);                      \
   } while (false)
 
 }  // namespace
@@ -255,8 +255,9 @@ TEST_CASE("limits on random chains match the brute force with one-sided bounds")
     g_err = std::max(g_err, e_g);
     for (JointState s : ws.friction.state) at_limit_states += s == JointState::AtLimit;
   }
-  std::printf("limits vs brute force, %d random chains (%d draws skipped; %d stuck joints on a limit, %d AtLimit, "
-              "%d infeasible): max rel. error qdd %.2e, g %.2e\n",
-              accepted, attempts - accepted, on_limit, at_limit_states, infeasible, qdd_err, g_err);
+  std::printf(
+      "limits vs brute force, %d random chains (%d draws skipped; %d stuck joints on a limit, %d AtLimit, "
+      "%d infeasible): max rel. error qdd %.2e, g %.2e\n",
+      accepted, attempts - accepted, on_limit, at_limit_states, infeasible, qdd_err, g_err);
   CHECK(at_limit_states > 10);
 }

@@ -184,10 +184,11 @@ TEST_CASE("brute force maximises g; the grid sampling agrees (random chains)") {
       max_grid_gap = std::max(max_grid_gap, bound > 0 ? gap / bound : 0.0);
     }
   }
-  std::printf("friction references: %d random problems (%d ill-posed draws skipped), %d sampled on a grid\n"
-              "  spread among valid patterns %.1e, g vs dense solve %.1e, qdd vs dense solve %.1e,\n"
-              "  max excess of g at random box points %.1e, grid gap / bound %.2f\n",
-              accepted, ill_posed, sampled, max_spread, max_dual_err, max_qdd_err, max_excess, max_grid_gap);
+  std::printf(
+      "friction references: %d random problems (%d ill-posed draws skipped), %d sampled on a grid\n"
+      "  spread among valid patterns %.1e, g vs dense solve %.1e, qdd vs dense solve %.1e,\n"
+      "  max excess of g at random box points %.1e, grid gap / bound %.2f\n",
+      accepted, ill_posed, sampled, max_spread, max_dual_err, max_qdd_err, max_excess, max_grid_gap);
   CHECK(max_spread < 1e-9);
   CHECK(max_dual_err < 1e-10);
   CHECK(max_qdd_err < 1e-10);

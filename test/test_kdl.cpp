@@ -57,9 +57,10 @@ TEST_CASE("hybrid dynamics matches KDL's Vereshchagin solver on 200+ random chai
       kdl_torque_replay_miss = std::max(kdl_torque_replay_miss, (ws.solution.qdd - kdl.qdd).cwiseAbs().maxCoeff());
     }
   }
-  std::printf("KDL Vereshchagin, %d chains (%d with 1-6 end-effector rows): max rel. error qdd %.2e  nu %.2e  "
-              "tau_c %.2e\n  replaying tau + KDL's constraint_torques misses KDL's own qdd by up to %.3g rad/s^2\n",
-              accepted, constrained, qdd_err, nu_err, tauc_err, kdl_torque_replay_miss);
+  std::printf(
+      "KDL Vereshchagin, %d chains (%d with 1-6 end-effector rows): max rel. error qdd %.2e  nu %.2e  "
+      "tau_c %.2e\n  replaying tau + KDL's constraint_torques misses KDL's own qdd by up to %.3g rad/s^2\n",
+      accepted, constrained, qdd_err, nu_err, tauc_err, kdl_torque_replay_miss);
   CHECK(constrained >= 150);
   CHECK(qdd_err < 1e-9);
   CHECK(nu_err < 1e-9);
@@ -73,7 +74,8 @@ TEST_CASE("RNEA matches KDL's ChainIdSolver_RNE, fixed joints included") {
   for (int trial = 0; trial < 200; ++trial) {
     RandomInverseDynamics c(rng);
     REQUIRE(c.solve());
-    err = std::max(err, relativeError(c.ws.tau, kdlInverseDynamics(c.spec, c.in.q, c.in.qd, c.qdd, c.in.gravity, c.in.wrenches)));
+    err = std::max(
+        err, relativeError(c.ws.tau, kdlInverseDynamics(c.spec, c.in.q, c.in.qd, c.qdd, c.in.gravity, c.in.wrenches)));
   }
   std::printf("KDL RNE, 200 chains: max rel. error %.2e\n", err);
   CHECK(err < 1e-9);

@@ -7,13 +7,13 @@
 #include <random>
 #include <string>
 
-#include <catch2/catch.hpp>
+#include <tinyxml.h>
+#include <urdf_parser/urdf_parser.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <catch2/catch.hpp>
 #include <kdl/chainhdsolver_vereshchagin.hpp>
-#include <tinyxml.h>
-#include <urdf_parser/urdf_parser.h>
 
 #include "support/chain_spec.hpp"
 #include "support/dense_reference.hpp"
@@ -48,12 +48,13 @@ DynamicsInput randomInput(std::mt19937_64& rng, const ChainSpec& spec) {
   in.q = randomVector(rng, n, 2.0);
   in.qd = randomVector(rng, n, 1.5);
   in.tau = randomVector(rng, n, 10.0);
-  in.gravity = uniform01(rng) < 0.7 ? Eigen::Vector3d(0.0, 0.0, -kGravity) : Eigen::Vector3d(kGravity * randomUnitVector(rng));
+  in.gravity =
+      uniform01(rng) < 0.7 ? Eigen::Vector3d(0.0, 0.0, -kGravity) : Eigen::Vector3d(kGravity * randomUnitVector(rng));
   const int wrenches = uniformInt(rng, 0, 3);
   for (int k = 0; k < wrenches; ++k) {
     const std::size_t link = static_cast<std::size_t>(uniformInt(rng, 0, static_cast<int>(spec.links.size()) - 1));
-    in.wrenches.push_back({spec.links[link].name, Vector6d(randomVector(rng, 6, 5.0)),
-                           uniform01(rng) < 0.5 ? Axes::Local : Axes::World});
+    in.wrenches.push_back(
+        {spec.links[link].name, Vector6d(randomVector(rng, 6, 5.0)), uniform01(rng) < 0.5 ? Axes::Local : Axes::World});
   }
   return in;
 }
@@ -237,22 +238,24 @@ TEST_CASE("toUrdf: urdfdom reads back every field exactly", "[references][urdf]"
     REQUIRE(robot);
     CHECK(std::string(robot->Attribute("xmlns:drake")) == "http://drake.mit.edu");
     int transmissions = 0;
-    for (const TiXmlElement* t = robot->FirstChildElement("transmission"); t; t = t->NextSiblingElement("transmission")) {
+    for (const TiXmlElement* t = robot->FirstChildElement("transmission"); t;
+         t = t->NextSiblingElement("transmission")) {
       ++transmissions;
       const std::string joint_name = t->FirstChildElement("joint")->Attribute("name");
-      const JointSpec& joint =
-          *std::find_if(spec.joints.begin(), spec.joints.end(), [&](const JointSpec& j) { return j.name == joint_name; });
+      const JointSpec& joint = *std::find_if(spec.joints.begin(), spec.joints.end(),
+                                             [&](const JointSpec& j) { return j.name == joint_name; });
       const TiXmlElement* actuator = t->FirstChildElement("actuator");
       REQUIRE(actuator);
       double rotor = 0.0, ratio = 0.0;
-      REQUIRE(actuator->FirstChildElement("drake:rotor_inertia")->QueryDoubleAttribute("value", &rotor) == TIXML_SUCCESS);
+      REQUIRE(actuator->FirstChildElement("drake:rotor_inertia")->QueryDoubleAttribute("value", &rotor) ==
+              TIXML_SUCCESS);
       REQUIRE(actuator->FirstChildElement("drake:gear_ratio")->QueryDoubleAttribute("value", &ratio) == TIXML_SUCCESS);
       CHECK(rotor == joint.rotor_inertia);
       CHECK(ratio == joint.gear_ratio);
     }
-    CHECK(transmissions == static_cast<int>(std::count_if(spec.joints.begin(), spec.joints.end(), [](const JointSpec& j) {
-            return !j.isFixed() && j.rotor_inertia > 0.0;
-          })));
+    CHECK(transmissions ==
+          static_cast<int>(std::count_if(spec.joints.begin(), spec.joints.end(),
+                                         [](const JointSpec& j) { return !j.isFixed() && j.rotor_inertia > 0.0; })));
   }
 }
 
@@ -369,8 +372,7 @@ TEST_CASE("dense reference: pendulum and vertical slider under gravity", "[refer
     spec.joints[0].rotor_inertia = 0.01;
     spec.joints[0].gear_ratio = 5.0;
     const Eigen::Vector3d u = rpyToMatrix(spec.joints[0].rpy) * spec.joints[0].axis;
-    CHECK(denseDynamics(spec, in).qdd(0) ==
-          Approx((tau + m * in.gravity.dot(u)) / (m + 0.25)).epsilon(1e-14));
+    CHECK(denseDynamics(spec, in).qdd(0) == Approx((tau + m * in.gravity.dot(u)) / (m + 0.25)).epsilon(1e-14));
 
     // Vertical again, held by a vertical unit force at the carriage: p̈_z = 0.
     spec.joints[0].rpy.setZero();
@@ -400,7 +402,8 @@ TEST_CASE("dense reference: forward kinematics agrees with KDL's", "[references]
     const auto dense = poses(spec, q);
     const auto kdl = kdlLinkPoses(spec, q);
     REQUIRE(dense.size() == kdl.size());
-    for (std::size_t i = 0; i < dense.size(); ++i) worst = std::max(worst, (dense[i].matrix() - kdl[i].matrix()).norm());
+    for (std::size_t i = 0; i < dense.size(); ++i)
+      worst = std::max(worst, (dense[i].matrix() - kdl[i].matrix()).norm());
   }
   INFO("max pose difference " << worst);
   CHECK(worst < 1e-13);
@@ -432,8 +435,9 @@ TEST_CASE("dense reference: KKT solution, symmetry, constraint rows, Gauss", "[r
     int row = 0;
     for (const ConstraintInput& c : in.constraints) {
       const int link = spec.linkIndex(c.link);
-      const Eigen::Matrix3d R = c.axes == Axes::Local ? Eigen::Matrix3d(r.poses[static_cast<std::size_t>(link)].linear())
-                                                      : Eigen::Matrix3d::Identity();
+      const Eigen::Matrix3d R = c.axes == Axes::Local
+                                    ? Eigen::Matrix3d(r.poses[static_cast<std::size_t>(link)].linear())
+                                    : Eigen::Matrix3d::Identity();
       Matrix6Xd A_world(6, c.A.cols());
       A_world << R * c.A.topRows<3>(), R * c.A.bottomRows<3>();
       tau_c += linkJacobian(spec, in.q, c.link, Axes::World).transpose() * A_world * r.nu.segment(row, c.A.cols());
@@ -466,7 +470,8 @@ TEST_CASE("dense reference: Jacobians and J̇q̇ against finite differences", "[
   for (int trial = 0; trial < 40; ++trial) {
     const ChainSpec spec = randomChain(rng, {});
     const int n = spec.dof();
-    const Eigen::VectorXd q = randomVector(rng, n, 2.0), qd = randomVector(rng, n, 1.5), qdd = randomVector(rng, n, 3.0);
+    const Eigen::VectorXd q = randomVector(rng, n, 2.0), qd = randomVector(rng, n, 1.5),
+                          qdd = randomVector(rng, n, 3.0);
     const DenseKinematics kin = denseKinematics(spec, q, qd);
     const DenseKinematics plus = denseKinematics(spec, q + h * qd, qd), minus = denseKinematics(spec, q - h * qd, qd);
     for (std::size_t i = 0; i < spec.links.size(); ++i) {
@@ -562,7 +567,8 @@ TEST_CASE("dense reference: H and C from Lagrange's equations by finite differen
       G_fd(k) = (V_plus - V_minus) / (2.0 * h);
       for (const WrenchInput& w : in.wrenches) {
         const auto i = static_cast<std::size_t>(spec.linkIndex(w.link));
-        const Eigen::Matrix3d R = w.axes == Axes::Local ? Eigen::Matrix3d(here[i].linear()) : Eigen::Matrix3d::Identity();
+        const Eigen::Matrix3d R =
+            w.axes == Axes::Local ? Eigen::Matrix3d(here[i].linear()) : Eigen::Matrix3d::Identity();
         const Eigen::Vector3d dp = (plus[i].translation() - minus[i].translation()) / (2.0 * h);
         const Eigen::Vector3d dtheta = rotationVector(plus[i].linear() * minus[i].linear().transpose()) / (2.0 * h);
         Q_fd(k) += (R * w.wrench.head<3>()).dot(dp) + (R * w.wrench.tail<3>()).dot(dtheta);
@@ -731,7 +737,8 @@ TEST_CASE("KDL conventions: the sign of ν and what constraint_torques are", "[r
       const int f = n - 1 - j;
       articulated(j) = physical(j);
       if (f > 0)
-        articulated(j) -= dense.H.row(j).segment(j + 1, f).dot(dense.H.block(j + 1, j + 1, f, f).ldlt().solve(physical.tail(f)));
+        articulated(j) -=
+            dense.H.row(j).segment(j + 1, f).dot(dense.H.block(j + 1, j + 1, f, f).ldlt().solve(physical.tail(f)));
     }
     worst_articulated = std::max(worst_articulated, relErr(kdl.constraint_torques_kdl, articulated));
 
@@ -822,7 +829,8 @@ TEST_CASE("mergeFixedJoints keeps the dynamics (dense and KDL)", "[references][k
     in.wrenches.clear();
     for (const LinkSpec& link : merged.links)  // wrenches on surviving links only
       if (uniform01(rng) < 0.3)
-        in.wrenches.push_back({link.name, Vector6d(randomVector(rng, 6, 5.0)), uniform01(rng) < 0.5 ? Axes::Local : Axes::World});
+        in.wrenches.push_back(
+            {link.name, Vector6d(randomVector(rng, 6, 5.0)), uniform01(rng) < 0.5 ? Axes::Local : Axes::World});
     const int m = uniformInt(rng, 0, std::min(6, spec.dof()));
     if (m > 0) in.constraints.push_back(randomConstraint(rng, spec.links.back().name, m));
     const DenseResult a = denseDynamics(spec, in);

@@ -293,7 +293,7 @@ void checkAgainstPseudoInverse(const ChainSpec& spec, const DynamicsInput& in, b
   const double d_qdd = relativeDifference(s.qdd, best.qdd), d_nu = relativeDifference(s.nu, best.nu);
   const double d_residual = std::abs(s.balance.residual - best.residual) / scale;
   INFO("q̈ " << d_qdd << ", ν " << d_nu << ", residual ours " << s.balance.residual << " dense " << best.residual
-             << ", rank ours " << s.balance.rank << " dense " << best.rank << ", condition " << s.balance.condition);
+            << ", rank ours " << s.balance.rank << " dense " << best.rank << ", condition " << s.balance.condition);
   CHECK(d_qdd <= tolerance);
   CHECK(d_nu <= tolerance);
   CHECK(d_residual <= tolerance);
@@ -322,7 +322,7 @@ ChainSpec sixJointArm(std::mt19937_64& rng, bool seven) {
   ChainSpec spec;
   spec.name = seven ? "seven_joint_arm" : "six_joint_arm";
   std::vector<std::pair<Eigen::Vector3d, double>> axes_offsets = {
-      {Eigen::Vector3d::UnitZ(), 0.3}, {Eigen::Vector3d::UnitY(), 0.0}, {Eigen::Vector3d::UnitY(), 0.4},
+      {Eigen::Vector3d::UnitZ(), 0.3},  {Eigen::Vector3d::UnitY(), 0.0}, {Eigen::Vector3d::UnitY(), 0.4},
       {Eigen::Vector3d::UnitZ(), 0.35}, {Eigen::Vector3d::UnitY(), 0.1}, {Eigen::Vector3d::UnitZ(), 0.1}};
   if (seven) axes_offsets.insert(axes_offsets.begin() + 2, {Eigen::Vector3d::UnitZ(), 0.2});
   spec.links.push_back(LinkSpec{"base", 0.0, {}, {}, Eigen::Matrix3d::Zero()});
@@ -377,8 +377,8 @@ TEST_CASE("six rows on a 1–5 joint chain: consistent tasks met exactly, incons
     checkAgainstPseudoInverse(spec, in, consistent, consistent ? 1e-10 : 1e-9, worst);
   }
   WARN("1-5 joint chains, 6 rows: " << worst.tested << " solves (" << worst.consistent << " consistent, "
-                                    << worst.inconsistent << " inconsistent); worst relative difference q̈ "
-                                    << worst.qdd << ", ν " << worst.nu << ", residual " << worst.residual
+                                    << worst.inconsistent << " inconsistent); worst relative difference q̈ " << worst.qdd
+                                    << ", ν " << worst.nu << ", residual " << worst.residual
                                     << "; consistent tasks met to " << worst.met);
   CHECK(worst.tested == 320);
   CHECK(worst.consistent == 240);
@@ -565,7 +565,8 @@ TEST_CASE("balance options out of range: clear errors") {
       {[](BalanceOptions& o) { o.singular_threshold = 1.0; }, "singular_threshold 1 must be in (0, 1)"},
       {[nan](BalanceOptions& o) { o.singular_threshold = nan; }, "singular_threshold nan must be in (0, 1)"},
       {[](BalanceOptions& o) { o.rank_tolerance = -1e-12; }, "rank_tolerance -1e-12 must be in [0, singular_threshold"},
-      {[](BalanceOptions& o) { o.rank_tolerance = 1e-6; }, "rank_tolerance 1e-06 must be in [0, singular_threshold = 1e-06)"},
+      {[](BalanceOptions& o) { o.rank_tolerance = 1e-6; },
+       "rank_tolerance 1e-06 must be in [0, singular_threshold = 1e-06)"},
       {[](BalanceOptions& o) { o.residual_tolerance = 0.0; }, "residual_tolerance 0 must be finite and positive"},
       {[](BalanceOptions& o) { o.residual_tolerance = std::numeric_limits<double>::infinity(); },
        "residual_tolerance inf must be finite and positive"},

@@ -130,7 +130,8 @@ DynamicsInput extremeProblem(std::mt19937_64& rng, const ChainSpec& spec, TaskKi
   // `stuck` joints exactly at rest, chosen at random.
   std::vector<int> order(static_cast<std::size_t>(n));
   for (int j = 0; j < n; ++j) order[static_cast<std::size_t>(j)] = j;
-  for (int j = n - 1; j > 0; --j) std::swap(order[static_cast<std::size_t>(j)], order[static_cast<std::size_t>(uniformInt(rng, 0, j))]);
+  for (int j = n - 1; j > 0; --j)
+    std::swap(order[static_cast<std::size_t>(j)], order[static_cast<std::size_t>(uniformInt(rng, 0, j))]);
   for (int s = 0; s < stuck; ++s) in.qd[order[static_cast<std::size_t>(s)]] = 0.0;
 
   const std::string& tip = spec.links.back().name;
@@ -182,7 +183,7 @@ struct Worst {
   int stuck_joints_max = 0, stuck_hist[9] = {};
   int active_iterations_max = 0, gradient_iterations_max = 0, gradient_not_converged = 0;
   int stick = 0, slip = 0;
-  int constraint_failures = 0;  // regular tasks beyond kConstraintTolerance
+  int constraint_failures = 0;         // regular tasks beyond kConstraintTolerance
   int singular_residual_failures = 0;  // closure or tau_c beyond tolerance (singular tasks only in the default run)
   int dissipation_violations = 0, disagreements = 0, active_not_converged = 0, feasibility_violations = 0;
 };
@@ -207,7 +208,8 @@ Residuals residuals(const Model& model, const Task& task, const DynamicsInput& i
   r.closure = ratio(inf(Eigen::VectorXd(id - s.tau_control - tau_friction)),
                     inf(H) * inf(s.qdd) + inf(C) + inf(s.tau_control) + inf(tau_friction) + constraint_forces);
   if (task.constraintRows() > 0) {
-    r.constraint = ratio(inf(Eigen::VectorXd(dense.G * s.qdd - dense.gamma)), inf(dense.G) * inf(s.qdd) + inf(dense.gamma));
+    r.constraint =
+        ratio(inf(Eigen::VectorXd(dense.G * s.qdd - dense.gamma)), inf(dense.G) * inf(s.qdd) + inf(dense.gamma));
     const Eigen::MatrixXd Gt = dense.G.transpose();
     r.tau_c = ratio(inf(Eigen::VectorXd(s.tau_constraint - Gt * s.nu)), inf(Gt) * inf(s.nu) + inf(s.tau_constraint));
   }
@@ -236,8 +238,8 @@ void runStress() {
   std::printf("numerical stress: seed %llu\n", seed);
   std::mt19937_64 rng(seed);
   Worst worst;
-  const TaskKind kinds[] = {TaskKind::Random, TaskKind::Random, TaskKind::NearSingular, TaskKind::RepeatedRow,
-                            TaskKind::OnBase, TaskKind::OverConstrained};
+  const TaskKind kinds[] = {TaskKind::Random,      TaskKind::Random, TaskKind::NearSingular,
+                            TaskKind::RepeatedRow, TaskKind::OnBase, TaskKind::OverConstrained};
   const int chains = 150;
   for (int c = 0; c < chains; ++c) {
     const ChainSpec spec = extremeChain(rng, 7);
@@ -333,7 +335,8 @@ void runStress() {
         for (const int j : fr.stuck) {
           char line[200];
           std::snprintf(line, sizeof line, "\n  joint %d: f %.6g mu %.17g qdd %.6g qdd(0) %.6g state %s", j,
-                        model.joint(j).breakaway_friction, fr.mu[j], qdd[j], qdd0[j], toString(fr.state[static_cast<std::size_t>(j)]));
+                        model.joint(j).breakaway_friction, fr.mu[j], qdd[j], qdd0[j],
+                        toString(fr.state[static_cast<std::size_t>(j)]));
           detail += line;
         }
         INFO("stuck joints (scale " << scale << ", iterations " << fr.iterations << ", kkt " << fr.kkt_residual
@@ -370,15 +373,16 @@ void runStress() {
       "  draws per stuck-set size 0..7:",
       worst.draws, chains, worst.solves, worst.singular, worst.regular_constrained, worst.degenerate, worst.closure,
       kClosureTolerance, worst.constraint, kConstraintTolerance, worst.tau_c, kTauConstraintTolerance,
-      worst.closure_singular, worst.dissipation,
-      kDissipationTolerance, kSingularDissipationTolerance, worst.feasibility, worst.agreement, kAgreementTolerance,
-      kSingularAgreementTolerance, worst.active_iterations_max,
+      worst.closure_singular, worst.dissipation, kDissipationTolerance, kSingularDissipationTolerance,
+      worst.feasibility, worst.agreement, kAgreementTolerance, kSingularAgreementTolerance, worst.active_iterations_max,
       worst.gradient_iterations_max, worst.gradient_not_converged, worst.stick, worst.slip);
   for (int k = 0; k <= 7; ++k) std::printf(" %d", worst.stuck_hist[k]);
-  std::printf("\n  beyond tolerance: %d solves of singular tasks miss closure or tau_c = G^T nu (asserted);"
-              " %d solves of regular tasks miss the constraint tolerance, %d friction solves violate maximum dissipation,"
-              " %d |mu| > f, %d active-set runs not converged, %d maximiser disagreements\n",
-              worst.singular_residual_failures, worst.constraint_failures, worst.dissipation_violations, worst.feasibility_violations, worst.active_not_converged, worst.disagreements);
+  std::printf(
+      "\n  beyond tolerance: %d solves of singular tasks miss closure or tau_c = G^T nu (asserted);"
+      " %d solves of regular tasks miss the constraint tolerance, %d friction solves violate maximum dissipation,"
+      " %d |mu| > f, %d active-set runs not converged, %d maximiser disagreements\n",
+      worst.singular_residual_failures, worst.constraint_failures, worst.dissipation_violations,
+      worst.feasibility_violations, worst.active_not_converged, worst.disagreements);
   CHECK(worst.regular_constrained > 50);  // the checks above did run on constrained tasks
   CHECK(worst.singular > 50);
   CHECK(worst.stick > 50);
@@ -426,13 +430,13 @@ Model heavyLightArm(double breakaway) {
   j.name = "light";
   j.placement = Transform::translation(Vec3(1, 0, 0));
   j.breakaway_friction = j.kinetic_friction = 0.0;
-  builder.addJoint(j, "link2",
-                   RigidInertia::fromMassComInertia(1e-6, Vec3(5e-4, 0, 0), Mat3::Identity() * 1e-13));
+  builder.addJoint(j, "link2", RigidInertia::fromMassComInertia(1e-6, Vec3(5e-4, 0, 0), Mat3::Identity() * 1e-13));
   return builder.build();
 }
 }  // namespace
 
-TEST_CASE("a heavy stuck joint next to a light fast one sticks (friction scales from the stuck joints only)", "[friction]") {
+TEST_CASE("a heavy stuck joint next to a light fast one sticks (friction scales from the stuck joints only)",
+          "[friction]") {
   // Joint 'heavy' is stuck (q̇ = 0), pushed by 1 N·m, breakaway 10 N·m: it must
   // stick (q̈ = 0, μ ≈ 1). The light joint spins at 1e3 rad/s. The maximiser's
   // zero-curvature threshold was once 1e-10 · max_i 1/D_i over ALL bodies, set
@@ -450,8 +454,8 @@ TEST_CASE("a heavy stuck joint next to a light fast one sticks (friction scales 
     INFO("method " << (method == FrictionMethod::ActiveSet ? "active set" : "projected gradient") << ": mu "
                    << ws.friction.mu.transpose() << ", qdd " << ws.solution.qdd.transpose() << ", state "
                    << toString(ws.friction.state[0]) << ", kkt " << ws.friction.kkt_residual);
-    CHECK(std::abs(ws.friction.mu[0]) < 10.0);           // inside the friction cone
-    CHECK(std::abs(ws.solution.qdd[0]) <= 1e-9);         // sticks
+    CHECK(std::abs(ws.friction.mu[0]) < 10.0);    // inside the friction cone
+    CHECK(std::abs(ws.solution.qdd[0]) <= 1e-9);  // sticks
     CHECK(ws.friction.state[0] == JointState::Stick);
   }
 }

@@ -33,7 +33,9 @@ std::string modelError(const std::function<void()>& f) {
   return "(no ModelError)";
 }
 
-RigidInertia box(double mass) { return RigidInertia::fromMassComInertia(mass, Vec3(0.1, 0, 0), Mat3::Identity() * 0.01); }
+RigidInertia box(double mass) {
+  return RigidInertia::fromMassComInertia(mass, Vec3(0.1, 0, 0), Mat3::Identity() * 0.01);
+}
 
 Joint revolute(const std::string& name) {
   Joint j;
@@ -278,14 +280,17 @@ std::string urdfWith(const std::string& transmissions) {
   <link name="l2"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
   <joint name="j1" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
   <joint name="j2" type="continuous"><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
-)" + transmissions + "\n</robot>\n";
+)" + transmissions +
+         "\n</robot>\n";
 }
 
 std::string transmission(const std::string& name, const std::string& joints, const std::string& actuators) {
   return "<transmission name=\"" + name + "\">" + joints + actuators + "</transmission>";
 }
 
-std::string urdfError(const std::string& xml) { return modelError([&] { loadUrdfString(xml); }); }
+std::string urdfError(const std::string& xml) {
+  return modelError([&] { loadUrdfString(xml); });
+}
 }  // namespace
 
 TEST_CASE("errors: URDF <transmission> rotor inertias (the messages test_urdf does not reach)", "[errors]") {
@@ -297,7 +302,8 @@ TEST_CASE("errors: URDF <transmission> rotor inertias (the messages test_urdf do
               .joint(0)
               .rotor_inertia == 0.5);  // the template itself loads
   CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia/>")))),
-             Contains("<string>: transmission 't': <actuator> 'm'") && Contains("<drake:rotor_inertia> has no value attribute"));
+             Contains("<string>: transmission 't': <actuator> 'm'") &&
+                 Contains("<drake:rotor_inertia> has no value attribute"));
   CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia value=\"heavy\"/>")))),
              Contains("<drake:rotor_inertia> value \"heavy\" is not a number"));
   CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:gear_ratio value=\"1 2\"/>")))),
@@ -313,8 +319,8 @@ TEST_CASE("errors: URDF <transmission> rotor inertias (the messages test_urdf do
   CHECK_THAT(urdfError(urdfWith(transmission("t", j1 + j2, actuator("m", "<drake:rotor_inertia value=\"1\"/>")))),
              Contains("transmission 't': a <drake:rotor_inertia> needs exactly one <joint name=") &&
                  Contains("found 2"));
-  CHECK_THAT(urdfError(urdfWith(transmission("t", "<joint name=\"j7\"/>",
-                                             actuator("m", "<drake:rotor_inertia value=\"1\"/>")))),
+  CHECK_THAT(urdfError(urdfWith(
+                 transmission("t", "<joint name=\"j7\"/>", actuator("m", "<drake:rotor_inertia value=\"1\"/>")))),
              Contains("transmission 't': <joint> 'j7' is not a joint of the URDF"));
   CHECK_THAT(urdfError(urdfWith(transmission("t", j1, actuator("m", "<drake:rotor_inertia value=\"1\"/>")) +
                                 transmission("u", j1, actuator("n", "<drake:rotor_inertia value=\"2\"/>")))),

@@ -98,7 +98,8 @@ Outcome run(const Model& model, long solves) {
         hash.add(ws.solution.nu);
         break;
     }
-    if (!status.ok() && out.failures++ == 0) std::snprintf(out.first_failure, sizeof out.first_failure, "solve %ld: %s", i, status.message);
+    if (!status.ok() && out.failures++ == 0)
+      std::snprintf(out.first_failure, sizeof out.first_failure, "solve %ld: %s", i, status.message);
     hash.add(ws.solution.qdd);
     hash.add(ws.solution.tau_control);
     hash.add(ws.solution.gauss);
@@ -120,14 +121,16 @@ TEST_CASE("8 threads share one model, each with its own workspace: results ident
   std::vector<Outcome> outcomes(kThreads);
   std::vector<std::thread> threads;
   for (int t = 0; t < kThreads; ++t)
-    threads.emplace_back([&model, &outcomes, solves, t] { outcomes[static_cast<std::size_t>(t)] = run(model, solves); });
+    threads.emplace_back(
+        [&model, &outcomes, solves, t] { outcomes[static_cast<std::size_t>(t)] = run(model, solves); });
   for (std::thread& thread : threads) thread.join();
   for (int t = 0; t < kThreads; ++t) {
     INFO("thread " << t);
     CHECK(outcomes[static_cast<std::size_t>(t)].failures == 0);
     CHECK(outcomes[static_cast<std::size_t>(t)].hash == reference.hash);
   }
-  std::printf("threads: %d x %ld solves on one shared Panda model, every thread bit-identical to the single-thread run"
-              " (hash %016llx)\n",
-              kThreads, solves, static_cast<unsigned long long>(reference.hash));
+  std::printf(
+      "threads: %d x %ld solves on one shared Panda model, every thread bit-identical to the single-thread run"
+      " (hash %016llx)\n",
+      kThreads, solves, static_cast<unsigned long long>(reference.hash));
 }

@@ -47,10 +47,13 @@ const std::string kJointBody = R"(<origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="0 
 std::string arm(const std::string& joint_body = kJointBody, const std::string& inertial = kInertial,
                 const std::string& extra = "", const std::string& type = "revolute") {
   return robot(R"(<link name="base"/>
-  <joint name="j1" type=")" + type + R"("><parent link="base"/><child link="l1"/>
-    )" + joint_body + R"(
+  <joint name="j1" type=")" +
+               type + R"("><parent link="base"/><child link="l1"/>
+    )" + joint_body +
+               R"(
   </joint>
-  <link name="l1">)" + inertial + R"(</link>
+  <link name="l1">)" +
+               inertial + R"(</link>
   )" + extra);
 }
 
@@ -200,14 +203,15 @@ TEST_CASE("a fixed child's inertia is merged into its body", "[urdf]") {
   // l2 welded at (0.5, 0, 0) turned 90° about z: 1 kg at (0.2, 0, 0) of l2,
   // i.e. (0.5, 0.2, 0) of l1, I = diag(0.01, 0.02, 0.025) in l2's axes,
   // diag(0.02, 0.01, 0.025) in l1's.
-  const std::string inertial1 = inertialWith("2", R"(ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3")",
-                                             R"(<origin xyz="0.1 0 0"/>)");
-  const std::string extra = R"(
+  const std::string inertial1 =
+      inertialWith("2", R"(ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3")", R"(<origin xyz="0.1 0 0"/>)");
+  const std::string extra =
+      R"(
     <joint name="weld" type="fixed"><parent link="l1"/><child link="l2"/>
       <origin xyz="0.5 0 0" rpy="0 0 1.5707963267948966"/></joint>
-    <link name="l2">)" + inertialWith("1", R"(ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.025")",
-                                      R"(<origin xyz="0.2 0 0"/>)") +
-                            "</link>";
+    <link name="l2">)" +
+      inertialWith("1", R"(ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.025")", R"(<origin xyz="0.2 0 0"/>)") +
+      "</link>";
   const Model m = loadUrdfString(arm(kJointBody, inertial1, extra));
   REQUIRE(m.dof() == 1);
   const zwang::RigidInertia& I = m.inertia(1);
@@ -242,9 +246,8 @@ TEST_CASE("joint types, default axis and limits", "[urdf]") {
     CHECK(m.joint(0).effort_limit == std::numeric_limits<double>::infinity());
   }
   SECTION("prismatic") {
-    const Model m = loadUrdfString(
-        arm(R"(<axis xyz="0 1 0"/><limit lower="0" upper="0.3" effort="100" velocity="1"/>)", kInertial, "",
-            "prismatic"));
+    const Model m = loadUrdfString(arm(R"(<axis xyz="0 1 0"/><limit lower="0" upper="0.3" effort="100" velocity="1"/>)",
+                                       kInertial, "", "prismatic"));
     CHECK(m.joint(0).type == JointType::Prismatic);
     CHECK(near(m.joint(0).axis, Vec3::UnitY()));
     CHECK(m.joint(0).upper == 0.3);
@@ -294,8 +297,8 @@ TEST_CASE("rotor inertia from Drake's transmission tags, and the override", "[ur
   SECTION("an override naming a joint off the chain is an error") {
     UrdfOptions o = rootTip("", "l1");
     o.rotor_inertia["j2"] = 0.1;
-    REQUIRE_THROWS_WITH(loadUrdfString(two_links, o),
-                        Contains("'j2'") && Contains("not a moving joint of the chain") && !Contains("no joint of that name"));
+    REQUIRE_THROWS_WITH(loadUrdfString(two_links, o), Contains("'j2'") && Contains("not a moving joint of the chain") &&
+                                                          !Contains("no joint of that name"));
   }
   SECTION("a negative override is an error") {
     UrdfOptions o;
@@ -379,15 +382,14 @@ TEST_CASE("root and tip selection", "[urdf]") {
 TEST_CASE("error: missing or unreadable file", "[urdf][errors]") {
   REQUIRE_THROWS_AS(loadUrdfFile("/nonexistent/dir/robot.urdf"), ModelError);
   REQUIRE_THROWS_WITH(loadUrdfFile("/nonexistent/dir/robot.urdf"),
-                      Contains("/nonexistent/dir/robot.urdf") && Contains("cannot open") &&
-                          Contains("No such file"));
+                      Contains("/nonexistent/dir/robot.urdf") && Contains("cannot open") && Contains("No such file"));
   REQUIRE_THROWS_WITH(loadUrdfFile(kModels), Contains(kModels) && Contains("directory"));
 }
 
 TEST_CASE("error: malformed XML gives the line", "[urdf][errors]") {
   const std::string xml = "<robot name=\"r\">\n  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n";
-  REQUIRE_THROWS_WITH(loadUrdfString(xml), Contains("<string>") && Contains("malformed XML") && Contains("line 4") &&
-                                               Contains("end tag"));
+  REQUIRE_THROWS_WITH(loadUrdfString(xml),
+                      Contains("<string>") && Contains("malformed XML") && Contains("line 4") && Contains("end tag"));
   REQUIRE_THROWS_WITH(loadUrdfString(""), Contains("<string>") && Contains("malformed XML"));
   REQUIRE_THROWS_WITH(loadUrdfString("<model/>"), Contains("<string>") && Contains("<robot>") && Contains("<model>"));
 
@@ -414,7 +416,8 @@ TEST_CASE("error: unknown root or tip, tip not below root", "[urdf][errors]") {
                       Contains("<string>") && Contains("tip link 'l2b' is not below root link 'l2a'") &&
                           Contains("'l1'"));
   REQUIRE_THROWS_WITH(loadUrdfFile(kModels + "/panda.urdf", rootTip("panda_link5", "panda_link2")),
-                      Contains("panda.urdf") && Contains("tip link 'panda_link2' is not below root link 'panda_link5'"));
+                      Contains("panda.urdf") &&
+                          Contains("tip link 'panda_link2' is not below root link 'panda_link5'"));
   REQUIRE_THROWS_WITH(loadUrdfString(kTree, rootTip("l1", "sensor")),
                       Contains("<string>") && Contains("'l1'") && Contains("'sensor'") && Contains("no moving joint"));
 }
@@ -427,7 +430,8 @@ TEST_CASE("error: floating and planar joints on the chain", "[urdf][errors]") {
                       Contains("joint 'j1'") && Contains("planar") && Contains("not supported"));
   // Off the chain it is fine (it is not part of the model).
   const std::string extra = R"(<joint name="free" type="floating"><parent link="base"/><child link="ball"/></joint>
-      <link name="ball">)" + kInertial + "</link>";
+      <link name="ball">)" + kInertial +
+                            "</link>";
   UrdfOptions o = rootTip("", "l1");
   CHECK(loadUrdfString(arm(kJointBody, kInertial, extra), o).dof() == 1);
 }
@@ -437,22 +441,27 @@ TEST_CASE("error: bad masses and inertias", "[urdf][errors]") {
   REQUIRE_THROWS_WITH(loadUrdfString(arm(kJointBody, inertialWith("-1", unit))),
                       Contains("<string>") && Contains("link 'l1'") && Contains("<mass>") && Contains("-1") &&
                           Contains("negative"));
-  REQUIRE_THROWS_WITH(loadUrdfString(arm(kJointBody, inertialWith("0", R"(ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0")"))),
-                      Contains("<string>") && Contains("link 'l1'") && Contains("zero mass") && Contains("j1"));
+  REQUIRE_THROWS_WITH(
+      loadUrdfString(arm(kJointBody, inertialWith("0", R"(ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0")"))),
+      Contains("<string>") && Contains("link 'l1'") && Contains("zero mass") && Contains("j1"));
   REQUIRE_THROWS_WITH(loadUrdfString(arm(kJointBody, "")), Contains("link 'l1'") && Contains("zero mass"));
-  REQUIRE_THROWS_WITH(loadUrdfString(arm(kJointBody, inertialWith("1", R"(ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="-1")"))),
-                      Contains("<string>") && Contains("link 'l1'") && Contains("inertia") &&
-                          Contains("not positive semi-definite") && Contains("-1 kg·m² is negative"));
-  REQUIRE_THROWS_WITH(loadUrdfString(arm(kJointBody, inertialWith("1", R"(ixx="1" ixy="2" ixz="0" iyy="1" iyz="0" izz="1")"))),
-                      Contains("link 'l1'") && Contains("not positive semi-definite"));
+  REQUIRE_THROWS_WITH(
+      loadUrdfString(arm(kJointBody, inertialWith("1", R"(ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="-1")"))),
+      Contains("<string>") && Contains("link 'l1'") && Contains("inertia") && Contains("not positive semi-definite") &&
+          Contains("-1 kg·m² is negative"));
+  REQUIRE_THROWS_WITH(
+      loadUrdfString(arm(kJointBody, inertialWith("1", R"(ixx="1" ixy="2" ixz="0" iyy="1" iyz="0" izz="1")"))),
+      Contains("link 'l1'") && Contains("not positive semi-definite"));
   // A welded link on a moving body is checked too.
   const std::string welded = R"(<joint name="w" type="fixed"><parent link="l1"/><child link="l2"/></joint>
-      <link name="l2">)" + inertialWith("-2", unit) + "</link>";
+      <link name="l2">)" + inertialWith("-2", unit) +
+                             "</link>";
   REQUIRE_THROWS_WITH(loadUrdfString(arm(kJointBody, kInertial, welded)),
                       Contains("link 'l2'") && Contains("<mass>") && Contains("negative"));
   // A massless last body is fine when a welded link beyond it carries the mass.
   const std::string carrier = R"(<joint name="w" type="fixed"><parent link="l1"/><child link="l2"/></joint>
-      <link name="l2">)" + kInertial + "</link>";
+      <link name="l2">)" + kInertial +
+                              "</link>";
   CHECK(loadUrdfString(arm(kJointBody, "", carrier)).inertia(1).mass == Approx(1.0));
 }
 
@@ -464,7 +473,8 @@ TEST_CASE("error: negative friction, damping and limits", "[urdf][errors]") {
   REQUIRE_THROWS_WITH(loadUrdfString(arm(body(lim, R"(friction="-1" damping="0")"))),
                       Contains("<string>: joint 'j1': <dynamics> friction -1 is negative"));
   REQUIRE_THROWS_WITH(loadUrdfString(arm(body(lim, R"(friction="1" damping="-0.5")"))),
-                      Contains("<string>") && Contains("joint 'j1'") && Contains("<dynamics> damping -0.5 is negative"));
+                      Contains("<string>") && Contains("joint 'j1'") &&
+                          Contains("<dynamics> damping -0.5 is negative"));
   REQUIRE_THROWS_WITH(loadUrdfString(arm(body(R"(lower="2" upper="1" effort="10" velocity="2")", "friction=\"0\""))),
                       Contains("<string>") && Contains("joint 'j1'") && Contains("<limit> lower 2") &&
                           Contains("upper 1"));
@@ -475,8 +485,9 @@ TEST_CASE("error: negative friction, damping and limits", "[urdf][errors]") {
 }
 
 TEST_CASE("error: zero axis", "[urdf][errors]") {
-  REQUIRE_THROWS_WITH(loadUrdfString(arm(R"(<axis xyz="0 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>)")),
-                      Contains("<string>") && Contains("joint 'j1'") && Contains("<axis>") && Contains("zero"));
+  REQUIRE_THROWS_WITH(
+      loadUrdfString(arm(R"(<axis xyz="0 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>)")),
+      Contains("<string>") && Contains("joint 'j1'") && Contains("<axis>") && Contains("zero"));
 }
 
 TEST_CASE("error: NaN, Inf and non-numbers anywhere", "[urdf][errors]") {
@@ -485,8 +496,8 @@ TEST_CASE("error: NaN, Inf and non-numbers anywhere", "[urdf][errors]") {
   const auto link = [&](const std::string& inertial) { return loadUrdfString(arm(kJointBody, inertial)); };
   const std::string unit = R"(ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1")";
 
-  REQUIRE_THROWS_WITH(joint(R"(<origin xyz="nan 0 0"/>)"), Contains("<string>: joint 'j1': <origin> xyz") &&
-                                                                Contains("nan 0 0") && Contains("not finite"));
+  REQUIRE_THROWS_WITH(joint(R"(<origin xyz="nan 0 0"/>)"),
+                      Contains("<string>: joint 'j1': <origin> xyz") && Contains("nan 0 0") && Contains("not finite"));
   REQUIRE_THROWS_WITH(joint(R"(<origin rpy="0 inf 0"/>)"),
                       Contains("joint 'j1'") && Contains("<origin> rpy") && Contains("not finite"));
   REQUIRE_THROWS_WITH(joint(R"(<origin xyz="1e999 0 0"/>)"),
@@ -517,7 +528,8 @@ TEST_CASE("error: NaN, Inf and non-numbers anywhere", "[urdf][errors]") {
 
   // Anywhere: also on a link that would not be part of the model.
   const std::string off = R"(<joint name="jx" type="continuous"><parent link="base"/><child link="lx"/></joint>
-      <link name="lx">)" + inertialWith("nan", unit) + "</link>";
+      <link name="lx">)" + inertialWith("nan", unit) +
+                          "</link>";
   REQUIRE_THROWS_WITH(loadUrdfString(arm(kJointBody, kInertial, off), rootTip("", "l1")),
                       Contains("link 'lx'") && Contains("not finite"));
 }

@@ -21,12 +21,16 @@ namespace {
 
 // base --j1 (revolute about z)--> l1 with this <inertial> body; `extra` inside <robot>.
 std::string arm(const std::string& mass, const std::string& inertia, const std::string& com = "0.5 0 0",
-                const std::string& extra = "", const std::string& limit = R"(lower="-2" upper="2" effort="10" velocity="3")") {
+                const std::string& extra = "",
+                const std::string& limit = R"(lower="-2" upper="2" effort="10" velocity="3")") {
   return R"(<robot name="arm"><link name="base"/>
   <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
-    <limit )" + limit + R"(/></joint>
-  <link name="l1"><inertial><origin xyz=")" + com + R"("/><mass value=")" + mass + R"("/>
-    <inertia )" + inertia + R"(/></inertial></link>)" + extra + "</robot>";
+    <limit )" +
+         limit + R"(/></joint>
+  <link name="l1"><inertial><origin xyz=")" +
+         com + R"("/><mass value=")" + mass + R"("/>
+    <inertia )" +
+         inertia + R"(/></inertial></link>)" + extra + "</robot>";
 }
 
 std::string diagonal(const std::string& ixx, const std::string& iyy, const std::string& izz) {
@@ -73,7 +77,8 @@ TEST_CASE("semi-definite inertias load: point mass, thin rod, tiny inertia far f
     // Through ModelBuilder directly, the same.
     Joint j;
     j.name = "j1";
-    const RigidInertia I = RigidInertia::fromMassComInertia(2.0, Vec3(0.32, 0, 0), Vec3(1e-18, 2e-18, 2.5e-18).asDiagonal());
+    const RigidInertia I =
+        RigidInertia::fromMassComInertia(2.0, Vec3(0.32, 0, 0), Vec3(1e-18, 2e-18, 2.5e-18).asDiagonal());
     const Model built = ModelBuilder("m", "base").addJoint(j, "l1", I).build();
     CHECK(codes(built) == Codes{WarningCode::PointMass});
   }
@@ -145,8 +150,8 @@ TEST_CASE("links welded to the fixed base are not judged, whichever link is the 
 }
 
 TEST_CASE("placeholder limits are no limits, with a warning", "[urdf][warnings]") {
-  const std::string xml = arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", "",
-                              R"(lower="0" upper="0" effort="0" velocity="0")");
+  const std::string xml =
+      arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", "", R"(lower="0" upper="0" effort="0" velocity="0")");
   const Model m = loadUrdfString(xml);
   REQUIRE(codes(m) == Codes{WarningCode::PlaceholderLimits});
   CHECK_THAT(m.warnings()[0].message, Contains("<string>: joint 'j1': placeholder <limit lower=\"0\" upper=\"0\""));
@@ -155,8 +160,8 @@ TEST_CASE("placeholder limits are no limits, with a warning", "[urdf][warnings]"
   CHECK(m.joint(0).effort_limit == std::numeric_limits<double>::infinity());
   REQUIRE_THROWS_WITH(loadUrdfString(xml, strict()), Contains("placeholder <limit"));
   // Equal bounds with an effort are a real (locked) joint: kept.
-  const Model locked = loadUrdfString(arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", "",
-                                          R"(lower="0.3" upper="0.3" effort="5" velocity="0")"));
+  const Model locked = loadUrdfString(
+      arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", "", R"(lower="0.3" upper="0.3" effort="5" velocity="0")"));
   CHECK(locked.warnings().empty());
   CHECK(locked.joint(0).lower == 0.3);
 }
@@ -262,7 +267,7 @@ TEST_CASE("point-mass and thin-rod chains agree with the dense reference", "[urd
   spec.links.pop_back();
   spec.joints.pop_back();
   spec.links[1].inertia = Vec3(0.0, 0.03, 0.03).asDiagonal();  // a thin rod along x
-  spec.links[2].inertia.setZero();                              // a point mass (COM off every axis)
+  spec.links[2].inertia.setZero();                             // a point mass (COM off every axis)
   spec.links[3].inertia.setZero();
   const Model model = modelFromSpec(spec);
   REQUIRE(model.dof() == 3);
@@ -307,10 +312,9 @@ TEST_CASE("a payload joint locked at a given position", "[urdf][warnings]") {
   Workspace ws(m, task);
   const Eigen::Vector2d q(0.3, -0.7);
   REQUIRE(inverseDynamics(m, task, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), ws));
-  const Eigen::VectorXd dense =
-      denseInverseDynamics(spec, Eigen::Vector3d(0.3, -0.7, 0.04), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
-                           task.gravity)
-          .head(2);
+  const Eigen::VectorXd dense = denseInverseDynamics(spec, Eigen::Vector3d(0.3, -0.7, 0.04), Eigen::Vector3d::Zero(),
+                                                     Eigen::Vector3d::Zero(), task.gravity)
+                                    .head(2);
   CHECK(relativeError(ws.tau, dense) < 1e-12);
   o.locked_positions = {{"j2", 0.1}};
   REQUIRE_THROWS_WITH(loadUrdfString(toUrdf(spec), o),

@@ -85,8 +85,9 @@ enum class WarningCode {
   TriangleInequality,  ///< principal moments with a + b < c (no real body has them)
   PlaceholderLimits,   ///< <limit lower == upper, effort == velocity == 0>: read as "no limits"
   MassBeyondTip,       ///< links behind a moving joint below the tip carry mass the chain ignores
-  PayloadAttached,     ///< that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
-  Urdfdom,             ///< urdfdom's own warning, passed on once
+  /// that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
+  PayloadAttached,
+  Urdfdom,  ///< urdfdom's own warning, passed on once
 };
 /// "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.
 const char* toString(WarningCode code);

@@ -9,14 +9,14 @@ namespace zwang {
 
 /// What went wrong in a hot-path call (docs/errors.md, "Solve statuses").
 enum class StatusCode {
-  Ok = 0,            ///< success
-  SizeMismatch,      ///< an input vector has the wrong length
-  NonFinite,         ///< an input holds NaN or Inf
-  WorkspaceTooSmall, ///< the workspace was sized for fewer constraint rows
-  ModelMismatch,     ///< task or workspace built for another model
-  Degenerate,        ///< a joint has no inertia to move (D_j ≤ 0) in this configuration
-  BadOption,         ///< an option or per-solve override is out of range
-  Infeasible,        ///< the task drives a joint into its position limit (outputs finite, not physical)
+  Ok = 0,             ///< success
+  SizeMismatch,       ///< an input vector has the wrong length
+  NonFinite,          ///< an input holds NaN or Inf
+  WorkspaceTooSmall,  ///< the workspace was sized for fewer constraint rows
+  ModelMismatch,      ///< task or workspace built for another model
+  Degenerate,         ///< a joint has no inertia to move (D_j ≤ 0) in this configuration
+  BadOption,          ///< an option or per-solve override is out of range
+  Infeasible,         ///< the task drives a joint into its position limit (outputs finite, not physical)
 };
 
 /// The result of a hot-path call: a code and, on error, a message naming the input at fault.

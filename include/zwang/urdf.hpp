@@ -35,10 +35,10 @@ struct UrdfOptions {
   /// How the caller spells these options, for the hints in messages (the CLI
   /// says "--tip", Python "tip=").
   struct Names {
-    std::string tip = "UrdfOptions::tip";  ///< the name of the tip option
-    std::string rotor_inertia = "UrdfOptions::rotor_inertia";  ///< the name of the rotor_inertia option
+    std::string tip = "UrdfOptions::tip";                              ///< the name of the tip option
+    std::string rotor_inertia = "UrdfOptions::rotor_inertia";          ///< the name of the rotor_inertia option
     std::string attach_beyond_tip = "UrdfOptions::attach_beyond_tip";  ///< the name of the attach_beyond_tip option
-  } names;  ///< see Names
+  } names;                                                             ///< see Names
 };
 
 /// Throw ModelError with a message naming the file (or "<string>"), the link or

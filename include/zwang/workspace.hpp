@@ -22,8 +22,8 @@ struct FrictionScratch;
 // How the balance of line 25 went (docs/solver.md, "Singular tasks"). The
 // eigenvalues meant here are those of the equilibrated 𝓛̃ (see BalanceOptions).
 struct BalanceReport {
-  int rows = 0;             // m, the number of constraint rows
-  int rank = 0;             // m minus the directions of exact rank loss (σ̃ ≤ rank_tolerance)
+  int rows = 0;  // m, the number of constraint rows
+  int rank = 0;  // m minus the directions of exact rank loss (σ̃ ≤ rank_tolerance)
   // Frobenius condition number ‖𝓛̃‖_F ‖𝓛̃⁻¹‖_F of the equilibrated matrix
   // (infinite when 𝓛 is singular): at least σ̃_max/σ̃_min and at most m times it.
   double condition = 1.0;
@@ -32,7 +32,7 @@ struct BalanceReport {
   // rank_tolerance); 0 when every direction was solved exactly or dropped as
   // exact rank loss.
   double damping = 0.0;
-  bool singular = false;    // some σ̃ below singular_threshold: a direction was dropped or damped
+  bool singular = false;  // some σ̃ below singular_threshold: a direction was dropped or damped
   // ‖Aᵀ Ẍ − b‖₂ over the task's rows, in the rows' own units (m/s², rad/s²),
   // measured on the final accelerations.
   double residual = 0.0;
@@ -55,13 +55,13 @@ struct BalanceFactorisation {
   /// Euclidean projection: 1 at exact rank loss, falling to 0 at the threshold.
   Eigen::MatrixXd near_null_basis;
   Eigen::VectorXd near_null_weight;  ///< the weight of each of those directions (see near_null_basis)
-  int near_null_count = 0;        ///< columns of near_null_basis in use
-  Eigen::VectorXd work;           ///< scratch of balanceApply (V's coordinates)
+  int near_null_count = 0;           ///< columns of near_null_basis in use
+  Eigen::VectorXd work;              ///< scratch of balanceApply (V's coordinates)
 };
 
 /// What a solve computes (Workspace::solution).
 struct Solution {
-  Eigen::VectorXd qdd;             ///< q̈
+  Eigen::VectorXd qdd;  ///< q̈
   /// ν, constraint magnitudes, in the task's row order. Sized to the task's
   /// rows; a solve resizes it only when the task's row count changed since the
   /// last solve (the one allocation a solve can make; none for a fixed task).
@@ -107,26 +107,26 @@ class Workspace {
   // transforms ⁱX_{i−1} between bodies are then identities.
 
   // --- outward sweep: poses, velocities, bias terms (Algorithm 1, lines 2–10)
-  std::vector<Transform> Xworld;     ///< ⁱX₀, world → body i
-  std::vector<Vec6> S;               ///< S_i, motion subspace
-  std::vector<RigidInertia> I;       ///< I_i, body inertia
-  std::vector<Vec6> v;               ///< Ẋ_i
-  std::vector<Vec6> c;               ///< Ẍ_bias,i = Ẋ_i × S_i q̇_i
-  std::vector<Vec6> Fbias;           ///< F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
+  std::vector<Transform> Xworld;  ///< ⁱX₀, world → body i
+  std::vector<Vec6> S;            ///< S_i, motion subspace
+  std::vector<RigidInertia> I;    ///< I_i, body inertia
+  std::vector<Vec6> v;            ///< Ẋ_i
+  std::vector<Vec6> c;            ///< Ẍ_bias,i = Ẋ_i × S_i q̇_i
+  std::vector<Vec6> Fbias;        ///< F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
 
   // --- inward sweep: articulated quantities (lines 11–22)
-  std::vector<Mat6> IA;              ///< I^A_i
-  std::vector<Vec6> FA;              ///< F^A_bias,i
-  std::vector<Vec6> IAS;             ///< I^A_i S_i
-  std::vector<double> D;             ///< D_i = d_i + S_iᵀ I^A_i S_i
-  std::vector<double> u;             ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
-  Eigen::MatrixXd SA;                ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
-  ConstraintMatrix Ahat;             ///< A_i (6 × capacity), updated in place from A_N down to A_0
+  std::vector<Mat6> IA;   ///< I^A_i
+  std::vector<Vec6> FA;   ///< F^A_bias,i
+  std::vector<Vec6> IAS;  ///< I^A_i S_i
+  std::vector<double> D;  ///< D_i = d_i + S_iᵀ I^A_i S_i
+  std::vector<double> u;  ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
+  Eigen::MatrixXd SA;     ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
+  ConstraintMatrix Ahat;  ///< A_i (6 × capacity), updated in place from A_N down to A_0
   /// U_0, acceleration energy of bias forces and torques: the report's U (not
   /// Featherstone's or Pinocchio's U = I^A S, which is IAS here).
   Eigen::VectorXd U;
-  Eigen::VectorXd L_scale;           ///< Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
-  Eigen::MatrixXd L;                 ///< 𝓛_0, the balance matrix of line 25 (capacity², lower triangle)
+  Eigen::VectorXd L_scale;  ///< Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
+  Eigen::MatrixXd L;        ///< 𝓛_0, the balance matrix of line 25 (capacity², lower triangle)
 
   // --- the task in sweep form, solver column order (see Task::groups)
   ConstraintMatrix A_body;  ///< columns of each constraint, as unit forces on its body
@@ -134,19 +134,19 @@ class Workspace {
 
   // --- balance (line 25), src/dynamics/balance.cpp
   BalanceFactorisation balance_factorisation;  ///< the last balance's factorisation
-  Eigen::VectorXd rhs;      ///< b − A_0ᵀẌ_0 − U_0
-  Eigen::VectorXd nu;       ///< ν in solver order
+  Eigen::VectorXd rhs;                         ///< b − A_0ᵀẌ_0 − U_0
+  Eigen::VectorXd nu;                          ///< ν in solver order
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
-  std::vector<Vec6> a;      ///< Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])
-  std::vector<Vec6> f;      ///< accumulated forces (RNEA)
+  std::vector<Vec6> a;  ///< Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])
+  std::vector<Vec6> f;  ///< accumulated forces (RNEA)
 
   // --- other algorithms
-  std::vector<Mat6> Ic;     ///< composite inertias (CRBA)
-  Eigen::MatrixXd H;        ///< joint-space inertia (CRBA)
-  Eigen::VectorXd tau;      ///< inverse dynamics result (RNEA)
+  std::vector<Mat6> Ic;  ///< composite inertias (CRBA)
+  Eigen::MatrixXd H;     ///< joint-space inertia (CRBA)
+  Eigen::VectorXd tau;   ///< inverse dynamics result (RNEA)
 
- /// Scratch of the friction extension (src/friction/friction.cpp).
+  /// Scratch of the friction extension (src/friction/friction.cpp).
   internal::FrictionScratch& frictionScratch() { return *friction_scratch_; }
 
  private:

@@ -2,6 +2,7 @@
 /// zwang: constrained hybrid dynamics (Popov–Vereshchagin) with static friction.
 #pragma once
 
+#include "zwang/friction.hpp"
 #include "zwang/hybrid_dynamics.hpp"
 #include "zwang/inverse_dynamics.hpp"
 #include "zwang/kinematics.hpp"
@@ -10,7 +11,6 @@
 #include "zwang/task.hpp"
 #include "zwang/urdf.hpp"
 #include "zwang/workspace.hpp"
-#include "zwang/friction.hpp"
 
 /// \namespace zwang
 /// Constrained hybrid dynamics (Popov–Vereshchagin) with static friction: Model,

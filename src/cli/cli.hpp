@@ -86,7 +86,7 @@ bool plotWithGnuplot(const std::string& command, const std::filesystem::path& di
 // --no-plots, no positional arguments; one model from the models directory;
 // a CSV and, with gnuplot, PNG plots into --out.
 struct ReportCommand {
-  std::string name;            // the command, for messages
+  std::string name;  // the command, for messages
   Arguments args;
   std::filesystem::path out;   // --out (created)
   std::filesystem::path urdf;  // the model file loaded

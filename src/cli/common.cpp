@@ -185,12 +185,14 @@ std::string printable(const std::string& text, std::size_t max_length) {
 }
 
 void printWarnings(const Model& model) {
-  for (const ModelWarning& w : model.warnings()) std::fprintf(stderr, "zwang: warning: %s\n", printable(w.message, 4000).c_str());
+  for (const ModelWarning& w : model.warnings())
+    std::fprintf(stderr, "zwang: warning: %s\n", printable(w.message, 4000).c_str());
 }
 
 std::string readFile(const std::string& path, std::size_t max_bytes) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw CliError(kExitError, path + ": cannot read the file: it is a directory");
+  if (std::filesystem::is_directory(path, ec))
+    throw CliError(kExitError, path + ": cannot read the file: it is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int err = errno;
@@ -265,7 +267,8 @@ bool onPath(const std::string& program) {
     if (dir.empty()) dir = ".";
     const std::string candidate = dir + "/" + program;
     struct stat st {};
-    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0) return true;
+    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(candidate.c_str(), X_OK) == 0)
+      return true;
   }
   return false;
 }
@@ -292,13 +295,15 @@ int runGnuplot(const std::filesystem::path& dir, const std::string& script) {
 
 bool plotWithGnuplot(const std::string& command, const std::filesystem::path& dir, const std::string& script) {
   if (!onPath("gnuplot")) {
-    std::fprintf(stderr, "zwang: %s: gnuplot is not on PATH: no PNG plots (the CSVs are written; "
-                         "install gnuplot, e.g. Debian's gnuplot-nox, and run `gnuplot %s` in %s)\n",
+    std::fprintf(stderr,
+                 "zwang: %s: gnuplot is not on PATH: no PNG plots (the CSVs are written; "
+                 "install gnuplot, e.g. Debian's gnuplot-nox, and run `gnuplot %s` in %s)\n",
                  command.c_str(), script.c_str(), dir.string().c_str());
     return false;
   }
   if (const int rc = runGnuplot(dir, script); rc != 0) {
-    std::fprintf(stderr, "zwang: %s: gnuplot failed (exit %d): no PNG plots (the CSVs are written)\n", command.c_str(), rc);
+    std::fprintf(stderr, "zwang: %s: gnuplot failed (exit %d): no PNG plots (the CSVs are written)\n", command.c_str(),
+                 rc);
     return false;
   }
   return true;
@@ -330,12 +335,12 @@ std::optional<ReportCommand> startReportCommand(const std::string& command, int 
   }
   bool as_expected = report.model.dof() == expected.dof;
   for (const std::string& frame : expected.frames) as_expected = as_expected && report.model.hasFrame(frame);
-  if (!as_expected)
-    throw CliError(kExitError, command + ": " + report.urdf.string() + ": expected " + expected.what);
+  if (!as_expected) throw CliError(kExitError, command + ": " + report.urdf.string() + ": expected " + expected.what);
   std::error_code ec;
   std::filesystem::create_directories(report.out, ec);
   if (ec)
-    throw CliError(kExitError, command + ": " + report.out.string() + ": cannot create the directory (" + ec.message() + ")");
+    throw CliError(kExitError,
+                   command + ": " + report.out.string() + ": cannot create the directory (" + ec.message() + ")");
   return report;
 }
 

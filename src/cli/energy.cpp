@@ -198,7 +198,9 @@ std::string plotScript(const Model& model, const std::vector<PoseResult>& result
        "set grid ytics\n"
        "set key outside bottom center horizontal box maxrows 1 width -2\n"
        "set yrange [0:*]\n"
-       "set xrange [-0.6:" << results.size() - 0.4 << "]\n"
+       "set xrange [-0.6:"
+    << results.size() - 0.4
+    << "]\n"
        "\n"
        "set terminal pngcairo size 900,520 font \"DejaVu Sans,11\"\n"
        "set output \"panda_energy.png\"\n"
@@ -214,7 +216,9 @@ std::string plotScript(const Model& model, const std::vector<PoseResult>& result
        "set multiplot layout 2,3 title \"Panda holding still: |τ_{control,j}| per joint (bars) and breakaway friction f_j (red)\"\n"
        "set key inside top right vertical maxrows auto width 0 box opaque font \",8\"\n"
        "set offsets 0, 0, graph 0.05, 0\n"
-       "set xrange [-0.6:" << kJoints - 0.4 << "]\n"
+       "set xrange [-0.6:"
+    << kJoints - 0.4
+    << "]\n"
        "set xlabel \"joint\"\n"
        "set ylabel \"|τ| [N·m]\"\n"
        "set yrange [0:*]\n";
@@ -251,22 +255,26 @@ int commandEnergy(int argc, char** argv) {
   std::printf("task: tool0 fixed (6 rows, world axes) + panda_link1 angular z (= qdd1) fixed: qdd = 0 exactly\n");
   std::printf("breakaway friction f [N·m] (URDF <dynamics friction>):");
   for (int j = 0; j < kJoints; ++j) std::printf(" %s", fmt(model.joint(j).breakaway_friction).c_str());
-  std::printf("\nplain: solveHybridDynamics (tau_control = gravity torques G(q)); friction-aware: solveWithFriction,\n"
-              "all joints stick, mu* indeterminate, the maximiser with the least |tau_control|^2 using at most\n"
-              "margin*f_j, so |tau_control,j| = max(0, |G_j| - margin*f_j).\n\n");
+  std::printf(
+      "\nplain: solveHybridDynamics (tau_control = gravity torques G(q)); friction-aware: solveWithFriction,\n"
+      "all joints stick, mu* indeterminate, the maximiser with the least |tau_control|^2 using at most\n"
+      "margin*f_j, so |tau_control,j| = max(0, |G_j| - margin*f_j).\n\n");
 
   std::printf("poses: q [rad], tool0 position [m]\n");
-  std::vector<std::vector<std::string>> poses{{"pose", "what", "q1", "q2", "q3", "q4", "q5", "q6", "q7", "tool x", "y", "z"}};
+  std::vector<std::vector<std::string>> poses{
+      {"pose", "what", "q1", "q2", "q3", "q4", "q5", "q6", "q7", "tool x", "y", "z"}};
   for (std::size_t p = 0; p < results.size(); ++p) {
     std::vector<std::string> row{kPoses[p].name, kPoses[p].what};
     for (const double x : kPoses[p].q) row.push_back(fmt(x));
-    for (int k = 0; k < 3; ++k) row.push_back(fmt(std::abs(results[p].tool[k]) < 5e-4 ? 0.0 : results[p].tool[k], "%.3f"));
+    for (int k = 0; k < 3; ++k)
+      row.push_back(fmt(std::abs(results[p].tool[k]) < 5e-4 ? 0.0 : results[p].tool[k], "%.3f"));
     poses.push_back(row);
   }
   printColumns(poses, 2);
 
   std::printf("\ntau_control per joint [N·m]\n");
-  std::vector<std::vector<std::string>> joints{{"pose", "variant", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6", "tau7"}};
+  std::vector<std::vector<std::string>> joints{
+      {"pose", "variant", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6", "tau7"}};
   for (std::size_t p = 0; p < results.size(); ++p)
     for (int v = 0; v < kVariantCount; ++v) {
       std::vector<std::string> row{v == 0 ? kPoses[p].name : "", kVariants[v].name};
@@ -275,8 +283,9 @@ int commandEnergy(int argc, char** argv) {
     }
   printColumns(joints, 2);
 
-  std::printf("\nactuator effort: |tau| = 2-norm of tau_control [N·m], sum|tau| [N·m], |tau|^2 [N²m²];\n"
-              "m = margin of the friction-aware solve; saved = how much less |tau|^2 with m=1 than plain\n");
+  std::printf(
+      "\nactuator effort: |tau| = 2-norm of tau_control [N·m], sum|tau| [N·m], |tau|^2 [N²m²];\n"
+      "m = margin of the friction-aware solve; saved = how much less |tau|^2 with m=1 than plain\n");
   std::vector<std::vector<std::string>> table{{"pose", "|tau| plain", "|tau| m=0.5", "|tau| m=1", "sum|tau| plain",
                                                "sum|tau| m=0.5", "sum|tau| m=1", "|tau|^2 plain", "|tau|^2 m=0.5",
                                                "|tau|^2 m=1", "saved m=1", "check"}};
@@ -295,12 +304,14 @@ int commandEnergy(int argc, char** argv) {
   printColumns(table);
   std::printf("\nall poses: |tau|^2 summed %s (plain), %s (margin 0.5), %s (margin 1): %s %% and %s %% less\n",
               fmt(total[0]).c_str(), fmt(total[1]).c_str(), fmt(total[2]).c_str(),
-              fmt(100.0 * (1.0 - total[1] / total[0]), "%.1f").c_str(), fmt(100.0 * (1.0 - total[2] / total[0]), "%.1f").c_str());
+              fmt(100.0 * (1.0 - total[1] / total[0]), "%.1f").c_str(),
+              fmt(100.0 * (1.0 - total[2] / total[0]), "%.1f").c_str());
   std::printf("check: rank 7, |qdd| < 1e-9 and tau_control = the closed form within 1e-9 (G from RNEA)\n");
 
   writeOutput((out / "panda_energy.csv").string(), csvText(results));
-  std::printf("wrote %s/panda_energy.csv (pose, variant, q1-7, tau1-7 = tau_control, mu1-7, tau_norm, tau_sq, tau_abs_sum)\n",
-              out.string().c_str());
+  std::printf(
+      "wrote %s/panda_energy.csv (pose, variant, q1-7, tau1-7 = tau_control, mu1-7, tau_norm, tau_sq, tau_abs_sum)\n",
+      out.string().c_str());
   writePlots(*report, "energy.gp", plotScript(model, results), "panda_energy.png, panda_energy_joints.png");
   return reportExitCode(*report, all_ok, "the closed form");
 }

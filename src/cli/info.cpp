@@ -46,7 +46,8 @@ void printTable(const std::vector<std::vector<std::string>>& rows) {
     std::string line = "";
     for (std::size_t c = 0; c < rows[r].size(); ++c) {
       const std::string& text = rows[r][c];
-      const bool numeric = r > 0 && !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '-');
+      const bool numeric =
+          r > 0 && !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '-');
       const std::string pad(width[c] - displayWidth(text), ' ');
       line += "  " + (numeric ? pad + text : text + pad);
     }
@@ -84,7 +85,8 @@ Json infoJson(const Model& model, const std::string& path) {
   for (const Frame& f : model.frames())
     frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyLink(model, f.body)}});
   Json warnings = Json::array();
-  for (const ModelWarning& w : model.warnings()) warnings.push_back({{"code", toString(w.code)}, {"message", w.message}});
+  for (const ModelWarning& w : model.warnings())
+    warnings.push_back({{"code", toString(w.code)}, {"message", w.message}});
   const Masses mass(model);
   return {{"file", path},
           {"model", model.name()},
@@ -106,9 +108,9 @@ void printInfoTable(const Model& model, const std::string& path) {
     const Joint& j = model.joint(k);
     char axis[64];
     std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
-    rows.push_back({std::to_string(k), j.name, toString(j.type), axis, cell(j.lower), cell(j.upper), cell(j.effort_limit),
-                    cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction), cell(j.viscous_friction),
-                    cell(j.rotor_inertia)});
+    rows.push_back({std::to_string(k), j.name, toString(j.type), axis, cell(j.lower), cell(j.upper),
+                    cell(j.effort_limit), cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction),
+                    cell(j.viscous_friction), cell(j.rotor_inertia)});
   }
   printTable(rows);
   std::printf("\nframes\n");

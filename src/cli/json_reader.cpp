@@ -1,9 +1,9 @@
 // Path-tracking JSON parsing and checked access (see json_reader.hpp).
 #include "json_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <cstdlib>
 #include <vector>
 
@@ -216,7 +216,8 @@ Eigen::VectorXd JsonReader::numbers(const Json& value, const std::string& path, 
     fail(path, "has " + std::to_string(count) + (count == 1 ? " entry" : " entries") + ", expected " +
                    std::to_string(expected) + (expected_what.empty() ? "" : " (" + expected_what + ")"));
   Eigen::VectorXd out(count);
-  for (std::size_t k = 0; k < value.size(); ++k) out[static_cast<Eigen::Index>(k)] = number(value[k], childPath(path, k));
+  for (std::size_t k = 0; k < value.size(); ++k)
+    out[static_cast<Eigen::Index>(k)] = number(value[k], childPath(path, k));
   return out;
 }
 

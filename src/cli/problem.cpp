@@ -27,7 +27,8 @@ WrenchSpec parseWrench(const JsonReader& in, const Json& value, const std::strin
   w.frame = in.string(value["frame"], childPath(path, "frame"));
   if (value.contains("expressed_in"))
     w.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), false);
-  if (value.contains("force")) w.value.head<3>() = in.numbers(value["force"], childPath(path, "force"), 3, "fx, fy, fz");
+  if (value.contains("force"))
+    w.value.head<3>() = in.numbers(value["force"], childPath(path, "force"), 3, "fx, fy, fz");
   if (value.contains("torque"))
     w.value.tail<3>() = in.numbers(value["torque"], childPath(path, "torque"), 3, "nx, ny, nz");
   return w;
@@ -41,7 +42,8 @@ ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const st
   c.frame = in.string(value["frame"], childPath(path, "frame"));
   if (value.contains("expressed_in"))
     c.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), true);
-  if (!value.contains("directions")) in.fail(path, "missing key \"directions\" (a list of 6-vectors, linear part first)");
+  if (!value.contains("directions"))
+    in.fail(path, "missing key \"directions\" (a list of 6-vectors, linear part first)");
   const std::string dpath = childPath(path, "directions");
   const Json& directions = in.array(value["directions"], dpath);
   if (directions.empty()) in.fail(dpath, "needs at least one direction");
@@ -50,7 +52,8 @@ ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const st
     c.A.col(static_cast<Eigen::Index>(k)) =
         in.numbers(directions[k], childPath(dpath, k), 6, "linear part first: lx, ly, lz, rx, ry, rz");
   if (value.contains("acceleration"))
-    c.acceleration = in.numbers(value["acceleration"], childPath(path, "acceleration"), c.A.cols(), "one per direction");
+    c.acceleration =
+        in.numbers(value["acceleration"], childPath(path, "acceleration"), c.A.cols(), "one per direction");
   else
     c.acceleration = Eigen::VectorXd::Zero(c.A.cols());
   return c;
@@ -141,7 +144,8 @@ Problem readProblem(const std::string& file) {
   if (doc.contains("root")) p.root = in.string(doc["root"], "root");
   if (doc.contains("tip")) p.tip = in.string(doc["tip"], "tip");
   if (doc.contains("strict")) p.strict = in.boolean(doc["strict"], "strict");
-  if (doc.contains("attach_beyond_tip")) p.attach_beyond_tip = in.boolean(doc["attach_beyond_tip"], "attach_beyond_tip");
+  if (doc.contains("attach_beyond_tip"))
+    p.attach_beyond_tip = in.boolean(doc["attach_beyond_tip"], "attach_beyond_tip");
   if (doc.contains("gravity")) p.gravity = Vec3(in.numbers(doc["gravity"], "gravity", 3, "gx, gy, gz"));
   for (const char* key : {"q", "qd", "tau"})
     if (doc.contains(key)) {
@@ -152,7 +156,8 @@ Problem readProblem(const std::string& file) {
   if (doc.contains("breakaway")) p.breakaway = nonNegative(in, doc["breakaway"], "breakaway");
   if (doc.contains("wrenches")) {
     const Json& list = in.array(doc["wrenches"], "wrenches");
-    for (std::size_t k = 0; k < list.size(); ++k) p.wrenches.push_back(parseWrench(in, list[k], childPath("wrenches", k)));
+    for (std::size_t k = 0; k < list.size(); ++k)
+      p.wrenches.push_back(parseWrench(in, list[k], childPath("wrenches", k)));
   }
   if (doc.contains("constraints")) {
     const Json& list = in.array(doc["constraints"], "constraints");
@@ -221,7 +226,8 @@ BoundProblem bindProblem(const Problem& p) {
 
   auto frameIndex = [&](const std::string& name, const std::string& path) {
     if (!m.hasFrame(name))
-      in.fail(childPath(path, "frame"), "unknown frame \"" + printable(name, 60) + "\" (the chain's frames: " + frameList(m) + ")");
+      in.fail(childPath(path, "frame"),
+              "unknown frame \"" + printable(name, 60) + "\" (the chain's frames: " + frameList(m) + ")");
     const int f = m.frameIndex(name);
     bool seen = false;
     for (const int g : b.reported_frames) seen = seen || g == f;

@@ -29,11 +29,11 @@ namespace {
 constexpr int kSamples = 201;
 
 struct Scenario {
-  const char* name;       // file stem
-  const char* title;      // for the table and the plots
-  double tip_force_y;     // world y force at the tip [N] (0: none)
-  bool constrained;       // link1's angular acceleration about z set to `target`
-  double target;          // [rad/s²]
+  const char* name;    // file stem
+  const char* title;   // for the table and the plots
+  double tip_force_y;  // world y force at the tip [N] (0: none)
+  bool constrained;    // link1's angular acceleration about z set to `target`
+  double target;       // [rad/s²]
   // The report's result (its sign convention: magnitudes, Fig. 5.5 opposite sign)
   const char* report;
   // Ours (docs/theory.md, "The reference cases"), for the self-check.
@@ -48,8 +48,7 @@ const Scenario kScenarios[] = {
      "Fig. 6.5-6.7: mu* = 10 N·m (magnitude), resulting torque -1 N·m, qdd = -0.44 rad/s²", -10.0, -1.0 / 2.25, 0.0,
      "slip-"},
     {"fig5_5", "Fig. 5.5: link1 angular acceleration 5 rad/s²", 0.0, true, 5.0,
-     "Fig. 5.5: g linear in mu, maximum at the vertex -10 N·m (report's sign)", 10.0, 5.0, 2.25 * 5.0 + 10.0,
-     "slip+"},
+     "Fig. 5.5: g linear in mu, maximum at the vertex -10 N·m (report's sign)", 10.0, 5.0, 2.25 * 5.0 + 10.0, "slip+"},
 };
 
 struct Result {
@@ -83,7 +82,8 @@ Result run(const Model& model, const Scenario& sc) {
   r.tau_control = ws.solution.tau_control[0];
   r.state = toString(ws.friction.state[0]);
   r.g = ws.friction.gauss_dual;
-  if (!inverseDynamics(model, free_task, q, qd, ws.solution.qdd, ws)) throw CliError(kExitError, "scenarios: RNEA failed");
+  if (!inverseDynamics(model, free_task, q, qd, ws.solution.qdd, ws))
+    throw CliError(kExitError, "scenarios: RNEA failed");
   r.tau_net = ws.tau[0];
 
   // The sampling view: the plain solver with τ = τ₀ − μ.
@@ -99,7 +99,8 @@ Result run(const Model& model, const Scenario& sc) {
     r.g_grid.push_back(ws.solution.gauss);
     r.qdd_grid.push_back(ws.solution.qdd[0]);
     r.tau_grid.push_back(tau0[0] + ws.solution.tau_constraint[0]);
-    if (!inverseDynamics(model, free_task, q, qd, ws.solution.qdd, ws)) throw CliError(kExitError, "scenarios: RNEA failed");
+    if (!inverseDynamics(model, free_task, q, qd, ws.solution.qdd, ws))
+      throw CliError(kExitError, "scenarios: RNEA failed");
     r.net_grid.push_back(ws.tau[0]);
     if (ws.solution.gauss > best) {
       best = ws.solution.gauss;
@@ -108,8 +109,9 @@ Result run(const Model& model, const Scenario& sc) {
     if (std::abs(mu - r.mu) < 1e-12) r.grid_g_at_mu = ws.solution.gauss;
   }
   const double tol = 1e-9;
-  r.ok = std::abs(r.mu - sc.mu) < tol && std::abs(r.qdd - sc.qdd) < tol && std::abs(r.tau_control - sc.tau_control) < tol &&
-         r.state == sc.state && std::abs(r.grid_g_at_mu - r.g) < tol * (1 + std::abs(r.g));
+  r.ok = std::abs(r.mu - sc.mu) < tol && std::abs(r.qdd - sc.qdd) < tol &&
+         std::abs(r.tau_control - sc.tau_control) < tol && r.state == sc.state &&
+         std::abs(r.grid_g_at_mu - r.g) < tol * (1 + std::abs(r.g));
   return r;
 }
 
@@ -125,8 +127,8 @@ void writeCsv(const std::filesystem::path& path, const Result& r) {
   out << "mu,g,qdd,tau_control,tau_net\n";
   char line[200];
   for (std::size_t i = 0; i < r.mu_grid.size(); ++i) {
-    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g\n", r.mu_grid[i], r.g_grid[i], r.qdd_grid[i], r.tau_grid[i],
-                  r.net_grid[i]);
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g,%.17g\n", r.mu_grid[i], r.g_grid[i], r.qdd_grid[i],
+                  r.tau_grid[i], r.net_grid[i]);
     out << line;
   }
   writeOutput(path.string(), out.str());
@@ -170,16 +172,19 @@ std::string plotScript(const std::vector<Result>& results, double f) {
       const std::string star = std::string("$star_") + sc.name;
       const std::string mu_label = "μ* = " + fmt(r.mu) + " (exact, " + r.state + ")";
       if (std::string(p.suffix) == "g")
-        s << "plot " << csv << " using 1:2 with lines linewidth 2 linecolor rgb \"#0060c0\" title \"g(μ), 201 samples\", \\\n  "
-          << star << " using 1:2 with points pointtype 7 pointsize 1.6 linecolor rgb \"#c00000\" title \"" << mu_label
+        s << "plot " << csv
+          << " using 1:2 with lines linewidth 2 linecolor rgb \"#0060c0\" title \"g(μ), 201 samples\", \\\n  " << star
+          << " using 1:2 with points pointtype 7 pointsize 1.6 linecolor rgb \"#c00000\" title \"" << mu_label
           << "\"\n";
       else if (std::string(p.suffix) == "qdd")
         s << "plot " << csv << " using 1:3 with lines linewidth 2 linecolor rgb \"#0060c0\" title \"q̈(μ)\", \\\n  "
           << star << " using 1:3 with points pointtype 7 pointsize 1.6 linecolor rgb \"#c00000\" title \"" << mu_label
           << "\"\n";
       else
-        s << "plot " << csv << " using 1:5 with lines linewidth 2 linecolor rgb \"#0060c0\" title \"net joint torque H q̈ + C\", \\\n  "
-          << csv << " using 1:4 with lines linewidth 2 dashtype 3 linecolor rgb \"#208020\" title \"τ_{control} = τ + τ_c (motor)\", \\\n  "
+        s << "plot " << csv
+          << " using 1:5 with lines linewidth 2 linecolor rgb \"#0060c0\" title \"net joint torque H q̈ + C\", \\\n  "
+          << csv
+          << " using 1:4 with lines linewidth 2 dashtype 3 linecolor rgb \"#208020\" title \"τ_{control} = τ + τ_c (motor)\", \\\n  "
           << star << " using 1:5 with points pointtype 7 pointsize 1.6 linecolor rgb \"#c00000\" title \"" << mu_label
           << "\", \\\n  " << star
           << " using 1:4 with points pointtype 6 pointsize 1.6 linecolor rgb \"#c00000\" notitle\n";
@@ -204,8 +209,9 @@ int commandScenarios(int argc, char** argv) {
   std::printf("zwang scenarios: the report's chapter 6 and Fig. 5.5 with %s\n", report->shownUrdf().c_str());
   std::printf("1-DOF arm: inertia about the joint %s kg·m², breakaway friction f = %s N·m, no gravity, at rest.\n",
               fmt(inertia).c_str(), fmt(f).c_str());
-  std::printf("Sign: mu > 0 opposes positive motion (the joint feels tau - mu); the report plots magnitudes and\n"
-              "uses the opposite sign in Fig. 5.5. tau_net = H qdd + C is the report's \"resulting torque\".\n\n");
+  std::printf(
+      "Sign: mu > 0 opposes positive motion (the joint feels tau - mu); the report plots magnitudes and\n"
+      "uses the opposite sign in Fig. 5.5. tau_net = H qdd + C is the report's \"resulting torque\".\n\n");
 
   std::vector<Result> results;
   bool all_ok = true;
@@ -215,8 +221,8 @@ int commandScenarios(int argc, char** argv) {
     writeCsv(out / (std::string(sc.name) + ".csv"), results.back());
   }
 
-  std::vector<std::vector<std::string>> rows{
-      {"scenario", "mu* [N·m]", "qdd* [rad/s²]", "tau_control [N·m]", "tau_net [N·m]", "state", "g(mu*)", "grid argmax", "check"}};
+  std::vector<std::vector<std::string>> rows{{"scenario", "mu* [N·m]", "qdd* [rad/s²]", "tau_control [N·m]",
+                                              "tau_net [N·m]", "state", "g(mu*)", "grid argmax", "check"}};
   for (std::size_t k = 0; k < results.size(); ++k) {
     const Result& r = results[k];
     rows.push_back({kScenarios[k].name, fmt(r.mu), fmt(r.qdd), fmt(r.tau_control), fmt(r.tau_net), r.state, fmt(r.g),
@@ -225,7 +231,8 @@ int commandScenarios(int argc, char** argv) {
   printColumns(rows);
   std::printf("\nThe report's results:\n");
   for (const Scenario& sc : kScenarios) std::printf("  %-9s  %s\n", sc.name, sc.report);
-  std::printf("\ngrid argmax: the best of the %d samples of g (the report's sampling method); mu* is exact.\n", kSamples);
+  std::printf("\ngrid argmax: the best of the %d samples of g (the report's sampling method); mu* is exact.\n",
+              kSamples);
   std::printf("wrote %s/{%s,%s,%s}.csv (columns mu, g, qdd, tau_control, tau_net)\n", out.string().c_str(),
               kScenarios[0].name, kScenarios[1].name, kScenarios[2].name);
 

@@ -16,8 +16,8 @@ void warnOutsideLimits(const std::string& file, const Model& model, const Eigen:
   for (int j = 0; j < model.dof(); ++j) {
     const Joint& joint = model.joint(j);
     if (std::isnan(q[j]) || (q[j] >= joint.lower && q[j] <= joint.upper)) continue;  // NaN: the solve refuses it
-    std::fprintf(stderr, "zwang: warning: %s: q[%d] = %g puts joint '%s' outside its limits [%g, %g]\n", file.c_str(), j,
-                 q[j], printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
+    std::fprintf(stderr, "zwang: warning: %s: q[%d] = %g puts joint '%s' outside its limits [%g, %g]\n", file.c_str(),
+                 j, q[j], printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
   }
 }
 

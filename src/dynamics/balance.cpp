@@ -279,7 +279,7 @@ void balanceApply(const BalanceFactorisation& f, const Eigen::Ref<const Eigen::V
   const auto V = f.factor.topLeftCorner(m, m);
   const auto e = f.equilibration.head(m);
   removeNearNullComponent(Z, w, out);  // r's part along null(𝓛): no force can meet it (least squares)
-  out.array() *= e.array();     // into 𝓛̃'s coordinates: 𝓛⁺ = E 𝓛̃⁺ E on range(𝓛)
+  out.array() *= e.array();            // into 𝓛̃'s coordinates: 𝓛⁺ = E 𝓛̃⁺ E on range(𝓛)
   for (Eigen::Index k = 0; k < m; ++k) work[k] = f.gain[k] * V.col(k).dot(out);
   out.setZero();
   for (Eigen::Index k = 0; k < m; ++k) out += V.col(k) * work[k];

@@ -12,12 +12,12 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   using namespace internal;
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   Solution& out = ws.solution;
-  jointsOutsideLimits(model, q, out);                            // a warning: solved as given
-  outwardSweep(model, task, q, qd, ws);                          // lines 2–10
+  jointsOutsideLimits(model, q, out);                              // a warning: solved as given
+  outwardSweep(model, task, q, qd, ws);                            // lines 2–10
   if (Status s = inwardSweep(model, task, tau, ws); !s) return s;  // lines 11–22
-  balance(task, ws);                                             // lines 23–25
-  outwardAccelerations(model, task, ws, out.qdd);                // lines 26–30
-  taskResidual(task, ws);                                        // how well Aᵀ Ẍ = b is met
+  balance(task, ws);                                               // lines 23–25
+  outwardAccelerations(model, task, ws, out.qdd);                  // lines 26–30
+  taskResidual(task, ws);                                          // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(task.constraintRows()), out.tau_constraint);
   out.tau_control = tau + out.tau_constraint;

@@ -1,6 +1,6 @@
+#include "zwang/inverse_dynamics.hpp"
 #include "dynamics/checks.hpp"
 #include "dynamics/sweeps.hpp"
-#include "zwang/inverse_dynamics.hpp"
 
 namespace zwang {
 

@@ -55,8 +55,8 @@ Status checkWorkspace(const Model& model, const Workspace& ws) noexcept {
 Status checkFrame(const Model& model, int frame) noexcept {
   const int frames = static_cast<int>(model.frames().size());
   if (frame < 0 || frame >= frames)
-    return Status::error(StatusCode::ModelMismatch, "frame index %d is not a frame of this model (it has %d frames)", frame,
-                         frames);
+    return Status::error(StatusCode::ModelMismatch, "frame index %d is not a frame of this model (it has %d frames)",
+                         frame, frames);
   return {};
 }
 

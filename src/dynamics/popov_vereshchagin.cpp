@@ -14,8 +14,8 @@
 #include <cmath>
 #include <limits>
 
-#include "dynamics/checks.hpp"
 #include "dynamics/balance.hpp"
+#include "dynamics/checks.hpp"
 #include "dynamics/sweeps.hpp"
 
 namespace zwang::internal {
@@ -93,9 +93,9 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
   const int N = model.dof();
   const int m = task.constraintRows();
-  ws.U.head(m).setZero();              // U_N = 0
+  ws.U.head(m).setZero();  // U_N = 0
   ws.L_scale.head(m).setZero();
-  ws.L.topLeftCorner(m, m).setZero();  // 𝓛_N = 0 (only the lower triangle is kept)
+  ws.L.topLeftCorner(m, m).setZero();   // 𝓛_N = 0 (only the lower triangle is kept)
   ws.IA[at(N)] = ws.I[at(N)].matrix();  // line 9 for the last body
   ws.FA[at(N)] = ws.Fbias[at(N)];       // line 8
   ConstraintMatrix& A = ws.Ahat;        // A_i, updated in place
@@ -113,8 +113,8 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
       return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)",
                            joint.name.c_str(), D);
     Vec6 pA = ws.FA[at(i)];
-    pA.noalias() += IA * c;                    // F^A + I^A Ẍ_bias
-    const double u = tau[i - 1] - S.dot(pA);   // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
+    pA.noalias() += IA * c;                   // F^A + I^A Ẍ_bias
+    const double u = tau[i - 1] - S.dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
     ws.u[at(i)] = u;
     const double inverse_D = 1.0 / D;  // one division per body; the rest multiply
     const double u_D = u * inverse_D;
@@ -125,13 +125,13 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     double* sA = ws.SA.col(i).data();
     const double SS_D = S.squaredNorm() * inverse_D;
     for (int col = 0; col < k; ++col) {
-      sA[col] = S.dot(A.col(col));                          // (Sᵀ A_i)ᵀ
+      sA[col] = S.dot(A.col(col));                         // (Sᵀ A_i)ᵀ
       ws.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
     }
     for (int col = 0; col < k; ++col) {
       const double sA_D = sA[col] * inverse_D;
       ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
-      double* L_col = &ws.L(0, col);                     // line 21 (sign: see top), lower triangle
+      double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
       for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
       A.col(col) -= IAS * sA_D;  // line 19: A_{i−1} = P^A A_i …
     }
@@ -161,7 +161,7 @@ void balance(const Task& task, Workspace& ws) {
       for (int col = 0; col <= r; ++col) ws.L(r, col) = 0.0;
       for (int row = r; row < m; ++row) ws.L(row, r) = 0.0;
     }
-  ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);  // line 25 …
+  ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);                                                // line 25 …
   ws.rhs.head(m).noalias() -= ws.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
   ws.solution.balance =
       solveBalance(ws.L.topLeftCorner(m, m), ws.rhs.head(m), ws.nu.head(m), ws.balance_factorisation, task.balance);
@@ -172,9 +172,9 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   for (int i = 1; i <= model.dof(); ++i) {
     const Vec6& a_parent = ws.a[at(i - 1)];
     const int k = task.activeColumns(i);
-    const double constraint = ws.SA.col(i).head(k).dot(ws.nu.head(k));                  // Sᵀ A_i ν
+    const double constraint = ws.SA.col(i).head(k).dot(ws.nu.head(k));                    // Sᵀ A_i ν
     qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(a_parent) + constraint) / ws.D[at(i)];  // line 28
-    ws.a[at(i)] = a_parent + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                     // line 29
+    ws.a[at(i)] = a_parent + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                      // line 29
   }
 }
 
@@ -210,7 +210,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
       du(i, c) = du_ic;
       const double du_D = du_ic * inverse_D;
       for (int r = 0; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
-      dF.col(c) += IAS * du_D;                                       // lines 17–18
+      dF.col(c) += IAS * du_D;                                      // lines 17–18
     }
   }
   du.row(0).setZero();

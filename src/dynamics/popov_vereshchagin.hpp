@@ -16,7 +16,9 @@ using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 // The body joint j moves (joint j − 1 moves body j: 0 is the fixed base), and
 // that joint's articulated inertia D (line 13) after the inward sweep.
 inline int bodyOfJoint(int joint) { return joint + 1; }
-inline double jointInertia(const Workspace& ws, int joint) { return ws.D[static_cast<std::size_t>(bodyOfJoint(joint))]; }
+inline double jointInertia(const Workspace& ws, int joint) {
+  return ws.D[static_cast<std::size_t>(bodyOfJoint(joint))];
+}
 
 // Input checks shared by every solve (the balance options included).
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,

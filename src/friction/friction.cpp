@@ -21,10 +21,10 @@
 #include <cmath>
 #include <limits>
 
-#include "qp/box_qp.hpp"
 #include "dynamics/checks.hpp"
-#include "friction/friction_scratch.hpp"
 #include "dynamics/popov_vereshchagin.hpp"
+#include "friction/friction_scratch.hpp"
+#include "qp/box_qp.hpp"
 
 namespace zwang {
 
@@ -56,8 +56,9 @@ Status checkOptions(const Model& model, const FrictionOptions& o) {
                            ov.name, static_cast<long>(ov.v.size()), n);
     for (Eigen::Index j = 0; j < ov.v.size(); ++j)
       if (!std::isfinite(ov.v[j]) || ov.v[j] < 0.0)
-        return Status::error(StatusCode::BadOption, "friction override '%s' for joint '%s' is %g (must be finite and >= 0)",
-                             ov.name, model.joint(static_cast<int>(j)).name.c_str(), ov.v[j]);
+        return Status::error(StatusCode::BadOption,
+                             "friction override '%s' for joint '%s' is %g (must be finite and >= 0)", ov.name,
+                             model.joint(static_cast<int>(j)).name.c_str(), ov.v[j]);
   }
   if (!(o.velocity_tolerance >= 0.0) || !std::isfinite(o.velocity_tolerance))
     return Status::error(StatusCode::BadOption, "velocity_tolerance %g must be finite and >= 0", o.velocity_tolerance);
@@ -74,8 +75,9 @@ Status checkOptions(const Model& model, const FrictionOptions& o) {
 // box Λ (a joint on a position limit gets an unbounded side: the stop pushes);
 // kinetic and viscous friction of the moving joints folded into τ.
 void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
-                                const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                                const FrictionOptions& options, FrictionScratch& fs, FrictionResult& fr) {
+                                const Eigen::Ref<const Eigen::VectorXd>& qd,
+                                const Eigen::Ref<const Eigen::VectorXd>& tau, const FrictionOptions& options,
+                                FrictionScratch& fs, FrictionResult& fr) {
   const int n = model.dof();
   for (int j = 0; j < n; ++j) {
     const Joint& joint = model.joint(j);
@@ -123,8 +125,8 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   outwardAccelerations(model, task, ws, fs.qdd0);
   fs.nu0.head(m) = ws.nu.head(m);
   if (k > 0)
-    unitTorqueColumns(model, task, ws, stuck, fs.du.leftCols(k), fs.dU.topLeftCorner(m, k),
-                      fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da.leftCols(k));
+    unitTorqueColumns(model, task, ws, stuck, fs.du.leftCols(k), fs.dU.topLeftCorner(m, k), fs.dnu.topLeftCorner(m, k),
+                      fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da.leftCols(k));
   return {};
 }
 
@@ -162,8 +164,8 @@ QpReport maximiseDual(const Workspace& ws, const std::vector<int>& stuck, const 
   mu.setZero();  // feasible: 0 ∈ Λ
   if (k == 0) return {};
   return options.method == FrictionMethod::ActiveSet
-             ? boxQpActiveSet(K, fs.qdd0_stuck.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp,
-                              options.max_iterations, tolerance, curvature_scale)
+             ? boxQpActiveSet(K, fs.qdd0_stuck.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp, options.max_iterations,
+                              tolerance, curvature_scale)
              : boxQpProjectedGradient(K, fs.qdd0_stuck.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp,
                                       options.max_iterations, tolerance, curvature_scale);
 }
@@ -270,17 +272,16 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
 
   fr.indeterminate = false;
   Eigen::Index sticking = 0;
-  const Eigen::Index nullity =
-      k > 0 && !report.unbounded
-          ? flatDirections(fs.K.topLeftCorner(k, k), fs.qdd0_stuck.head(k), fs.mu.head(k), fs.lo.head(k),
-                           fs.hi.head(k), acc_tolerance, fs.choice, sticking)
-          : 0;
+  const Eigen::Index nullity = k > 0 && !report.unbounded
+                                   ? flatDirections(fs.K.topLeftCorner(k, k), fs.qdd0_stuck.head(k), fs.mu.head(k),
+                                                    fs.lo.head(k), fs.hi.head(k), acc_tolerance, fs.choice, sticking)
+                                   : 0;
   if (nullity > 0) {
     effortAtFirstMaximiser(model, task, tau, fr.stuck, options, ws, fs);
     const double mu_scale = 1e-9 * (1.0 + fs.breakaway.cwiseAbs().maxCoeff());  // maximisers this close are one
-    fr.indeterminate = leastEffortMaximiser(fs.lo.head(k), fs.hi.head(k), fs.margin_limit.head(k),
-                                            fs.effort_offset.head(k), sticking, nullity, mu_scale,
-                                            options.max_iterations, fs.mu.head(k), fs.choice);
+    fr.indeterminate =
+        leastEffortMaximiser(fs.lo.head(k), fs.hi.head(k), fs.margin_limit.head(k), fs.effort_offset.head(k), sticking,
+                             nullity, mu_scale, options.max_iterations, fs.mu.head(k), fs.choice);
   }
 
   motionAtMaximiser(model, task, k, ws, fs);

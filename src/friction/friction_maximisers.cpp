@@ -110,8 +110,8 @@ Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
 
 bool leastEffortMaximiser(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                           const Eigen::Ref<const Eigen::VectorXd>& margin_limit,
-                          const Eigen::Ref<const Eigen::VectorXd>& effort_offset, Eigen::Index ns,
-                          Eigen::Index nullity, double mu_scale, int max_iterations, Eigen::Ref<Eigen::VectorXd> mu,
+                          const Eigen::Ref<const Eigen::VectorXd>& effort_offset, Eigen::Index ns, Eigen::Index nullity,
+                          double mu_scale, int max_iterations, Eigen::Ref<Eigen::VectorXd> mu,
                           MaximiserChoiceScratch& s) {
   const auto N = s.null_basis.topLeftCorner(ns, nullity);
   const auto sticking = s.sticking.head(ns);

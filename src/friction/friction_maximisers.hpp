@@ -14,8 +14,20 @@ namespace zwang::internal {
 // k stuck joints), s over Σ ⊆ Θ₀ (the ns sticking ones).
 struct MaximiserChoiceScratch {
   explicit MaximiserChoiceScratch(int n)
-      : qdd_star(n), sticking(n), K_sticking(n, n), null_basis(n, n), pivots(n), mu_first(n), lo(n), hi(n),
-        curvature_direction(n), mu_chosen(n), target(n), z(n), z_target(n), qp(n) {}
+      : qdd_star(n),
+        sticking(n),
+        K_sticking(n, n),
+        null_basis(n, n),
+        pivots(n),
+        mu_first(n),
+        lo(n),
+        hi(n),
+        curvature_direction(n),
+        mu_chosen(n),
+        target(n),
+        z(n),
+        z_target(n),
+        qp(n) {}
   Eigen::VectorXd qdd_star;             // q̈*_Θ = q̈_Θ(0) − K_ΘΘ μ* (k)
   Eigen::VectorXi sticking;             // position in Θ₀ of each sticking joint (ns)
   Eigen::MatrixXd K_sticking;           // K_ΣΣ (ns × ns), factored in place by nearNullSpace
@@ -50,8 +62,8 @@ Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
 // size below which two maximisers count as the same.
 bool leastEffortMaximiser(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                           const Eigen::Ref<const Eigen::VectorXd>& margin_limit,
-                          const Eigen::Ref<const Eigen::VectorXd>& effort_offset, Eigen::Index ns,
-                          Eigen::Index nullity, double mu_scale, int max_iterations, Eigen::Ref<Eigen::VectorXd> mu,
+                          const Eigen::Ref<const Eigen::VectorXd>& effort_offset, Eigen::Index ns, Eigen::Index nullity,
+                          double mu_scale, int max_iterations, Eigen::Ref<Eigen::VectorXd> mu,
                           MaximiserChoiceScratch& s);
 
 }  // namespace zwang::internal

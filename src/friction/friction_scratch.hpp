@@ -2,19 +2,39 @@
 // after docs/friction.md's sections; indices a run over Θ₀, the k stuck joints.
 #pragma once
 
-#include "qp/box_qp.hpp"
-#include "friction/friction_maximisers.hpp"
 #include "dynamics/popov_vereshchagin.hpp"
+#include "friction/friction_maximisers.hpp"
+#include "qp/box_qp.hpp"
 #include "zwang/workspace.hpp"
 
 namespace zwang::internal {
 
 struct FrictionScratch {
   FrictionScratch(int dof, int bodies, int capacity)
-      : breakaway(dof), kinetic(dof), viscous(dof), tau_effective(dof), lo(dof), hi(dof), qdd0(dof),
-        nu0(capacity), du(bodies, dof), dU(capacity, dof), dnu(capacity, dof), dqdd(dof, dof), dF(6, dof),
-        da(6, dof), K(dof, dof), qdd0_stuck(dof), mu(dof), qp(dof), margin_limit(dof), effort_offset(dof),
-        nu_first(capacity), tau_constraint_first(dof), choice(dof), tau_joint(dof) {}
+      : breakaway(dof),
+        kinetic(dof),
+        viscous(dof),
+        tau_effective(dof),
+        lo(dof),
+        hi(dof),
+        qdd0(dof),
+        nu0(capacity),
+        du(bodies, dof),
+        dU(capacity, dof),
+        dnu(capacity, dof),
+        dqdd(dof, dof),
+        dF(6, dof),
+        da(6, dof),
+        K(dof, dof),
+        qdd0_stuck(dof),
+        mu(dof),
+        qp(dof),
+        margin_limit(dof),
+        effort_offset(dof),
+        nu_first(capacity),
+        tau_constraint_first(dof),
+        choice(dof),
+        tau_joint(dof) {}
 
   // The model of friction, per joint (the options' overrides, else the model's)
   Eigen::VectorXd breakaway, kinetic, viscous;  // f_j, f_c,j, b_j
@@ -22,13 +42,13 @@ struct FrictionScratch {
   Eigen::VectorXd lo, hi;                       // Λ on Θ₀ (±∞ where a limit stop pushes)
 
   // ∂q̈/∂μ in the same sweeps
-  Eigen::VectorXd qdd0;    // q̈(μ = 0)
-  Eigen::VectorXd nu0;     // ν(μ = 0), solver order
-  Eigen::MatrixXd du;      // bodies × k: δu_i per unit torque (sweep scratch)
-  Eigen::MatrixXd dU;      // capacity × k: δU₀ per unit torque
-  Eigen::MatrixXd dnu;     // capacity × k: δν per unit torque
-  Eigen::MatrixXd dqdd;    // dof × k: δq̈ per unit torque
-  Matrix6X dF, da;         // 6 × k: δF^A and δẌ per unit torque (sweep scratch)
+  Eigen::VectorXd qdd0;  // q̈(μ = 0)
+  Eigen::VectorXd nu0;   // ν(μ = 0), solver order
+  Eigen::MatrixXd du;    // bodies × k: δu_i per unit torque (sweep scratch)
+  Eigen::MatrixXd dU;    // capacity × k: δU₀ per unit torque
+  Eigen::MatrixXd dnu;   // capacity × k: δν per unit torque
+  Eigen::MatrixXd dqdd;  // dof × k: δq̈ per unit torque
+  Matrix6X dF, da;       // 6 × k: δF^A and δẌ per unit torque (sweep scratch)
 
   // The maximiser: min ½ μᵀ K_ΘΘ μ − μᵀ q̈_Θ(0) over Λ
   Eigen::MatrixXd K;           // K_ΘΘ = rows Θ of −∂q̈/∂μ

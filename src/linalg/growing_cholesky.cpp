@@ -72,7 +72,7 @@ void GrowingCholesky::remove(int position) {
 
 void GrowingCholesky::solveInPlace(Eigen::Ref<Eigen::VectorXd> x) const {
   for (int a = 0; a < size_; ++a) x[a] = (x[a] - U_.col(a).head(a).dot(x.head(a))) / U_(a, a);  // L y = x
-  for (int a = size_ - 1; a >= 0; --a) {  // U x = y, by columns
+  for (int a = size_ - 1; a >= 0; --a) {                                                        // U x = y, by columns
     x[a] /= U_(a, a);
     x.head(a) -= x[a] * U_.col(a).head(a);
   }
@@ -109,7 +109,7 @@ Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::R
   if (nullity == 0) return 0;
   for (Eigen::Index j = 0; j < r; ++j) {
     for (Eigen::Index i = 0; i < j; ++i) A(i, j) = 0.0;  // L is lower trapezoidal (above: scratch)
-    for (Eigen::Index h = 0; h < j; ++h) {                // the earlier reflectors act on column j
+    for (Eigen::Index h = 0; h < j; ++h) {               // the earlier reflectors act on column j
       double dot = 0.0;
       for (Eigen::Index i = h; i < n; ++i) dot += A(i, h) * A(i, j);
       for (Eigen::Index i = h; i < n; ++i) A(i, j) -= 2.0 * dot * A(i, h);
@@ -117,7 +117,7 @@ Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::R
     double norm2 = 0.0;
     for (Eigen::Index i = j; i < n; ++i) norm2 += A(i, j) * A(i, j);
     const double alpha = A(j, j) >= 0.0 ? std::sqrt(norm2) : -std::sqrt(norm2);
-    A(j, j) += alpha;  // v = x + sign(x_j)‖x‖ e_j, then normalised
+    A(j, j) += alpha;                                        // v = x + sign(x_j)‖x‖ e_j, then normalised
     const double v_norm = std::sqrt(2.0 * alpha * A(j, j));  // ‖v‖² = 2α(x_j + α)
     const double scale = v_norm > 0.0 ? 1.0 / v_norm : 0.0;
     for (Eigen::Index i = j; i < n; ++i) A(i, j) *= scale;

@@ -194,7 +194,8 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
 
   // The joint's placement is relative to the parent link's frame; rebase it on
   // the parent body's frame (they differ when the parent link was merged in).
-  if (!parent_frame.empty()) joint.placement = joint.placement * model_.frame(model_.frameIndex(parent_frame)).placement;
+  if (!parent_frame.empty())
+    joint.placement = joint.placement * model_.frame(model_.frameIndex(parent_frame)).placement;
 
   model_.joints_.push_back(joint);
   model_.inertias_.push_back(child_inertia);
@@ -252,7 +253,8 @@ ModelBuilder& ModelBuilder::setRotorInertia(const std::string& joint, double val
 ModelBuilder& ModelBuilder::setFriction(const std::string& joint, double breakaway, double kinetic, double viscous) {
   for (double v : {breakaway, kinetic, viscous})
     if (!std::isfinite(v) || v < 0.0)
-      throw ModelError("joint '" + joint + "': breakaway, kinetic and viscous friction must be finite and non-negative");
+      throw ModelError("joint '" + joint +
+                       "': breakaway, kinetic and viscous friction must be finite and non-negative");
   Joint& j = jointNamed(joint);
   j.breakaway_friction = breakaway;
   j.kinetic_friction = kinetic;
@@ -264,7 +266,8 @@ Model ModelBuilder::build() const {
   // Each link passed on its own; their sum is checked too, to rounding of the
   // merged figures, so no moving body reaches a solve with a negative moment.
   for (int b = 1; b < model_.bodyCount(); ++b) {
-    const std::string link = model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(b)])].name;
+    const std::string link =
+        model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(b)])].name;
     validate::rigidInertia("body of link '" + link + "' (with the links welded to it)",
                            model_.inertias_[static_cast<std::size_t>(b)]);
   }
@@ -277,9 +280,10 @@ Model ModelBuilder::build() const {
     mass_beyond += I.mass + I.Ibar.trace();
     const Joint& joint = model_.joints_[static_cast<std::size_t>(j)];
     if (mass_beyond <= 0.0 && joint.rotor_inertia <= 0.0) {
-      const std::string link = model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(j + 1)])].name;
-      throw ModelError("link '" + link + "': zero mass on a moving body with nothing beyond it (joint '" +
-                       joint.name + "' would have no inertia to move)");
+      const std::string link =
+          model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(j + 1)])].name;
+      throw ModelError("link '" + link + "': zero mass on a moving body with nothing beyond it (joint '" + joint.name +
+                       "' would have no inertia to move)");
     }
   }
   return model_;

@@ -25,7 +25,9 @@ int lookup(const std::vector<std::string>& names, const std::string& name) {
 int Task::addConstraint(int frame, const ConstraintMatrix& A, Expressed expressed) {
   if (frame < 0 || frame >= frames_) throw ModelError("task: frame index " + std::to_string(frame) + " out of range");
   if (A.cols() == 0) throw ModelError("task: a constraint needs at least one column");
-  if (!A.allFinite()) throw ModelError("task: constraint matrix on frame '" + frame_names_[static_cast<std::size_t>(frame)] + "' is not finite");
+  if (!A.allFinite())
+    throw ModelError("task: constraint matrix on frame '" + frame_names_[static_cast<std::size_t>(frame)] +
+                     "' is not finite");
   const int first = constraintRows();
   groups_.push_back(ConstraintGroup{frame, frame_bodies_[static_cast<std::size_t>(frame)], expressed, first,
                                     static_cast<int>(A.cols()), A});

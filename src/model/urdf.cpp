@@ -177,8 +177,10 @@ class CaptureHandler final : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char* filename, int line) override {
     if (errors != nullptr) {
-      if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors->push_back(text);
-      else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) warnings->push_back(text);
+      if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR)
+        errors->push_back(text);
+      else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN)
+        warnings->push_back(text);
     } else if (forward != nullptr && forward != this && level >= forward_level) {
       forward->log(text, level, filename, line);
     }
@@ -291,8 +293,7 @@ std::map<std::string, double> readTransmissions(const Reporter& report, const Ti
     if (joints.size() != 1)
       report.fail(who + ": a <drake:rotor_inertia> needs exactly one <joint name=…> in its transmission, found " +
                   std::to_string(joints.size()));
-    if (!urdf_model.getJoint(joints[0]))
-      report.fail(who + ": <joint> '" + joints[0] + "' is not a joint of the URDF");
+    if (!urdf_model.getJoint(joints[0])) report.fail(who + ": <joint> '" + joints[0] + "' is not a joint of the URDF");
     if (!reflected.emplace(joints[0], rotor_inertia).second)
       report.fail(who + ": joint '" + joints[0] + "' already has a rotor inertia from another transmission");
   }
@@ -302,7 +303,9 @@ std::map<std::string, double> readTransmissions(const Reporter& report, const Ti
 // ---------------------------------------------------------------------------
 // Geometry and inertia
 
-Mat3 rotationOf(const urdf::Rotation& q) { return Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix(); }
+Mat3 rotationOf(const urdf::Rotation& q) {
+  return Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+}
 Vec3 vectorOf(const urdf::Vector3& v) { return Vec3(v.x, v.y, v.z); }
 
 // ᶜX_p of a joint: the child link's frame (at q = 0) seen from its parent's.
@@ -326,7 +329,7 @@ RigidInertia linkInertia(const Reporter& report, const urdf::Link& link, bool on
       report.fail(who + " <mass> value " + fmt(in.mass) + " kg is above " + fmt(validate::kMaxMass) +
                   " kg, the heaviest link zwang accepts (a typo?)");
   }
-  Mat3 I_frame;  // in the COM frame given by <inertial><origin>
+  Mat3 I_frame;                       // in the COM frame given by <inertial><origin>
   I_frame << in.ixx, in.ixy, in.ixz,  //
       in.ixy, in.iyy, in.iyz,         //
       in.ixz, in.iyz, in.izz;
@@ -418,7 +421,7 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
     if (dyn.damping < 0.0) report.fail(who + ": <dynamics> damping " + fmt(dyn.damping) + " is negative");
     joint.breakaway_friction = dyn.friction;
     joint.kinetic_friction = dyn.friction;  // default f_c = f: docs/friction.md, "The model of friction"
-    joint.viscous_friction = dyn.damping;  // URDF calls the viscous coefficient "damping"
+    joint.viscous_friction = dyn.damping;   // URDF calls the viscous coefficient "damping"
   }
 
   const auto r = rotor.find(uj.name);
@@ -458,13 +461,11 @@ std::vector<LinkPtr> chainLinks(const Reporter& report, const urdf::ModelInterfa
         return path;
       }
     }
-    report.fail("tip link '" + tip_name + "' is not below root link '" + root->name + "' (its ancestors: " +
-                [&] {
-                  std::vector<std::string> names;
-                  for (std::size_t k = 1; k < path.size(); ++k) names.push_back(path[k]->name);
-                  return names.empty() ? std::string("none") : nameList(names);
-                }() +
-                ")");
+    report.fail("tip link '" + tip_name + "' is not below root link '" + root->name + "' (its ancestors: " + [&] {
+      std::vector<std::string> names;
+      for (std::size_t k = 1; k < path.size(); ++k) names.push_back(path[k]->name);
+      return names.empty() ? std::string("none") : nameList(names);
+    }() + ")");
   }
   // No tip given: follow the single branch that leads to moving joints.
   LinkPtr link = root;
@@ -597,8 +598,8 @@ void addChain(const Reporter& report, ModelBuilder& builder, Placement& placemen
 // ᶜX_p of a joint locked at position q (revolute and continuous turn about the
 // axis, prismatic slides along it; other types stay at their origin).
 Transform lockedPlacement(const Reporter& report, const urdf::Joint& uj, double q) {
-  if (q == 0.0 || (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS &&
-                   uj.type != urdf::Joint::PRISMATIC))
+  if (q == 0.0 ||
+      (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS && uj.type != urdf::Joint::PRISMATIC))
     return placementOf(uj);
   std::vector<ModelWarning> ignored;
   const Joint joint = makeJoint(report, uj, {}, ignored);
@@ -623,7 +624,8 @@ BeyondTip findBeyondTip(const Placement& placement) {
     const LinkPtr link = queue[head].second;
     beyond.links.push_back(queue[head]);
     if (link->inertial && std::isfinite(link->inertial->mass)) beyond.mass += link->inertial->mass;
-    for (std::size_t k = 0; k < link->child_joints.size(); ++k) queue.emplace_back(link->child_joints[k], link->child_links[k]);
+    for (std::size_t k = 0; k < link->child_joints.size(); ++k)
+      queue.emplace_back(link->child_joints[k], link->child_links[k]);
   }
   return beyond;
 }
@@ -648,21 +650,24 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
                            (joints.size() == 1 ? " " : "s ") + nameList(joints) + " beyond the tip '" + tip + "'";
   if (!options.attach_beyond_tip) {
     const char* verb = links.size() == 1 ? " is" : " are";
-    placement.warnings.push_back({WarningCode::MassBeyondTip, what + verb + " not on the chain: their mass is ignored (set " +
+    placement.warnings.push_back({WarningCode::MassBeyondTip, what + verb +
+                                                                  " not on the chain: their mass is ignored (set " +
                                                                   options.names.attach_beyond_tip +
                                                                   " to carry them as a payload of the tip body)"});
     return;
   }
   for (const auto& [joint, link] : beyond.links) {
     const auto locked = options.locked_positions.find(joint->name);
-    const Transform X = lockedPlacement(report, *joint, locked == options.locked_positions.end() ? 0.0 : locked->second);
+    const Transform X =
+        lockedPlacement(report, *joint, locked == options.locked_positions.end() ? 0.0 : locked->second);
     const RigidInertia inertia = linkInertia(report, *link, false);
     const std::string& name = link->name;  // clang 14: a lambda cannot capture structured bindings
     const std::string& parent = joint->parent_link_name;
     report.builder([&] { builder.addFixedFrame(name, parent, X, inertia); });
   }
-  placement.warnings.push_back({WarningCode::PayloadAttached, what + (links.size() == 1 ? " is" : " are") +
-                                                                  " welded to the tip body as a payload, those joints locked"});
+  placement.warnings.push_back(
+      {WarningCode::PayloadAttached,
+       what + (links.size() == 1 ? " is" : " are") + " welded to the tip body as a payload, those joints locked"});
 }
 
 // Strict mode: every warning about the data is an error. PayloadAttached only
@@ -676,7 +681,8 @@ void refuseWarnings(const Reporter& report, const Model& model) {
     ++count;
   }
   if (count > 0)
-    report.fail("refused in strict mode (" + std::to_string(count) + " warning" + (count == 1 ? "" : "s") + "): " + all);
+    report.fail("refused in strict mode (" + std::to_string(count) + " warning" + (count == 1 ? "" : "s") +
+                "): " + all);
 }
 
 Model load(const Reporter& report, const std::string& xml, const UrdfOptions& options) {
@@ -705,10 +711,11 @@ Model load(const Reporter& report, const std::string& xml, const UrdfOptions& op
     report.fail("the chain from root link '" + root->name + "' to tip link '" + tip_name + "' has no moving joint");
   for (const auto& entry : options.rotor_inertia) {
     if (std::find(moving.begin(), moving.end(), entry.first) != moving.end()) continue;
-    report.fail(options.names.rotor_inertia + " names joint '" + entry.first +
-                "', which is not a moving joint of the chain from '" + root->name + "' to '" + tip_name +
-                "' (chain joints: " + nameList(moving) + ")" +
-                (urdf_model->getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
+    report.fail(
+        options.names.rotor_inertia + " names joint '" + entry.first +
+        "', which is not a moving joint of the chain from '" + root->name + "' to '" + tip_name +
+        "' (chain joints: " + nameList(moving) + ")" +
+        (urdf_model->getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
   }
 
   ModelBuilder builder(urdf_model->getName(), root->name);

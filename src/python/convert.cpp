@@ -47,7 +47,8 @@ void copyReal(const char* name, const py::array& a, double* out) {
   py::array_t<double, py::array::forcecast> converted = py::array_t<double, py::array::forcecast>::ensure(a);
   if (!converted) {
     PyErr_Clear();
-    raise(PyExc_TypeError, std::string(name) + ": cannot convert dtype " + std::string(py::str(a.dtype())) + " to float64");
+    raise(PyExc_TypeError,
+          std::string(name) + ": cannot convert dtype " + std::string(py::str(a.dtype())) + " to float64");
   }
   const auto view = converted.unchecked<1>();
   for (py::ssize_t k = 0; k < n; ++k) out[k] = view(k);
@@ -55,8 +56,7 @@ void copyReal(const char* name, const py::array& a, double* out) {
 
 py::array vectorArray(const char* name, py::handle value) {
   py::array a = realArray(name, value);
-  if (a.ndim() != 1)
-    raise(PyExc_ValueError, std::string(name) + ": expected a 1-D array, got shape " + shapeText(a));
+  if (a.ndim() != 1) raise(PyExc_ValueError, std::string(name) + ": expected a 1-D array, got shape " + shapeText(a));
   return a;
 }
 

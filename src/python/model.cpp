@@ -15,8 +15,8 @@ std::string pathArg(py::handle path) {
   return fs.cast<std::string>();
 }
 
-UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia,
-                        bool strict, bool attach_beyond_tip) {
+UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia, bool strict,
+                        bool attach_beyond_tip) {
   UrdfOptions options;
   options.root = root;
   options.tip = tip;
@@ -53,8 +53,9 @@ Eigen::VectorXd perJointArg(const Model& model, const char* name, py::handle val
   Eigen::VectorXd buffer;
   Eigen::VectorXd v = vectorArg(name, value, buffer);
   if (v.size() != model.dof())
-    raise(exceptions().model_error, std::string(name) + ": has " + std::to_string(v.size()) + " entries, the model has " +
-                                        std::to_string(model.dof()) + " joints (" + jointNames(model) + ")");
+    raise(exceptions().model_error, std::string(name) + ": has " + std::to_string(v.size()) +
+                                        " entries, the model has " + std::to_string(model.dof()) + " joints (" +
+                                        jointNames(model) + ")");
   return v;
 }
 
@@ -65,9 +66,7 @@ py::array transformMatrix(const Eigen::Matrix3d& R, const Vec3& p) {
   return matrixCopy(T);
 }
 
-std::string jointRepr(const Joint& j) {
-  return "<zwang.Joint '" + j.name + "' " + toString(j.type) + ">";
-}
+std::string jointRepr(const Joint& j) { return "<zwang.Joint '" + j.name + "' " + toString(j.type) + ">"; }
 
 // Each of the model's warnings through Python's warnings machinery (so filters
 // apply: "error" turns one into an exception, "ignore" silences it).
@@ -82,120 +81,159 @@ std::shared_ptr<Model> issueWarnings(std::shared_ptr<Model> model) {
 void bindModel(py::module_& m) {
   py::class_<Joint>(m, "Joint", "A moving joint of the chain (read-only; SI units, radians).")
       .def_property_readonly("name", [](const Joint& j) { return j.name; })
-      .def_property_readonly("type", [](const Joint& j) { return std::string(toString(j.type)); },
-                             "'revolute', 'continuous' or 'prismatic'")
-      .def_property_readonly("axis", [](const Joint& j) { return vectorCopy(j.axis); },
-                             "unit axis in the joint (child link) frame")
+      .def_property_readonly(
+          "type", [](const Joint& j) { return std::string(toString(j.type)); },
+          "'revolute', 'continuous' or 'prismatic'")
+      .def_property_readonly(
+          "axis", [](const Joint& j) { return vectorCopy(j.axis); }, "unit axis in the joint (child link) frame")
       .def_property_readonly("lower", [](const Joint& j) { return j.lower; })
       .def_property_readonly("upper", [](const Joint& j) { return j.upper; })
       .def_property_readonly("effort_limit", [](const Joint& j) { return j.effort_limit; })
       .def_property_readonly("velocity_limit", [](const Joint& j) { return j.velocity_limit; })
-      .def_property_readonly("breakaway_friction", [](const Joint& j) { return j.breakaway_friction; },
-                             "f_j >= 0, the static friction bound (URDF <dynamics friction>)")
+      .def_property_readonly(
+          "breakaway_friction", [](const Joint& j) { return j.breakaway_friction; },
+          "f_j >= 0, the static friction bound (URDF <dynamics friction>)")
       .def_property_readonly("kinetic_friction", [](const Joint& j) { return j.kinetic_friction; })
       .def_property_readonly("viscous_friction", [](const Joint& j) { return j.viscous_friction; })
       .def_property_readonly("rotor_inertia", [](const Joint& j) { return j.rotor_inertia; })
-      .def_property_readonly("placement", [](const Joint& j) {
-        return transformMatrix(j.placement.rotationOfTarget(), j.placement.originOfTarget());
-      }, "4×4 pose of the joint frame in the parent body frame at q = 0")
+      .def_property_readonly(
+          "placement",
+          [](const Joint& j) { return transformMatrix(j.placement.rotationOfTarget(), j.placement.originOfTarget()); },
+          "4×4 pose of the joint frame in the parent body frame at q = 0")
       .def("__repr__", &jointRepr);
 
   py::class_<Frame>(m, "Frame", "A named frame (every URDF link), rigidly attached to a body.")
       .def_property_readonly("name", [](const Frame& f) { return f.name; })
-      .def_property_readonly("body", [](const Frame& f) { return f.body; }, "0 is the base; joint j moves body j+1")
-      .def_property_readonly("placement", [](const Frame& f) {
-        return transformMatrix(f.placement.rotationOfTarget(), f.placement.originOfTarget());
-      }, "4×4 pose of the frame in its body frame")
-      .def("__repr__", [](const Frame& f) { return "<zwang.Frame '" + f.name + "' on body " + std::to_string(f.body) + ">"; });
+      .def_property_readonly(
+          "body", [](const Frame& f) { return f.body; }, "0 is the base; joint j moves body j+1")
+      .def_property_readonly(
+          "placement",
+          [](const Frame& f) { return transformMatrix(f.placement.rotationOfTarget(), f.placement.originOfTarget()); },
+          "4×4 pose of the frame in its body frame")
+      .def("__repr__",
+           [](const Frame& f) { return "<zwang.Frame '" + f.name + "' on body " + std::to_string(f.body) + ">"; });
 
   py::class_<Model, std::shared_ptr<Model>>(m, "Model",
                                             "An immutable serial chain (zwang::Model). Make one with load_urdf().")
       .def_property_readonly("name", &Model::name)
       .def_property_readonly("dof", &Model::dof, "number of moving joints")
-      .def_property_readonly("joint_names", [](const Model& model) {
-        py::list names;
-        for (const Joint& j : model.joints()) names.append(j.name);
-        return names;
-      })
-      .def_property_readonly("frame_names", [](const Model& model) {
-        py::list names;
-        for (const Frame& f : model.frames()) names.append(f.name);
-        return names;
-      })
-      .def_property_readonly("joints", [](const Model& model) { return model.joints(); }, "list of Joint (copies)")
-      .def_property_readonly("frames", [](const Model& model) { return model.frames(); }, "list of Frame (copies)")
-      .def("joint", [](const Model& model, const std::string& name) { return model.joint(model.jointIndex(name)); },
-           py::arg("name"))
+      .def_property_readonly(
+          "joint_names",
+          [](const Model& model) {
+    py::list names;
+    for (const Joint& j : model.joints()) names.append(j.name);
+    return names;
+          })
+      .def_property_readonly(
+          "frame_names",
+          [](const Model& model) {
+    py::list names;
+    for (const Frame& f : model.frames()) names.append(f.name);
+    return names;
+          })
+      .def_property_readonly(
+          "joints", [](const Model& model) { return model.joints(); }, "list of Joint (copies)")
+      .def_property_readonly(
+          "frames", [](const Model& model) { return model.frames(); }, "list of Frame (copies)")
+      .def(
+          "joint", [](const Model& model, const std::string& name) { return model.joint(model.jointIndex(name)); },
+          py::arg("name"))
       .def("joint_index", &Model::jointIndex, py::arg("name"), "index of a moving joint; ModelError if unknown")
       .def("frame_index", &Model::frameIndex, py::arg("name"), "index of a frame; ModelError if unknown")
       .def("has_frame", &Model::hasFrame, py::arg("name"))
-      .def_property_readonly("lower", [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.lower; }); })
-      .def_property_readonly("upper", [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.upper; }); })
-      .def_property_readonly("effort_limit",
-                             [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.effort_limit; }); })
-      .def_property_readonly("velocity_limit",
-                             [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.velocity_limit; }); })
-      .def_property_readonly("breakaway_friction", [](const Model& model) {
-        return perJoint(model, [](const Joint& j) { return j.breakaway_friction; });
-      })
-      .def_property_readonly("kinetic_friction", [](const Model& model) {
-        return perJoint(model, [](const Joint& j) { return j.kinetic_friction; });
-      })
-      .def_property_readonly("viscous_friction", [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.viscous_friction; }); })
-      .def_property_readonly("rotor_inertia",
-                             [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.rotor_inertia; }); })
-      .def_property_readonly("warnings", [](const Model& model) {
-        py::list out;
-        for (const ModelWarning& w : model.warnings()) out.append(py::make_tuple(toString(w.code), w.message));
-        return out;
-      }, "list of (code, message): what was doubtful in the data ('point_mass', 'placeholder_inertia', ...)")
-      .def_property_readonly("base_mass", [](const Model& model) { return model.inertia(0).mass; },
-                             "mass welded to the fixed base (not in the dynamics) [kg]")
-      .def_property_readonly("mass", [](const Model& model) {
-        double mass = 0.0;
-        for (int b = 1; b < model.bodyCount(); ++b) mass += model.inertia(b).mass;
-        return mass;
-      }, "total mass of the moving bodies [kg]")
-      .def("with_rotor_inertia", [](const Model& model, py::handle values) {
-        const Eigen::VectorXd v = perJointArg(model, "rotor_inertia", values);
-        ModelBuilder builder(model);
-        for (int j = 0; j < model.dof(); ++j) builder.setRotorInertia(model.joint(j).name, v[j]);
-        return std::make_shared<Model>(builder.build());
-      }, py::arg("rotor_inertia"), "a copy with these reflected rotor inertias, one per joint")
-      .def("with_friction", [](const Model& model, py::handle breakaway, py::handle kinetic, py::handle viscous) {
-        const Eigen::VectorXd f = perJointArg(model, "breakaway", breakaway);
-        const Eigen::VectorXd fc = kinetic.is_none() ? f : perJointArg(model, "kinetic", kinetic);
-        Eigen::VectorXd b(model.dof());
-        for (int j = 0; j < model.dof(); ++j) b[j] = model.joint(j).viscous_friction;
-        if (!viscous.is_none()) b = perJointArg(model, "viscous", viscous);
-        ModelBuilder builder(model);
-        for (int j = 0; j < model.dof(); ++j) builder.setFriction(model.joint(j).name, f[j], fc[j], b[j]);
-        return std::make_shared<Model>(builder.build());
-      }, py::arg("breakaway"), py::arg("kinetic") = py::none(), py::arg("viscous") = py::none(),
-         "a copy with these friction parameters, one per joint (kinetic defaults to breakaway, viscous to the model's)")
+      .def_property_readonly("lower",
+                             [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.lower; }); })
+      .def_property_readonly("upper",
+                             [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.upper; }); })
+      .def_property_readonly(
+          "effort_limit",
+          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.effort_limit; }); })
+      .def_property_readonly(
+          "velocity_limit",
+          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.velocity_limit; }); })
+      .def_property_readonly(
+          "breakaway_friction",
+          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.breakaway_friction; }); })
+      .def_property_readonly(
+          "kinetic_friction",
+          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.kinetic_friction; }); })
+      .def_property_readonly(
+          "viscous_friction",
+          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.viscous_friction; }); })
+      .def_property_readonly(
+          "rotor_inertia",
+          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.rotor_inertia; }); })
+      .def_property_readonly(
+          "warnings",
+          [](const Model& model) {
+    py::list out;
+    for (const ModelWarning& w : model.warnings()) out.append(py::make_tuple(toString(w.code), w.message));
+    return out;
+          },
+          "list of (code, message): what was doubtful in the data ('point_mass', 'placeholder_inertia', ...)")
+      .def_property_readonly(
+          "base_mass", [](const Model& model) { return model.inertia(0).mass; },
+          "mass welded to the fixed base (not in the dynamics) [kg]")
+      .def_property_readonly(
+          "mass",
+          [](const Model& model) {
+    double mass = 0.0;
+    for (int b = 1; b < model.bodyCount(); ++b) mass += model.inertia(b).mass;
+    return mass;
+          },
+          "total mass of the moving bodies [kg]")
+      .def(
+          "with_rotor_inertia",
+          [](const Model& model, py::handle values) {
+    const Eigen::VectorXd v = perJointArg(model, "rotor_inertia", values);
+    ModelBuilder builder(model);
+    for (int j = 0; j < model.dof(); ++j) builder.setRotorInertia(model.joint(j).name, v[j]);
+    return std::make_shared<Model>(builder.build());
+          },
+          py::arg("rotor_inertia"), "a copy with these reflected rotor inertias, one per joint")
+      .def(
+          "with_friction",
+          [](const Model& model, py::handle breakaway, py::handle kinetic, py::handle viscous) {
+    const Eigen::VectorXd f = perJointArg(model, "breakaway", breakaway);
+    const Eigen::VectorXd fc = kinetic.is_none() ? f : perJointArg(model, "kinetic", kinetic);
+    Eigen::VectorXd b(model.dof());
+    for (int j = 0; j < model.dof(); ++j) b[j] = model.joint(j).viscous_friction;
+    if (!viscous.is_none()) b = perJointArg(model, "viscous", viscous);
+    ModelBuilder builder(model);
+    for (int j = 0; j < model.dof(); ++j) builder.setFriction(model.joint(j).name, f[j], fc[j], b[j]);
+    return std::make_shared<Model>(builder.build());
+          },
+          py::arg("breakaway"), py::arg("kinetic") = py::none(), py::arg("viscous") = py::none(),
+          "a copy with these friction parameters, one per joint (kinetic defaults to breakaway, viscous to the\n"
+          "model's)")
       .def("__repr__", [](const Model& model) {
         return "<zwang.Model '" + model.name() + "': " + std::to_string(model.dof()) + " joints (" + jointNames(model) +
                "), " + std::to_string(model.frames().size()) + " frames>";
       });
 
-  m.def("load_urdf", [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor,
-                        bool strict, bool attach_beyond_tip) {
-    return issueWarnings(std::make_shared<Model>(
-        loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip))));
-  }, py::arg("path"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(),
-        py::kw_only(), py::arg("strict") = false, py::arg("attach_beyond_tip") = false,
-        "Load the chain from link `root` (default: the URDF's root) to link `tip` (default: the unique leaf).\n"
-        "rotor_inertia: optional {joint name: reflected inertia} overriding the URDF.\n"
-        "Doubtful data loads with a zwang.ModelWarning per warning (also in Model.warnings);\n"
-        "strict=True raises ModelError instead. attach_beyond_tip=True welds links behind moving joints\n"
-        "below the tip to the tip body (joints locked at 0). Raises ModelError.");
-  m.def("load_urdf_string", [](const std::string& xml, const std::string& root, const std::string& tip,
-                               const py::object& rotor, bool strict, bool attach_beyond_tip) {
+  m.def(
+      "load_urdf",
+      [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
+         bool attach_beyond_tip) {
+    return issueWarnings(
+        std::make_shared<Model>(loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip))));
+      },
+      py::arg("path"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
+      py::arg("strict") = false, py::arg("attach_beyond_tip") = false,
+      "Load the chain from link `root` (default: the URDF's root) to link `tip` (default: the unique leaf).\n"
+      "rotor_inertia: optional {joint name: reflected inertia} overriding the URDF.\n"
+      "Doubtful data loads with a zwang.ModelWarning per warning (also in Model.warnings);\n"
+      "strict=True raises ModelError instead. attach_beyond_tip=True welds links behind moving joints\n"
+      "below the tip to the tip body (joints locked at 0). Raises ModelError.");
+  m.def(
+      "load_urdf_string",
+      [](const std::string& xml, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
+         bool attach_beyond_tip) {
     return issueWarnings(
         std::make_shared<Model>(loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip))));
-  }, py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(),
-        py::kw_only(), py::arg("strict") = false, py::arg("attach_beyond_tip") = false,
-        "load_urdf from a string holding the URDF XML.");
+      },
+      py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
+      py::arg("strict") = false, py::arg("attach_beyond_tip") = false, "load_urdf from a string holding the URDF XML.");
 }
 
 }  // namespace zwang::python

@@ -38,8 +38,9 @@ PyWorkspace& workspaceArg(const std::shared_ptr<Model>& model, py::handle ws_obj
   PyWorkspace& pw = ws_obj.cast<PyWorkspace&>();
   if (!model) raise(PyExc_TypeError, "model: expected a zwang.Model, got None");
   if (pw.model.get() != model.get()) {
-    Status s = Status::error(StatusCode::ModelMismatch, "the workspace was made for model '%s', not for this model '%s'",
-                             pw.model->name().c_str(), model->name().c_str());
+    Status s =
+        Status::error(StatusCode::ModelMismatch, "the workspace was made for model '%s', not for this model '%s'",
+                      pw.model->name().c_str(), model->name().c_str());
     raiseStatus(s, "solve");
   }
   return pw;
@@ -247,8 +248,7 @@ std::string resultRepr(const Result& r) {
 
 }  // namespace
 
-PyWorkspace::PyWorkspace(std::shared_ptr<Model> model_in, int max_constraint_rows)
-    : model(std::move(model_in)) {
+PyWorkspace::PyWorkspace(std::shared_ptr<Model> model_in, int max_constraint_rows) : model(std::move(model_in)) {
   if (!model) raise(PyExc_TypeError, "model: expected a zwang.Model, got None");
   if (max_constraint_rows < 0) raise(PyExc_ValueError, "max_constraint_rows must be >= 0");
   ws = std::make_unique<Workspace>(*model, max_constraint_rows);
@@ -292,17 +292,19 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("model", [](const PyWorkspace& pw) { return pw.model; })
       .def_property_readonly("dof", [](const PyWorkspace& pw) { return pw.ws->dof(); })
       .def_property_readonly("constraint_capacity", [](const PyWorkspace& pw) { return pw.ws->constraintCapacity(); })
-      .def_property_readonly("task_builds", [](const PyWorkspace& pw) { return pw.task_builds; },
-                             "how many times solve() built a Task (only when the constraint/wrench objects change)")
+      .def_property_readonly(
+          "task_builds", [](const PyWorkspace& pw) { return pw.task_builds; },
+          "how many times solve() built a Task (only when the constraint/wrench objects change)")
       .def("__repr__", [](const PyWorkspace& pw) {
         return "<zwang.Workspace for '" + pw.model->name() + "', " + std::to_string(pw.ws->constraintCapacity()) +
                " constraint rows>";
       });
 
   auto model_class = py::reinterpret_borrow<py::class_<Model, std::shared_ptr<Model>>>(m.attr("Model"));
-  model_class.def("workspace", [](std::shared_ptr<Model> model, int rows) {
-    return std::make_unique<PyWorkspace>(std::move(model), rows);
-  }, py::arg("max_constraint_rows") = 6, "zwang.Workspace(model, max_constraint_rows)");
+  model_class.def(
+      "workspace",
+      [](std::shared_ptr<Model> model, int rows) { return std::make_unique<PyWorkspace>(std::move(model), rows); },
+      py::arg("max_constraint_rows") = 6, "zwang.Workspace(model, max_constraint_rows)");
 
   // ---- Constraint ----------------------------------------------------------
   py::class_<Constraint>(m, "Constraint",
@@ -310,34 +312,38 @@ void bindSolve(py::module_& m) {
                          "origin; gravity not included). A is 6×m, its columns unit constraint forces, linear part\n"
                          "first; a 6-vector is one column. frame, A and expressed are fixed; b may be changed\n"
                          "between solves (c.b[:] = ... or c.b = ...) without rebuilding the task.")
-      .def(py::init([](const std::string& frame, py::handle A, py::handle b, const std::string& expressed) {
-             Constraint c{g_next_serial++, frame, expressedArg("expressed", expressed, true),
-                          constraintMatrixArg("A", A), {}};
-             c.b.setZero(c.A.cols());
-             if (!b.is_none()) {
-               Eigen::VectorXd buffer;
-               const auto v = vectorArg("b", b, buffer);
-               if (v.size() != c.A.cols())
-                 raise(PyExc_ValueError, "b: has " + std::to_string(v.size()) + " entries, A has " +
-                                             std::to_string(c.A.cols()) + " columns");
-               c.b = v;
-             }
-             return c;
-           }),
-           py::arg("frame"), py::arg("A"), py::arg("b") = py::none(), py::arg("expressed") = "local")
+      .def(
+          py::init(
+              [](const std::string& frame, py::handle A, py::handle b, const std::string& expressed) {
+    Constraint c{g_next_serial++, frame, expressedArg("expressed", expressed, true), constraintMatrixArg("A", A), {}};
+    c.b.setZero(c.A.cols());
+    if (!b.is_none()) {
+      Eigen::VectorXd buffer;
+      const auto v = vectorArg("b", b, buffer);
+      if (v.size() != c.A.cols())
+        raise(PyExc_ValueError,
+              "b: has " + std::to_string(v.size()) + " entries, A has " + std::to_string(c.A.cols()) + " columns");
+      c.b = v;
+    }
+    return c;
+          }),
+          py::arg("frame"), py::arg("A"), py::arg("b") = py::none(), py::arg("expressed") = "local")
       .def_property_readonly("frame", [](const Constraint& c) { return c.frame; })
       .def_property_readonly("expressed", [](const Constraint& c) { return std::string(expressedName(c.expressed)); })
-      .def_property_readonly("A", [](const Constraint& c) { return matrixCopy(c.A); }, "6×m (a copy)")
+      .def_property_readonly(
+          "A", [](const Constraint& c) { return matrixCopy(c.A); }, "6×m (a copy)")
       .def_property_readonly("rows", [](const Constraint& c) { return c.A.cols(); })
-      .def_property("b", [](py::object self) { return vectorView(self.cast<Constraint&>().b, self, true); },
-                    [](Constraint& c, py::handle value) {
-                      Eigen::VectorXd buffer;
-                      const auto v = vectorArg("b", value, buffer);
-                      if (v.size() != c.b.size())
-                        raise(PyExc_ValueError, "b: has " + std::to_string(v.size()) + " entries, the constraint has " +
-                                                    std::to_string(c.b.size()) + " rows");
-                      c.b = v;
-                    }, "set points, one per column of A (a writable view)")
+      .def_property(
+          "b", [](py::object self) { return vectorView(self.cast<Constraint&>().b, self, true); },
+          [](Constraint& c, py::handle value) {
+    Eigen::VectorXd buffer;
+    const auto v = vectorArg("b", value, buffer);
+    if (v.size() != c.b.size())
+      raise(PyExc_ValueError, "b: has " + std::to_string(v.size()) + " entries, the constraint has " +
+                                  std::to_string(c.b.size()) + " rows");
+    c.b = v;
+          },
+          "set points, one per column of A (a writable view)")
       .def("__repr__", [](const Constraint& c) {
         return "<zwang.Constraint on '" + c.frame + "', " + std::to_string(c.A.cols()) + " rows, " +
                expressedName(c.expressed) + ">";
@@ -363,15 +369,17 @@ void bindSolve(py::module_& m) {
            py::arg("torque") = py::none(), py::arg("expressed") = "local")
       .def_property_readonly("frame", [](const Wrench& w) { return w.frame; })
       .def_property_readonly("expressed", [](const Wrench& w) { return std::string(expressedName(w.expressed)); })
-      .def_property("value", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data(), 6, self, true); },
-                    [](Wrench& w, py::handle v) { w.value = vec6Arg("value", v); }, "[fx, fy, fz, nx, ny, nz] (a writable view)")
-      .def_property("force", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data(), 3, self, true); },
-                    [](Wrench& w, py::handle v) { w.value.head<3>() = vec3Arg("force", v); })
-      .def_property("torque", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data() + 3, 3, self, true); },
-                    [](Wrench& w, py::handle v) { w.value.tail<3>() = vec3Arg("torque", v); })
-      .def("__repr__", [](const Wrench& w) {
-        return "<zwang.Wrench on '" + w.frame + "', " + expressedName(w.expressed) + ">";
-      });
+      .def_property(
+          "value", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data(), 6, self, true); },
+          [](Wrench& w, py::handle v) { w.value = vec6Arg("value", v); }, "[fx, fy, fz, nx, ny, nz] (a writable view)")
+      .def_property(
+          "force", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data(), 3, self, true); },
+          [](Wrench& w, py::handle v) { w.value.head<3>() = vec3Arg("force", v); })
+      .def_property(
+          "torque", [](py::object self) { return vectorView(self.cast<Wrench&>().value.data() + 3, 3, self, true); },
+          [](Wrench& w, py::handle v) { w.value.tail<3>() = vec3Arg("torque", v); })
+      .def("__repr__",
+           [](const Wrench& w) { return "<zwang.Wrench on '" + w.frame + "', " + expressedName(w.expressed) + ">"; });
 
   // ---- Friction ------------------------------------------------------------
   py::class_<Friction>(m, "Friction",
@@ -391,7 +399,8 @@ void bindSolve(py::module_& m) {
              else if (method == "projected_gradient")
                f.options.method = FrictionMethod::ProjectedGradient;
              else
-               raise(PyExc_ValueError, "method: unknown value '" + method + "' (expected 'active_set' or 'projected_gradient')");
+               raise(PyExc_ValueError,
+                     "method: unknown value '" + method + "' (expected 'active_set' or 'projected_gradient')");
              f.options.max_iterations = max_iterations;
              f.options.kkt_tolerance = kkt_tolerance;
              f.options.breakaway = optionalOverride("breakaway", breakaway);
@@ -407,9 +416,11 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("velocity_tolerance", [](const Friction& f) { return f.options.velocity_tolerance; })
       .def_property_readonly("limit_tolerance", [](const Friction& f) { return f.options.limit_tolerance; })
       .def_property_readonly("joint_limits", [](const Friction& f) { return f.options.joint_limits; })
-      .def_property_readonly("method", [](const Friction& f) {
-        return std::string(f.options.method == FrictionMethod::ActiveSet ? "active_set" : "projected_gradient");
-      })
+      .def_property_readonly(
+          "method",
+          [](const Friction& f) {
+    return std::string(f.options.method == FrictionMethod::ActiveSet ? "active_set" : "projected_gradient");
+          })
       .def_property_readonly("max_iterations", [](const Friction& f) { return f.options.max_iterations; })
       .def_property_readonly("kkt_tolerance", [](const Friction& f) { return f.options.kkt_tolerance; })
       .def_property_readonly("breakaway", [](const Friction& f) { return overrideArray(f.options.breakaway); })
@@ -449,93 +460,125 @@ void bindSolve(py::module_& m) {
                      "What solve() computed. Arrays are read-only NumPy views on the workspace (no copy), valid\n"
                      "until the next call on that workspace; reading a Result after that raises\n"
                      "StaleResultError, and arrays taken earlier then show the new values. Result.copy() keeps it.")
-      .def_property_readonly("qdd", [](const Result& r) { return vectorView(r.solution().qdd, r.base()); }, "q̈")
-      .def_property_readonly("tau_constraint", [](const Result& r) { return vectorView(r.solution().tau_constraint, r.base()); },
-                             "τ_c = Σ Jᵀ A ν, the joint torques of the constraint forces")
-      .def_property_readonly("tau_control", [](const Result& r) { return vectorView(r.solution().tau_control, r.base()); },
-                             "τ + τ_c, the command for the motors")
-      .def_property_readonly("nu", [](const Result& r) { return vectorCopy(r.solution().nu); },
-                             "ν, constraint magnitudes in constraint order (a copy: its length follows the task)")
-      .def_property_readonly("gauss", [](const Result& r) { return r.solution().gauss; }, "Z(q̈)")
+      .def_property_readonly(
+          "qdd", [](const Result& r) { return vectorView(r.solution().qdd, r.base()); }, "q̈")
+      .def_property_readonly(
+          "tau_constraint", [](const Result& r) { return vectorView(r.solution().tau_constraint, r.base()); },
+          "τ_c = Σ Jᵀ A ν, the joint torques of the constraint forces")
+      .def_property_readonly(
+          "tau_control", [](const Result& r) { return vectorView(r.solution().tau_control, r.base()); },
+          "τ + τ_c, the command for the motors")
+      .def_property_readonly(
+          "nu", [](const Result& r) { return vectorCopy(r.solution().nu); },
+          "ν, constraint magnitudes in constraint order (a copy: its length follows the task)")
+      .def_property_readonly(
+          "gauss", [](const Result& r) { return r.solution().gauss; }, "Z(q̈)")
       .def_property_readonly("rows", [](const Result& r) { return r.solution().balance.rows; })
       .def_property_readonly("rank", [](const Result& r) { return r.solution().balance.rank; })
       .def_property_readonly("condition", [](const Result& r) { return r.solution().balance.condition; })
       .def_property_readonly("damping", [](const Result& r) { return r.solution().balance.damping; })
       .def_property_readonly("singular", [](const Result& r) { return r.solution().balance.singular; })
-      .def_property_readonly("residual", [](const Result& r) { return r.solution().balance.residual; },
-                             "‖Aᵀ Ẍ − b‖ over the constraint rows, in their own units")
-      .def_property_readonly("consistent", [](const Result& r) { return r.solution().balance.consistent; },
-                             "every constraint row met (False: least squares only, or a damped direction gave)")
-      .def_property_readonly("body_acc_local", [](const Result& r) { return bodyAccelerations(r, Expressed::Local); },
-                             "(bodies, 6) true classical accelerations of the body frames, body axes (a new array)")
-      .def_property_readonly("body_acc_world", [](const Result& r) { return bodyAccelerations(r, Expressed::World); },
-                             "(bodies, 6) the same in world axes (a new array)")
-      .def("frame_acceleration", [](const Result& r, py::handle frame, const std::string& expressed) {
-        return vectorCopy(frameAccelerationOf(r, frameArg(*r.model, frame), expressedArg("expressed", expressed, true)));
-      }, py::arg("frame"), py::arg("expressed") = "world", "true classical acceleration [p̈; ω̇] of a frame's origin")
+      .def_property_readonly(
+          "residual", [](const Result& r) { return r.solution().balance.residual; },
+          "‖Aᵀ Ẍ − b‖ over the constraint rows, in their own units")
+      .def_property_readonly(
+          "consistent", [](const Result& r) { return r.solution().balance.consistent; },
+          "every constraint row met (False: least squares only, or a damped direction gave)")
+      .def_property_readonly(
+          "body_acc_local", [](const Result& r) { return bodyAccelerations(r, Expressed::Local); },
+          "(bodies, 6) true classical accelerations of the body frames, body axes (a new array)")
+      .def_property_readonly(
+          "body_acc_world", [](const Result& r) { return bodyAccelerations(r, Expressed::World); },
+          "(bodies, 6) the same in world axes (a new array)")
+      .def(
+          "frame_acceleration",
+          [](const Result& r, py::handle frame, const std::string& expressed) {
+    return vectorCopy(frameAccelerationOf(r, frameArg(*r.model, frame), expressedArg("expressed", expressed, true)));
+          },
+          py::arg("frame"), py::arg("expressed") = "world", "true classical acceleration [p̈; ω̇] of a frame's origin")
       .def_property_readonly("infeasible", [](const Result& r) { return r.infeasible; })
       .def_property_readonly("message", [](const Result& r) { return r.message; })
       .def_property_readonly("with_friction", [](const Result& r) { return r.with_friction; })
-      .def_property_readonly("mu", [](const Result& r) -> py::object {
-        if (!r.with_friction) return py::none();
-        return vectorView(r.friction().mu, r.base());
-      }, "μ* per joint (0 for moving joints); μ > 0 opposes positive motion. None without friction")
-      .def_property_readonly("state", [](const Result& r) -> py::object {
-        if (!r.with_friction) return py::none();
-        py::list states;
-        for (const JointState s : r.friction().state) states.append(py::str(toString(s)));
-        return std::move(states);
-      }, "per joint: 'moving', 'stick', 'slip+', 'slip-', 'at-limit'. None without friction")
-      .def_property_readonly("tau_friction", [](const Result& r) -> py::object {
-        if (!r.with_friction) return py::none();
-        return vectorView(r.friction().tau_friction, r.base());
-      })
-      .def_property_readonly("dqdd_dmu", [](const Result& r) -> py::object {
-        if (!r.with_friction) return py::none();
-        return matrixView(r.friction().dqdd_dmu, r.base());
-      })
-      .def_property_readonly("stuck", [](const Result& r) -> py::object {
-        if (!r.with_friction) return py::none();
-        return py::cast(r.friction().stuck);
-      })
-      .def_property_readonly("gauss_dual", [](const Result& r) -> py::object {
-        if (!r.with_friction) return py::none();
-        return py::float_(r.friction().gauss_dual);
-      })
-      .def_property_readonly("iterations", [](const Result& r) { return r.with_friction ? r.friction().iterations : 0; })
-      .def_property_readonly("converged", [](const Result& r) { return r.with_friction ? r.friction().converged : true; })
-      .def_property_readonly("kkt_residual", [](const Result& r) { return r.with_friction ? r.friction().kkt_residual : 0.0; })
-      .def_property_readonly("indeterminate", [](const Result& r) { return r.with_friction && r.friction().indeterminate; })
-      .def_property_readonly("limit_impact", [](const Result& r) { return r.with_friction && r.friction().limit_impact; })
-      .def_property_readonly("impact_joint", [](const Result& r) { return r.with_friction ? r.friction().impact_joint : -1; })
+      .def_property_readonly(
+          "mu",
+          [](const Result& r) -> py::object {
+            if (!r.with_friction) return py::none();
+            return vectorView(r.friction().mu, r.base());
+          },
+          "μ* per joint (0 for moving joints); μ > 0 opposes positive motion. None without friction")
+      .def_property_readonly(
+          "state",
+          [](const Result& r) -> py::object {
+            if (!r.with_friction) return py::none();
+            py::list states;
+            for (const JointState s : r.friction().state) states.append(py::str(toString(s)));
+            return std::move(states);
+          },
+          "per joint: 'moving', 'stick', 'slip+', 'slip-', 'at-limit'. None without friction")
+      .def_property_readonly("tau_friction",
+                             [](const Result& r) -> py::object {
+                               if (!r.with_friction) return py::none();
+                               return vectorView(r.friction().tau_friction, r.base());
+                             })
+      .def_property_readonly("dqdd_dmu",
+                             [](const Result& r) -> py::object {
+                               if (!r.with_friction) return py::none();
+                               return matrixView(r.friction().dqdd_dmu, r.base());
+                             })
+      .def_property_readonly("stuck",
+                             [](const Result& r) -> py::object {
+                               if (!r.with_friction) return py::none();
+                               return py::cast(r.friction().stuck);
+                             })
+      .def_property_readonly("gauss_dual",
+                             [](const Result& r) -> py::object {
+                               if (!r.with_friction) return py::none();
+                               return py::float_(r.friction().gauss_dual);
+                             })
+      .def_property_readonly("iterations",
+                             [](const Result& r) { return r.with_friction ? r.friction().iterations : 0; })
+      .def_property_readonly("converged",
+                             [](const Result& r) { return r.with_friction ? r.friction().converged : true; })
+      .def_property_readonly("kkt_residual",
+                             [](const Result& r) { return r.with_friction ? r.friction().kkt_residual : 0.0; })
+      .def_property_readonly("indeterminate",
+                             [](const Result& r) { return r.with_friction && r.friction().indeterminate; })
+      .def_property_readonly("limit_impact",
+                             [](const Result& r) { return r.with_friction && r.friction().limit_impact; })
+      .def_property_readonly("impact_joint",
+                             [](const Result& r) { return r.with_friction ? r.friction().impact_joint : -1; })
       .def_property_readonly("is_copy", [](const Result& r) { return static_cast<bool>(r.data); })
-      .def("copy", [](const Result& r) {
-        auto data = std::make_shared<ResultData>();
-        data->solution = r.solution();
-        data->friction = r.friction();
-        const auto frames = static_cast<Eigen::Index>(r.model->frames().size());
-        data->frame_acc_local.resize(frames, 6);
-        data->frame_acc_world.resize(frames, 6);
-        for (int f = 0; f < frames; ++f) {
-          data->frame_acc_local.row(f) = frameAccelerationOf(r, f, Expressed::Local).transpose();
-          data->frame_acc_world.row(f) = frameAccelerationOf(r, f, Expressed::World).transpose();
-        }
-        Result copy;
-        copy.model = r.model;
-        copy.with_friction = r.with_friction;
-        copy.infeasible = r.infeasible;
-        copy.message = r.message;
-        copy.data_base = py::capsule(new std::shared_ptr<ResultData>(data),
-                                     [](void* p) { delete static_cast<std::shared_ptr<ResultData>*>(p); });
-        copy.data = std::move(data);
-        return copy;
-      }, "a detached copy that later solves do not change")
+      .def(
+          "copy",
+          [](const Result& r) {
+    auto data = std::make_shared<ResultData>();
+    data->solution = r.solution();
+    data->friction = r.friction();
+    const auto frames = static_cast<Eigen::Index>(r.model->frames().size());
+    data->frame_acc_local.resize(frames, 6);
+    data->frame_acc_world.resize(frames, 6);
+    for (int f = 0; f < frames; ++f) {
+      data->frame_acc_local.row(f) = frameAccelerationOf(r, f, Expressed::Local).transpose();
+      data->frame_acc_world.row(f) = frameAccelerationOf(r, f, Expressed::World).transpose();
+    }
+    Result copy;
+    copy.model = r.model;
+    copy.with_friction = r.with_friction;
+    copy.infeasible = r.infeasible;
+    copy.message = r.message;
+    copy.data_base = py::capsule(new std::shared_ptr<ResultData>(data),
+                                 [](void* p) { delete static_cast<std::shared_ptr<ResultData>*>(p); });
+    copy.data = std::move(data);
+    return copy;
+          },
+          "a detached copy that later solves do not change")
       .def("__repr__", &resultRepr);
 
   // ---- solve ---------------------------------------------------------------
-  m.def("solve", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
-                    py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
-                    py::handle balance) {
+  m.def(
+      "solve",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
+         py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity, py::handle balance) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const FrictionOptions* options = frictionArg(friction);
     const BalanceOptions& balance_options = balanceArg(balance);
@@ -562,21 +605,23 @@ void bindSolve(py::module_& m) {
       raiseStatus(status, "solve", py::cast(std::move(r)));
     }
     return r;
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
-        py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
-        py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("balance") = py::none(),
-        "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
-        "q, qd, tau: one entry per joint (qd, tau default to zeros); float64 arrays are read in place.\n"
-        "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
-        "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
-        "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
-        "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
-        "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions).");
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
+      py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
+      py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("balance") = py::none(),
+      "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
+      "q, qd, tau: one entry per joint (qd, tau default to zeros); float64 arrays are read in place.\n"
+      "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
+      "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
+      "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
+      "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
+      "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions).");
 
   // ---- the C++ cost of a solve, for measuring the Python-call overhead -----
-  m.def("_time_cpp_solve", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd,
-                              py::handle tau, py::handle constraints, py::handle wrenches, py::handle friction,
-                              py::handle gravity, int repeat) {
+  m.def(
+      "_time_cpp_solve",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
+         py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity, int repeat) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const FrictionOptions* options = frictionArg(friction);
     const Task& task = solveTask(pw, constraints, wrenches, gravity);
@@ -592,23 +637,29 @@ void bindSolve(py::module_& m) {
     const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
     if (!status) raiseStatus(status, "_time_cpp_solve");
     return elapsed.count() / std::max(repeat, 1);
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
-        py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
-        py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("repeat") = 1000,
-        "Seconds per call of the C++ solve alone (same arguments as solve), looped in C++: the baseline for\n"
-        "the Python-call overhead in docs/python.md. Not part of the API.");
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
+      py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
+      py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("repeat") = 1000,
+      "Seconds per call of the C++ solve alone (same arguments as solve), looped in C++: the baseline for\n"
+      "the Python-call overhead in docs/python.md. Not part of the API.");
 
   // ---- kinematics and dynamics ---------------------------------------------
-  m.def("forward_kinematics", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd) {
+  m.def(
+      "forward_kinematics",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const auto qv = vectorArg("q", q, pw.q_buf);
     ++pw.generation;
     const Status s = qd.is_none() ? forwardKinematics(*model, *pw.ws, qv)
                                   : forwardKinematics(*model, *pw.ws, qv, vectorArg("qd", qd, pw.qd_buf));
     if (!s) raiseStatus(s, "forward_kinematics");
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
-        "Poses (and velocities with qd) of every body into ws; then frame_pose/frame_velocity with q=None.");
-  m.def("frame_pose", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame) {
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
+      "Poses (and velocities with qd) of every body into ws; then frame_pose/frame_velocity with q=None.");
+  m.def(
+      "frame_pose",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const int f = frameArg(*model, frame);
     if (!q.is_none()) {
@@ -619,9 +670,12 @@ void bindSolve(py::module_& m) {
     Eigen::Isometry3d pose;
     if (const Status s = framePose(*model, *pw.ws, f, pose); !s) raiseStatus(s, "frame_pose");
     return matrixCopy(pose.matrix());
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), "4×4 pose of the frame in the world at q");
-  m.def("frame_velocity", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd,
-                             py::handle frame, const std::string& expressed) {
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), "4×4 pose of the frame in the world at q");
+  m.def(
+      "frame_velocity",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle frame,
+         const std::string& expressed) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const int f = frameArg(*model, frame);
     const auto qv = vectorArg("q", q, pw.q_buf);
@@ -633,10 +687,13 @@ void bindSolve(py::module_& m) {
     if (s) s = frameVelocity(*model, *pw.ws, f, e, v);
     if (!s) raiseStatus(s, "frame_velocity");
     return vectorCopy(v);
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd"), py::arg("frame"), py::arg("expressed") = "local",
-        "classical velocity [v; ω] of the frame origin");
-  m.def("frame_jacobian", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame,
-                             const std::string& expressed) {
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd"), py::arg("frame"), py::arg("expressed") = "local",
+      "classical velocity [v; ω] of the frame origin");
+  m.def(
+      "frame_jacobian",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame,
+         const std::string& expressed) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const int f = frameArg(*model, frame);
     const Expressed e = expressedArg("expressed", expressed, true);
@@ -645,10 +702,13 @@ void bindSolve(py::module_& m) {
     ++pw.generation;
     if (const Status s = frameJacobian(*model, *pw.ws, qv, f, e, J); !s) raiseStatus(s, "frame_jacobian");
     return matrixCopy(J);
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), py::arg("expressed") = "local",
-        "6×dof J with frame_velocity = J qd");
-  m.def("inverse_dynamics", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd,
-                               py::handle qdd, py::handle wrenches, py::handle gravity) {
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), py::arg("expressed") = "local",
+      "6×dof J with frame_velocity = J qd");
+  m.def(
+      "inverse_dynamics",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle qdd,
+         py::handle wrenches, py::handle gravity) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     Task& task = idTask(pw, wrenches, gravity);
     const auto qv = vectorArg("q", q, pw.q_buf);
@@ -657,16 +717,20 @@ void bindSolve(py::module_& m) {
     ++pw.generation;
     if (const Status s = inverseDynamics(*model, task, qv, qdv, qddv, *pw.ws); !s) raiseStatus(s, "inverse_dynamics");
     return vectorCopy(pw.ws->tau);
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("qdd") = py::none(),
-        py::kw_only(), py::arg("wrenches") = py::none(), py::arg("gravity") = py::none(),
-        "RNEA: τ = H(q) q̈ + C(q, q̇) − Σ Jᵀ F_ext (rotor inertias included), a new array");
-  m.def("joint_space_inertia", [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q) {
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("qdd") = py::none(),
+      py::kw_only(), py::arg("wrenches") = py::none(), py::arg("gravity") = py::none(),
+      "RNEA: τ = H(q) q̈ + C(q, q̇) − Σ Jᵀ F_ext (rotor inertias included), a new array");
+  m.def(
+      "joint_space_inertia",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const auto qv = vectorArg("q", q, pw.q_buf);
     ++pw.generation;
     if (const Status s = jointSpaceInertia(*model, qv, *pw.ws); !s) raiseStatus(s, "joint_space_inertia");
     return matrixCopy(pw.ws->H);
-  }, py::arg("model"), py::arg("ws"), py::arg("q"), "CRBA: H(q), rotor inertias included, a new array");
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), "CRBA: H(q), rotor inertias included, a new array");
 }
 
 }  // namespace zwang::python

@@ -53,22 +53,22 @@ struct ProjectedGradientScratch {
 // Scratch of leastDistanceQp (k ≤ n joints, q ≤ n unknowns, ≤ 2n rows).
 struct LeastDistanceScratch {
   explicit LeastDistanceScratch(int n);
-  Eigen::MatrixXd rows;          // n × 2n, constraint row r as column r (contiguous)
-  Eigen::VectorXd row_bounds;    // 2n, d_r of "row_r · z ≤ d_r"
-  Eigen::MatrixXd gram;          // 2n × 2n, C Cᵀ, filled as rows join W
-  Eigen::VectorXd row_dot_a;     // 2n, C a, filled as rows join W
-  Eigen::VectorXi working;       // 2n, 1 for a row in W
-  Eigen::VectorXd multipliers;   // n, λ_W
-  Eigen::VectorXd step;          // n, towards the subproblem's minimum z'
-  Eigen::VectorXd point;         // n, x0 + N z, per joint
-  Eigen::VectorXd rate;          // n, N·step, per joint
+  Eigen::MatrixXd rows;            // n × 2n, constraint row r as column r (contiguous)
+  Eigen::VectorXd row_bounds;      // 2n, d_r of "row_r · z ≤ d_r"
+  Eigen::MatrixXd gram;            // 2n × 2n, C Cᵀ, filled as rows join W
+  Eigen::VectorXd row_dot_a;       // 2n, C a, filled as rows join W
+  Eigen::VectorXi working;         // 2n, 1 for a row in W
+  Eigen::VectorXd multipliers;     // n, λ_W
+  Eigen::VectorXd step;            // n, towards the subproblem's minimum z'
+  Eigen::VectorXd point;           // n, x0 + N z, per joint
+  Eigen::VectorXd rate;            // n, N·step, per joint
   GrowingCholesky working_factor;  // of C_W C_Wᵀ
 };
 
 // Scratch of leastDistanceOnHyperplane.
 struct HyperplaneScratch {
   explicit HyperplaneScratch(int n);
-  Eigen::VectorXd breakpoints;     // 2n, distances |λ| where a term enters or leaves
+  Eigen::VectorXd breakpoints;      // 2n, distances |λ| where a term enters or leaves
   Eigen::VectorXi breakpoint_kind;  // 2n, 2i + (1 when term i becomes free there, 0 when it stops)
 };
 
@@ -86,7 +86,7 @@ struct QpReport {
   double kkt_residual = 0.0;  // boxQpKktResidual at the result
   bool converged = false;
   bool unbounded = false;
-  int unbounded_index = -1;   // a variable that runs off to an infinite bound
+  int unbounded_index = -1;  // a variable that runs off to an infinite bound
 };
 
 // min φ(x) = ½ xᵀ P x − cᵀ x  over lo ≤ x ≤ hi (entries may be ±∞, lo ≤ 0 ≤ hi),
@@ -114,9 +114,9 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
 // trace bound); a linear problem (P = 0) goes to its vertex. Unbounded by the
 // same rule as above.
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
-                                const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
-                                double curvature_scale = 0.0);
+                                const Eigen::Ref<const Eigen::VectorXd>& lo,
+                                const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> x,
+                                QpScratch& s, int max_iterations, double tolerance, double curvature_scale = 0.0);
 
 // The scale of the reach rule above: max(1, largest finite |bound|,
 // ‖c‖∞ / max(lambda_max_bound, curvature_scale)).
@@ -163,6 +163,7 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
 // untouched) if no root is found, i.e. the hyperplane misses the box.
 bool leastDistanceOnHyperplane(const Eigen::Ref<const Eigen::VectorXd>& v, double b,
                                const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::VectorXd>& lo,
-                               const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> mu, QpScratch& s);
+                               const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> mu,
+                               QpScratch& s);
 
 }  // namespace zwang::internal

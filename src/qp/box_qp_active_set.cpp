@@ -59,9 +59,7 @@ struct Box {
 };
 
 // value clamped to x_j's bounds.
-double clampTo(const Box& box, Eigen::Index j, double value) {
-  return std::min(box.hi[j], std::max(box.lo[j], value));
-}
+double clampTo(const Box& box, Eigen::Index j, double value) { return std::min(box.hi[j], std::max(box.lo[j], value)); }
 
 // Is `pivot`, the Schur pivot of adding j to F, a real curvature?
 bool independent(const Box& box, double pivot, int j) { return pivot > kDependent * box.P(j, j); }
@@ -74,8 +72,7 @@ void gradient(const Box& box, const VectorRef& x, ActiveSetScratch& s) {
   g.noalias() = box.P * x;
   g -= box.c;
   const double x_max = x.cwiseAbs().maxCoeff();
-  for (Eigen::Index j = 0; j < k; ++j)
-    s.gradient_noise[j] = kRounding * (s.row_sums[j] * x_max + std::abs(box.c[j]));
+  for (Eigen::Index j = 0; j < k; ++j) s.gradient_noise[j] = kRounding * (s.row_sums[j] * x_max + std::abs(box.c[j]));
 }
 
 // Room for x_j along the sign of `rate` (per unit of step), +∞ when unbounded.
@@ -103,8 +100,7 @@ int cutStep(const Box& box, const VectorRef& x, const GrowingCholesky& F, const 
 }
 
 // x_F ← clamp(x_F + alpha · direction) (the clamp only absorbs rounding).
-void moveFree(const Box& box, const GrowingCholesky& F, const Eigen::VectorXd& direction, double alpha,
-              VectorOut x) {
+void moveFree(const Box& box, const GrowingCholesky& F, const Eigen::VectorXd& direction, double alpha, VectorOut x) {
   for (int a = 0; a < F.size(); ++a) x[F.index(a)] = clampTo(box, F.index(a), x[F.index(a)] + alpha * direction[a]);
 }
 
@@ -303,7 +299,7 @@ bool zeroCurvatureMove(const Box& box, int j, VectorOut x, ActiveSetScratch& s, 
   d *= dir;
   double alpha = room(x[j], box.lo[j], box.hi[j], dir);
   const int blocking = cutStep(box, x, F, s.direction, alpha);  // −1: j itself
-  if (!std::isfinite(alpha)) {  // downhill for ever: a bound at infinity
+  if (!std::isfinite(alpha)) {                                  // downhill for ever: a bound at infinity
     report.unbounded = true;
     report.unbounded_index = unboundedIndex(box, j, dir, F, s.direction);
     return false;

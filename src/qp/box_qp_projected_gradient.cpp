@@ -126,9 +126,9 @@ void momentum(const Eigen::Ref<Eigen::VectorXd>& x, Iterates& v, double& t) {
 }  // namespace
 
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
-                                const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
-                                Eigen::Ref<Eigen::VectorXd> x, QpScratch& scratch, int max_iterations, double tolerance,
-                                double curvature_scale) {
+                                const Eigen::Ref<const Eigen::VectorXd>& lo,
+                                const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> x,
+                                QpScratch& scratch, int max_iterations, double tolerance, double curvature_scale) {
   if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
   const Index k = x.size();

@@ -150,8 +150,8 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
   const Index q = N.cols(), k = N.rows();
   const Index rows = constraintRows(N, x0, lo, hi, s);  // stage 1
   // (No rows at all when every bound is infinite: nothing limits z.)
-  const double scale = 1.0 + (q > 0 ? a.cwiseAbs().maxCoeff() : 0.0) +
-                       (rows > 0 ? s.row_bounds.head(rows).cwiseAbs().maxCoeff() : 0.0);
+  const double scale =
+      1.0 + (q > 0 ? a.cwiseAbs().maxCoeff() : 0.0) + (rows > 0 ? s.row_bounds.head(rows).cwiseAbs().maxCoeff() : 0.0);
   const double tol = kStepZero * scale;
   s.working_factor.clear();
   s.working.head(rows).setZero();
@@ -191,8 +191,8 @@ namespace {
 // their breakpoints (where each enters or leaves the free range, as |λ|) into
 // s, and the slope σ df/d|λ| and number of free terms just past λ = 0.
 // Returns the number of breakpoints.
-Index collectBreakpoints(const VectorRef& v, const VectorRef& t, const VectorRef& lo, const VectorRef& hi,
-                         double sigma, HyperplaneScratch& s, double& slope, Index& free_terms) {
+Index collectBreakpoints(const VectorRef& v, const VectorRef& t, const VectorRef& lo, const VectorRef& hi, double sigma,
+                         HyperplaneScratch& s, double& slope, Index& free_terms) {
   Eigen::VectorXd& at = s.breakpoints;
   Eigen::VectorXi& kind = s.breakpoint_kind;
   Index breaks = 0;
@@ -201,7 +201,7 @@ Index collectBreakpoints(const VectorRef& v, const VectorRef& t, const VectorRef
     if (rate == 0.0) continue;
     const double value = t[i];
     // Free just past 0: not already at (or beyond) the bound it moves towards.
-    const bool below = value < lo[i], above = value > hi[i];
+    const bool below = value<lo[i], above = value> hi[i];
     const bool free_now = rate > 0.0 ? (!below && value < hi[i]) : (!above && value > lo[i]);
     if (free_now) {
       slope += v[i] * v[i];

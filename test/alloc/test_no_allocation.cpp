@@ -14,9 +14,15 @@ Model panda() { return zwang::testing::pandaModel(); }
 }  // namespace
 
 TEST_CASE("the counter sees allocations at all (guards against a test that cannot fail)") {
-  CHECK(allocationsDuring([] { Eigen::VectorXd x(100); x.setOnes(); }) >= 1);
+  CHECK(allocationsDuring([] {
+          Eigen::VectorXd x(100);
+          x.setOnes();
+        }) >= 1);
   // (operator new directly: a new-expression paired with delete may be elided.)
-  CHECK(allocationsDuring([] { void* volatile p = ::operator new(16); ::operator delete(p); }) >= 1);
+  CHECK(allocationsDuring([] {
+          void* volatile p = ::operator new(16);
+          ::operator delete(p);
+        }) >= 1);
 }
 
 TEST_CASE("hybrid dynamics with constraints on two frames and a wrench allocates nothing") {
@@ -166,9 +172,9 @@ TEST_CASE("the kinematics entry points are declared noexcept") {
   static_assert(noexcept(frameAcceleration(model, ws, 0, Expressed::World, out)));
   // frameJacobian takes its output Ref by value, and copying a Ref is not
   // noexcept: assert the declaration itself (noexcept is part of the type).
-  static_assert(std::is_same_v<decltype(frameJacobian),
-                               Status(const Model&, Workspace&, const Eigen::Ref<const Eigen::VectorXd>&, int, Expressed,
-                                      Eigen::Ref<Eigen::MatrixXd>) noexcept>);
+  static_assert(
+      std::is_same_v<decltype(frameJacobian), Status(const Model&, Workspace&, const Eigen::Ref<const Eigen::VectorXd>&,
+                                                     int, Expressed, Eigen::Ref<Eigen::MatrixXd>) noexcept>);
   CHECK(forwardKinematics(model, ws, r, r).ok());  // (and they run)
   CHECK(framePose(model, ws, 0, pose).ok());
   CHECK(pose.isApprox(Eigen::Isometry3d::Identity()));  // frame 0 is the base
@@ -193,9 +199,8 @@ TEST_CASE("friction at a joint limit, with overrides, a margin and an infeasible
   zwang::testing::IntoUpperLimit into;
   Status status;
   solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws);  // warm
-  CHECK(allocationsDuring([&] {
-          status = solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws);
-        }) == 0);
+  CHECK(allocationsDuring(
+            [&] { status = solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws); }) == 0);
   CHECK(status.code == StatusCode::Infeasible);
 }
 
@@ -244,33 +249,33 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
   StatusCode codes[32];
   int n = 0;
   const long count = allocationsDuring([&] {
-    codes[n++] = solveHybridDynamics(model, task, short3, ok7, ok7, ws).code;        // SizeMismatch
-    codes[n++] = solveHybridDynamics(model, task, ok7, nan7, ok7, ws).code;          // NonFinite
-    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, small).code;        // WorkspaceTooSmall
-    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, foreign).code;      // ModelMismatch (workspace)
-    codes[n++] = solveHybridDynamics(model, foreign_task, ok7, ok7, ok7, ws).code;   // ModelMismatch (task)
-    codes[n++] = solveWithFriction(model, task, ok7, ok7, nan7, ws).code;            // NonFinite
-    for (std::size_t k = 0; k < bad_options.size(); ++k)                              // BadOption, each
+    codes[n++] = solveHybridDynamics(model, task, short3, ok7, ok7, ws).code;       // SizeMismatch
+    codes[n++] = solveHybridDynamics(model, task, ok7, nan7, ok7, ws).code;         // NonFinite
+    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, small).code;       // WorkspaceTooSmall
+    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, foreign).code;     // ModelMismatch (workspace)
+    codes[n++] = solveHybridDynamics(model, foreign_task, ok7, ok7, ok7, ws).code;  // ModelMismatch (task)
+    codes[n++] = solveWithFriction(model, task, ok7, ok7, nan7, ws).code;           // NonFinite
+    for (std::size_t k = 0; k < bad_options.size(); ++k)                            // BadOption, each
       option_codes[k] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_options[k].options).code;
-    codes[n++] = inverseDynamics(model, task, ok7, short3, ok7, ws).code;            // SizeMismatch
-    codes[n++] = inverseDynamics(model, task, ok7, ok7, ok7, foreign).code;          // ModelMismatch
-    codes[n++] = jointSpaceInertia(model, nan7, ws).code;                            // NonFinite
-    codes[n++] = jointSpaceInertia(model, ok7, foreign).code;                        // ModelMismatch
-    codes[n++] = forwardKinematics(model, ws, short3).code;                          // SizeMismatch
-    codes[n++] = forwardKinematics(model, ws, ok7, nan7).code;                       // NonFinite
-    codes[n++] = forwardKinematics(model, foreign, ok7).code;                        // ModelMismatch
-    codes[n++] = frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong).code;   // SizeMismatch
-    codes[n++] = frameJacobian(model, ws, nan7, 1, Expressed::World, J).code;        // NonFinite
-    codes[n++] = frameJacobian(model, ws, ok7, frames, Expressed::World, J).code;    // ModelMismatch (frame)
-    codes[n++] = framePose(model, ws, -1, pose).code;                                // ModelMismatch (frame)
-    codes[n++] = framePose(model, ws, frames, pose).code;                            // ModelMismatch (frame)
-    codes[n++] = framePose(model, foreign, 1, pose).code;                            // ModelMismatch (workspace)
-    codes[n++] = frameVelocity(model, ws, -1, Expressed::Local, out).code;           // ModelMismatch (frame)
-    codes[n++] = frameVelocity(model, ws, frames, Expressed::World, out).code;       // ModelMismatch (frame)
-    codes[n++] = frameVelocity(model, foreign, 1, Expressed::Local, out).code;       // ModelMismatch (workspace)
-    codes[n++] = frameAcceleration(model, ws, -1, Expressed::World, out).code;       // ModelMismatch (frame)
-    codes[n++] = frameAcceleration(model, ws, frames, Expressed::Local, out).code;   // ModelMismatch (frame)
-    codes[n++] = frameAcceleration(model, foreign, 1, Expressed::World, out).code;   // ModelMismatch (workspace)
+    codes[n++] = inverseDynamics(model, task, ok7, short3, ok7, ws).code;           // SizeMismatch
+    codes[n++] = inverseDynamics(model, task, ok7, ok7, ok7, foreign).code;         // ModelMismatch
+    codes[n++] = jointSpaceInertia(model, nan7, ws).code;                           // NonFinite
+    codes[n++] = jointSpaceInertia(model, ok7, foreign).code;                       // ModelMismatch
+    codes[n++] = forwardKinematics(model, ws, short3).code;                         // SizeMismatch
+    codes[n++] = forwardKinematics(model, ws, ok7, nan7).code;                      // NonFinite
+    codes[n++] = forwardKinematics(model, foreign, ok7).code;                       // ModelMismatch
+    codes[n++] = frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong).code;  // SizeMismatch
+    codes[n++] = frameJacobian(model, ws, nan7, 1, Expressed::World, J).code;       // NonFinite
+    codes[n++] = frameJacobian(model, ws, ok7, frames, Expressed::World, J).code;   // ModelMismatch (frame)
+    codes[n++] = framePose(model, ws, -1, pose).code;                               // ModelMismatch (frame)
+    codes[n++] = framePose(model, ws, frames, pose).code;                           // ModelMismatch (frame)
+    codes[n++] = framePose(model, foreign, 1, pose).code;                           // ModelMismatch (workspace)
+    codes[n++] = frameVelocity(model, ws, -1, Expressed::Local, out).code;          // ModelMismatch (frame)
+    codes[n++] = frameVelocity(model, ws, frames, Expressed::World, out).code;      // ModelMismatch (frame)
+    codes[n++] = frameVelocity(model, foreign, 1, Expressed::Local, out).code;      // ModelMismatch (workspace)
+    codes[n++] = frameAcceleration(model, ws, -1, Expressed::World, out).code;      // ModelMismatch (frame)
+    codes[n++] = frameAcceleration(model, ws, frames, Expressed::Local, out).code;  // ModelMismatch (frame)
+    codes[n++] = frameAcceleration(model, foreign, 1, Expressed::World, out).code;  // ModelMismatch (workspace)
   });
   CHECK(count == 0);
   const StatusCode expected[] = {

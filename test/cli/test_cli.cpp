@@ -128,7 +128,8 @@ TEST_CASE("Panda holds its tool still: the tool does not move; the tool and the 
   REQUIRE(zwang::solveWithFriction(model, task, q, zero, zero, ws).ok());
   auto same = [](const Json& j, const Eigen::VectorXd& v) {
     REQUIRE(j.size() == static_cast<std::size_t>(v.size()));
-    for (Eigen::Index k = 0; k < v.size(); ++k) CHECK(j[static_cast<std::size_t>(k)].get<double>() == Approx(v[k]).margin(1e-12));
+    for (Eigen::Index k = 0; k < v.size(); ++k)
+      CHECK(j[static_cast<std::size_t>(k)].get<double>() == Approx(v[k]).margin(1e-12));
   };
   same(s["qdd"], ws.solution.qdd);
   same(s["tau_constraint"], ws.solution.tau_constraint);
@@ -137,11 +138,13 @@ TEST_CASE("Panda holds its tool still: the tool does not move; the tool and the 
   same(s["friction"]["mu"], ws.friction.mu);
   CHECK(s["gauss"].get<double>() == Approx(ws.solution.gauss).margin(1e-12));
   for (int j = 0; j < 7; ++j)
-    CHECK(s["friction"]["state"][static_cast<std::size_t>(j)] == zwang::toString(ws.friction.state[static_cast<std::size_t>(j)]));
+    CHECK(s["friction"]["state"][static_cast<std::size_t>(j)] ==
+          zwang::toString(ws.friction.state[static_cast<std::size_t>(j)]));
   CHECK(s["friction"]["indeterminate"] == ws.friction.indeterminate);
   // friction within its bounds
   for (int j = 0; j < 7; ++j)
-    CHECK(std::abs(s["friction"]["mu"][static_cast<std::size_t>(j)].get<double>()) <= model.joint(j).breakaway_friction + 1e-12);
+    CHECK(std::abs(s["friction"]["mu"][static_cast<std::size_t>(j)].get<double>()) <=
+          model.joint(j).breakaway_friction + 1e-12);
 }
 
 TEST_CASE("No friction section: the plain solver, no friction key", "[golden]") {
@@ -151,7 +154,8 @@ TEST_CASE("No friction section: the plain solver, no friction key", "[golden]") 
   // the keys, in the documented order
   std::vector<std::string> keys;
   for (const auto& item : s.items()) keys.push_back(item.key());
-  CHECK(keys == std::vector<std::string>{"joints", "qdd", "tau_constraint", "tau_control", "nu", "gauss", "status", "frames"});
+  CHECK(keys ==
+        std::vector<std::string>{"joints", "qdd", "tau_constraint", "tau_control", "nu", "gauss", "status", "frames"});
   // friction disabled explicitly: the same
   const Json d = solve(problem("arm_friction_disabled.json"));
   CHECK_FALSE(d.contains("friction"));
@@ -176,7 +180,8 @@ TEST_CASE("Feed-forward torque, velocities, gravity, local wrench, world constra
   const Json& c = p["constraints"][0];
   zwang::ConstraintMatrix A(6, static_cast<Eigen::Index>(c["directions"].size()));
   for (std::size_t k = 0; k < c["directions"].size(); ++k)
-    A.col(static_cast<Eigen::Index>(k)) = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(numbers(c["directions"][k]).data());
+    A.col(static_cast<Eigen::Index>(k)) =
+        Eigen::Map<const Eigen::Matrix<double, 6, 1>>(numbers(c["directions"][k]).data());
   const int row = task.addConstraint(c["frame"].get<std::string>(), A, zwang::Expressed::World);
   const std::vector<double> acc = numbers(c["acceleration"]);
   for (std::size_t k = 0; k < acc.size(); ++k) task.targets()[row + static_cast<int>(k)] = acc[k];
@@ -220,7 +225,8 @@ TEST_CASE("Feed-forward torque, velocities, gravity, local wrench, world constra
   zwang::Vec6 a;
   REQUIRE(zwang::frameAcceleration(m2, ws, m2.frameIndex("panda_link5"), zwang::Expressed::World, a));
   for (int k = 0; k < 6; ++k)
-    CHECK(s["frames"]["panda_link5"]["acceleration_world"][static_cast<std::size_t>(k)].get<double>() == Approx(a[k]).margin(1e-12));
+    CHECK(s["frames"]["panda_link5"]["acceleration_world"][static_cast<std::size_t>(k)].get<double>() ==
+          Approx(a[k]).margin(1e-12));
 }
 
 TEST_CASE("--pretty and -o give the same numbers", "[golden]") {
@@ -284,7 +290,8 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_wrong_type_q.json", {": q: expected an array", "a number"}},
       {"err_wrong_type_enabled.json", {": friction.enabled: expected true or false", "string"}},
       {"err_direction_length.json", {": constraints[1].directions[2]: has 5 entries, expected 6"}},
-      {"err_acceleration_length.json", {": constraints[0].acceleration: has 2 entries, expected 1", "one per direction"}},
+      {"err_acceleration_length.json",
+       {": constraints[0].acceleration: has 2 entries, expected 1", "one per direction"}},
       {"err_q_length.json", {": q: has 2 entries, expected 1", "joint1"}},
       {"err_nonfinite.json", {": wrenches[0].force[1]: ", "1e400", "out of range"}},
       {"err_huge.json", {": gravity[2]: ", "-1e+300", "too large"}},
@@ -351,7 +358,8 @@ TEST_CASE("Errors outside the problem's content", "[errors]") {
     CHECK(contains(r.err, "nowhere"));
   }
   SECTION("scenarios: no model") {
-    const Run r = run({"scenarios", "--models", cli_test::scratchDir() + "/nothing", "--out", cli_test::scratchDir() + "/sc-none"});
+    const Run r = run(
+        {"scenarios", "--models", cli_test::scratchDir() + "/nothing", "--out", cli_test::scratchDir() + "/sc-none"});
     checkOneLineError(r, 1);
     CHECK(contains(r.err, "one_dof_arm.urdf"));
     CHECK(contains(r.err, "--models"));
@@ -381,16 +389,17 @@ TEST_CASE("Deeply nested arrays and objects", "[robustness]") {
   struct Case {
     std::string text, part;
   };
-  const std::vector<Case> cases = {
-      {std::string(depth, '[') + std::string(depth, ']'), "nested deeper than 64 levels"},
-      {"{\"model\": \"x.urdf\", \"q\": " + std::string(depth, '[') + std::string(depth, ']') + "}", "q[0][0][0]"},
-      {[&] {
-         std::string s;
-         for (std::size_t k = 0; k < depth; ++k) s += "{\"a\":";
-         return s + "1" + std::string(depth, '}');
-       }(),
-       "nested deeper than 64 levels"},
-      {std::string(depth, '['), "nested deeper than 64 levels"},  // unterminated
+  const std::vector<Case> cases =
+      {
+          {std::string(depth, '[') + std::string(depth, ']'), "nested deeper than 64 levels"},
+          {"{\"model\": \"x.urdf\", \"q\": " + std::string(depth, '[') + std::string(depth, ']') + "}", "q[0][0][0]"},
+          {[&] {
+    std::string s;
+    for (std::size_t k = 0; k < depth; ++k) s += "{\"a\":";
+    return s + "1" + std::string(depth, '}');
+           }(),
+           "nested deeper than 64 levels"},
+          {std::string(depth, '['), "nested deeper than 64 levels"},  // unterminated
   };
   for (const Case& c : cases) {
     const std::string file = cli_test::scratchDir() + "/deep.json";
@@ -406,20 +415,24 @@ TEST_CASE("Huge numbers", "[robustness]") {
   struct Case {
     std::string text, part;
   };
-  const std::vector<Case> cases = {
-      {"{\"model\": " + arm + ", \"q\": [1e400]}", "q[0]: line 1, column"},
-      {"{\"model\": " + arm + ", \"q\": [-1e400]}", "out of range"},
-      {"{\"model\": " + arm + ", \"tau\": [1e300]}", "tau[0]: the number 1e+300 is too large"},
-      {"{\"model\": " + arm + ", \"tau\": [1e13]}", "tau[0]: the number 1e+13 is too large"},
-      {"{\"model\": " + arm + ", \"q\": [123456789012345678901234567890]}", "q[0]: the number 1.2345678901234568e+29 is too large"},
-      {"{\"model\": " + arm + ", \"q\": [1" + std::string(5000, '0') + "]}", "out of range"},
-      {"{\"model\": " + arm + ", \"gravity\": [0, 0, 1e-400]}", ""},  // underflows to 0: fine
-      {"{\"model\": " + arm + ", \"q\": [" + [] {
-         std::string s = "0";
-         for (int k = 0; k < 300000; ++k) s += ",0";
-         return s;
-       }() + "]}",
-       "q: has 300001 entries, expected 1"},
+  const std::vector<Case> cases =
+      {
+          {"{\"model\": " + arm + ", \"q\": [1e400]}", "q[0]: line 1, column"},
+          {"{\"model\": " + arm + ", \"q\": [-1e400]}", "out of range"},
+          {"{\"model\": " + arm + ", \"tau\": [1e300]}", "tau[0]: the number 1e+300 is too large"},
+          {"{\"model\": " + arm + ", \"tau\": [1e13]}", "tau[0]: the number 1e+13 is too large"},
+          {"{\"model\": " + arm + ", \"q\": [123456789012345678901234567890]}",
+           "q[0]: the number 1.2345678901234568e+29 is too large"},
+          {"{\"model\": " + arm + ", \"q\": [1" + std::string(5000, '0') + "]}", "out of range"},
+          {"{\"model\": " + arm + ", \"gravity\": [0, 0, 1e-400]}", ""},  // underflows to 0: fine
+          {"{\"model\": " + arm + ", \"q\": [" +
+               [] {
+    std::string s = "0";
+    for (int k = 0; k < 300000; ++k) s += ",0";
+    return s;
+           }() +
+           "]}",
+           "q: has 300001 entries, expected 1"},
   };
   for (const Case& c : cases) {
     const std::string file = cli_test::scratchDir() + "/huge.json";
@@ -787,7 +800,8 @@ TEST_CASE("energy: usage and a missing model", "[energy]") {
   const Run extra = run({"energy", "extra"});
   CHECK(extra.exit_code == 2);
   CHECK(contains(extra.err, "unexpected argument 'extra'"));
-  const Run none = run({"energy", "--models", cli_test::scratchDir() + "/nothing", "--out", cli_test::scratchDir() + "/en-none"});
+  const Run none =
+      run({"energy", "--models", cli_test::scratchDir() + "/nothing", "--out", cli_test::scratchDir() + "/en-none"});
   checkOneLineError(none, 1);
   CHECK(contains(none.err, "zwang: energy: "));
   CHECK(contains(none.err, "panda.urdf"));
@@ -818,8 +832,10 @@ TEST_CASE("the docs link only to files that exist", "[docs]") {
       std::istringstream lines(cli_test::readText(docs + "/" + name));
       bool fenced = false;
       for (std::string line; std::getline(lines, line);) {
-        if (line.rfind("```", 0) == 0) fenced = !fenced;
-        else if (!fenced) page += line + "\n";
+        if (line.rfind("```", 0) == 0)
+          fenced = !fenced;
+        else if (!fenced)
+          page += line + "\n";
       }
     }
     // Markdown links and images: ](target) with a relative target.
@@ -901,7 +917,8 @@ TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8"
     const Run outside = run({"solve", file});
     INFO("stderr: " << outside.err);
     CHECK(outside.exit_code == 0);
-    CHECK(contains(outside.err, "zwang: warning: " + file + ": q[0] = 0.5 puts joint 'j1' outside its limits [-0.2, 0.2]"));
+    CHECK(contains(outside.err,
+                   "zwang: warning: " + file + ": q[0] = 0.5 puts joint 'j1' outside its limits [-0.2, 0.2]"));
     cli_test::writeText(file, R"({"model": "doubtful.urdf", "strict": true})");
     const Run strict = run({"solve", file});
     checkOneLineError(strict, 1);

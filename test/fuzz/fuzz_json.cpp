@@ -46,9 +46,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (e.what()[0] == '\0' || e.exitCode() != kExitError) fuzz::failure("bad CliError from readProblem", e.what());
     return 0;
   }
-  problem.model_path = std::string(ZWANG_MODELS_DIR) + (problem.model_path.find("panda") != std::string::npos
-                                                            ? "/panda.urdf"
-                                                            : "/one_dof_arm.urdf");
+  problem.model_path = std::string(ZWANG_MODELS_DIR) +
+                       (problem.model_path.find("panda") != std::string::npos ? "/panda.urdf" : "/one_dof_arm.urdf");
   BoundProblem bound;
   try {
     bound = bindProblem(problem);

@@ -162,8 +162,7 @@ bool documented(StatusCode code) {
     case StatusCode::ModelMismatch:
     case StatusCode::Degenerate:
     case StatusCode::BadOption:
-    case StatusCode::Infeasible:
-      return true;
+    case StatusCode::Infeasible: return true;
   }
   return false;
 }
@@ -199,9 +198,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (Eigen::Index r = 0; r < task.targets().size(); ++r) task.targets()[r] = signedLog(in, 1e-3, 1e3);
   // The balance options anywhere in their valid ranges (0 < rank_tolerance < singular_threshold < 1).
   task.balance.singular_threshold = in.ConsumeBool() ? 1e-6 : logUniform(in, 1e-16, 1e-1);
-  task.balance.rank_tolerance =
-      in.ConsumeBool() ? std::min(1e-11, 0.5 * task.balance.singular_threshold)
-                       : task.balance.singular_threshold * logUniform(in, 1e-8, 0.99);
+  task.balance.rank_tolerance = in.ConsumeBool() ? std::min(1e-11, 0.5 * task.balance.singular_threshold)
+                                                 : task.balance.singular_threshold * logUniform(in, 1e-8, 0.99);
   task.balance.residual_tolerance = in.ConsumeBool() ? 1e-9 : logUniform(in, 1e-14, 1e-3);
 
   Eigen::VectorXd q(n), qd(n), tau(n);
@@ -242,7 +240,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   Status status = solveHybridDynamics(model, task, q, qd, tau, ws);
   if (!documented(status.code)) fuzz::failure("undocumented status", "solveHybridDynamics");
-  if (finite_inputs && status.code == StatusCode::NonFinite) fuzz::failure("NonFinite for finite inputs", status.message);
+  if (finite_inputs && status.code == StatusCode::NonFinite)
+    fuzz::failure("NonFinite for finite inputs", status.message);
   if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "solveHybridDynamics");
   if (status.ok()) checkSolution(ws, "solveHybridDynamics");
 
@@ -258,8 +257,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   if (finite_inputs) {
     status = inverseDynamics(model, task, q, qd, tau, ws);
-    if (status.ok()) fuzz::requireFinite(ws.tau, "tau (RNEA)", "inverseDynamics");
-    else if (!documented(status.code)) fuzz::failure("undocumented status", "inverseDynamics");
+    if (status.ok())
+      fuzz::requireFinite(ws.tau, "tau (RNEA)", "inverseDynamics");
+    else if (!documented(status.code))
+      fuzz::failure("undocumented status", "inverseDynamics");
     status = jointSpaceInertia(model, q, ws);
     if (status.ok()) fuzz::requireFinite(ws.H, "H", "jointSpaceInertia");
     Eigen::MatrixXd J(6, n);

@@ -25,8 +25,7 @@ int ChainSpec::linkIndex(const std::string& link_name) const {
 
 void ChainSpec::check() const {
   const std::string where = "ChainSpec '" + name + "': ";
-  if (links.size() != joints.size() + 1)
-    throw std::invalid_argument(where + "needs links.size() == joints.size() + 1");
+  if (links.size() != joints.size() + 1) throw std::invalid_argument(where + "needs links.size() == joints.size() + 1");
   std::set<std::string> names;
   for (const LinkSpec& link : links) {
     if (!names.insert("link:" + link.name).second) throw std::invalid_argument(where + "repeated link " + link.name);

@@ -37,8 +37,8 @@ struct JointSpec {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
   double lower = 0.0, upper = 0.0, effort = 0.0, velocity = 0.0;  // <limit>
   double friction = 0.0, damping = 0.0;                           // <dynamics>
-  double rotor_inertia = 0.0;  // <drake:rotor_inertia>; 0: no <transmission>
-  double gear_ratio = 1.0;     // <drake:gear_ratio>
+  double rotor_inertia = 0.0;                                     // <drake:rotor_inertia>; 0: no <transmission>
+  double gear_ratio = 1.0;                                        // <drake:gear_ratio>
 
   bool isFixed() const { return type == "fixed"; }
   bool isPrismatic() const { return type == "prismatic"; }

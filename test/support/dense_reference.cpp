@@ -174,8 +174,7 @@ double gaussFunction(const ChainSpec& spec, const DynamicsInput& input, const Ei
     const Vector6d bias_force = forceCross(kin.v[i]) * I * kin.v[i] - f_ext[i] - I * g;
     Z += 0.5 * a.dot(I * a) + bias_force.dot(a);
   }
-  for (Eigen::Index j = 0; j < qdd.size(); ++j)
-    Z += 0.5 * kin.reflected(j) * qdd(j) * qdd(j) - input.tau(j) * qdd(j);
+  for (Eigen::Index j = 0; j < qdd.size(); ++j) Z += 0.5 * kin.reflected(j) * qdd(j) * qdd(j) - input.tau(j) * qdd(j);
   return Z;
 }
 
@@ -194,8 +193,7 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
   for (std::size_t i = 0; i < spec.links.size(); ++i) {
     const Matrix6d& I = kin.inertia[i];
     out.H += kin.J[i].transpose() * I * kin.J[i];
-    out.C += kin.J[i].transpose() *
-             (I * kin.bias[i] + forceCross(kin.v[i]) * I * kin.v[i] - f_ext[i] - I * g);
+    out.C += kin.J[i].transpose() * (I * kin.bias[i] + forceCross(kin.v[i]) * I * kin.v[i] - f_ext[i] - I * g);
   }
   out.H = (0.5 * (out.H + out.H.transpose())).eval();  // eval: the transpose aliases H
 
@@ -207,7 +205,8 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
   out.gamma = Eigen::VectorXd::Zero(m);
   int row = 0;
   for (const ConstraintInput& c : input.constraints) {
-    if (c.b.size() != c.A.cols()) throw std::invalid_argument("dense reference: constraint b must have A.cols() entries");
+    if (c.b.size() != c.A.cols())
+      throw std::invalid_argument("dense reference: constraint b must have A.cols() entries");
     const int link = spec.linkIndex(c.link);
     const auto li = static_cast<std::size_t>(link);
     const Eigen::Vector3d p = kin.poses[li].translation();

@@ -77,13 +77,13 @@ struct DenseKinematics {
 DenseKinematics denseKinematics(const ChainSpec& spec, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
 
 struct DenseResult {
-  Eigen::MatrixXd H;        // n×n joint-space inertia
-  Eigen::VectorXd C;        // bias (Coriolis, centrifugal, gravity, −external)
-  Eigen::VectorXd qdd;      // q̈
-  Eigen::VectorXd nu;       // ν, rows in input order (constraint by constraint)
-  Eigen::VectorXd tau_c;    // Σ J_iᵀ A_i ν_i = Gᵀ ν (physical constraint torques)
-  double gauss = 0.0;       // Z(q̈) of docs/theory.md §1 at the solution
-  Eigen::MatrixXd G;        // m×n constraint rows: G q̈ = gamma
+  Eigen::MatrixXd H;      // n×n joint-space inertia
+  Eigen::VectorXd C;      // bias (Coriolis, centrifugal, gravity, −external)
+  Eigen::VectorXd qdd;    // q̈
+  Eigen::VectorXd nu;     // ν, rows in input order (constraint by constraint)
+  Eigen::VectorXd tau_c;  // Σ J_iᵀ A_i ν_i = Gᵀ ν (physical constraint torques)
+  double gauss = 0.0;     // Z(q̈) of docs/theory.md §1 at the solution
+  Eigen::MatrixXd G;      // m×n constraint rows: G q̈ = gamma
   Eigen::VectorXd gamma;
   std::vector<Eigen::Isometry3d> poses;  // ⁰T_link for every link
   std::vector<Vector6d> acc_world;       // classical [p̈; ω̇] of every link origin, world axes
@@ -120,9 +120,9 @@ Vector6d linkAcceleration(const ChainSpec& spec, const Eigen::VectorXd& q, const
                           const Eigen::VectorXd& qdd, const std::string& link, Axes axes);
 
 // Small spatial-algebra helpers of the reference (linear part first).
-Eigen::Matrix3d skew3(const Eigen::Vector3d& a);           // skew3(a) b = a × b
-Matrix6d motionCross(const Vector6d& v);                   // v× = [ω× v×; 0 ω×]
-Matrix6d forceCross(const Vector6d& v);                    // v×* = −(v×)ᵀ
+Eigen::Matrix3d skew3(const Eigen::Vector3d& a);  // skew3(a) b = a × b
+Matrix6d motionCross(const Vector6d& v);          // v× = [ω× v×; 0 ω×]
+Matrix6d forceCross(const Vector6d& v);           // v×* = −(v×)ᵀ
 // Spatial inertia at the world origin of a body with mass m, COM c and
 // rotational inertia Ic about the COM (all world components).
 Matrix6d spatialInertia(double m, const Eigen::Vector3d& c, const Eigen::Matrix3d& Ic);

@@ -28,13 +28,13 @@ namespace zwang::testing {
 // What the caller expects from the model, the state and the options — read
 // straight from the Model's joints and the FrictionOptions overrides.
 struct FrictionExpectation {
-  std::vector<int> stuck;      // Θ₀
-  Eigen::VectorXd breakaway;   // f_j
-  Eigen::VectorXd kinetic;     // f_c,j
-  Eigen::VectorXd viscous;     // b_j
-  Eigen::VectorXd tau_kinetic; // −f_c sign q̇ − b q̇ on moving joints, 0 on stuck ones
-  Eigen::VectorXi limit_side;  // −1: stuck on the lower limit, +1: upper, 0: neither (or limits off)
-  Eigen::VectorXd tau;         // the feed-forward τ (for τ_control = τ + τ_c)
+  std::vector<int> stuck;       // Θ₀
+  Eigen::VectorXd breakaway;    // f_j
+  Eigen::VectorXd kinetic;      // f_c,j
+  Eigen::VectorXd viscous;      // b_j
+  Eigen::VectorXd tau_kinetic;  // −f_c sign q̇ − b q̇ on moving joints, 0 on stuck ones
+  Eigen::VectorXi limit_side;   // −1: stuck on the lower limit, +1: upper, 0: neither (or limits off)
+  Eigen::VectorXd tau;          // the feed-forward τ (for τ_control = τ + τ_c)
 };
 
 FrictionExpectation expectFriction(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,

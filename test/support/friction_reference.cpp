@@ -82,7 +82,7 @@ FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
     s.breakaway(j) = joint.friction;
     s.kinetic(j) = joint.friction;  // default f_c = f: docs/friction.md, "The model of friction"
-    s.viscous(j) = joint.damping;  // URDF <dynamics damping>
+    s.viscous(j) = joint.damping;   // URDF <dynamics damping>
     if (std::abs(qd(j)) <= velocity_tolerance) s.stuck.push_back(j);
   }
   return s;
@@ -130,7 +130,8 @@ FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput&
     Eigen::VectorXd mu = Eigen::VectorXd::Zero(n);
     for (int s = 0; s < k; ++s) {
       const int j = setup.stuck[static_cast<std::size_t>(s)];
-      const Choice c = choices[static_cast<std::size_t>(s)][static_cast<std::size_t>(digit[static_cast<std::size_t>(s)])];
+      const Choice c =
+          choices[static_cast<std::size_t>(s)][static_cast<std::size_t>(digit[static_cast<std::size_t>(s)])];
       if (c == Choice::Stick) {
         stick.push_back(j);
       } else {
@@ -148,9 +149,9 @@ FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput&
     bool singular = false;
     if (r > 0) {
       const Eigen::MatrixXd L = Gaug * Hinv * Gaug.transpose();
-      const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(0.5 * (L + L.transpose()),
-                                                                                 Eigen::EigenvaluesOnly)
-                                     .eigenvalues();
+      const Eigen::VectorXd ev =
+          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(0.5 * (L + L.transpose()), Eigen::EigenvaluesOnly)
+              .eigenvalues();
       singular = !(ev(0) > options.singular_threshold * ev(ev.size() - 1));
     }
     if (singular) {
@@ -172,7 +173,8 @@ FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput&
         const int j = setup.stuck[static_cast<std::size_t>(s)];
         const int side = limitSide(setup, j);
         const double f = setup.breakaway(j);
-        const Choice c = choices[static_cast<std::size_t>(s)][static_cast<std::size_t>(digit[static_cast<std::size_t>(s)])];
+        const Choice c =
+            choices[static_cast<std::size_t>(s)][static_cast<std::size_t>(digit[static_cast<std::size_t>(s)])];
         if (c == Choice::Stick) {
           const bool above = mu(j) > f + t_tol, below = mu(j) < -f - t_tol;
           if ((above && side <= 0) || (below && side >= 0)) valid = false;
@@ -197,8 +199,10 @@ FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput&
           out.pattern = pattern;
         } else {
           Eigen::VectorXd d = qdd - out.qdd;
-          out.qdd_spread = std::max(out.qdd_spread, d.cwiseAbs().maxCoeff() / std::max(1.0, out.qdd.cwiseAbs().maxCoeff()));
-          out.gauss_spread = std::max(out.gauss_spread, std::abs(g - out.gauss_dual) / std::max(1.0, std::abs(out.gauss_dual)));
+          out.qdd_spread =
+              std::max(out.qdd_spread, d.cwiseAbs().maxCoeff() / std::max(1.0, out.qdd.cwiseAbs().maxCoeff()));
+          out.gauss_spread =
+              std::max(out.gauss_spread, std::abs(g - out.gauss_dual) / std::max(1.0, std::abs(out.gauss_dual)));
           out.mu_spread = std::max(out.mu_spread, (mu - out.mu).cwiseAbs().maxCoeff());
         }
         ++out.valid_patterns;
@@ -268,7 +272,8 @@ SampledFriction sampledFriction(const ChainSpec& spec, const DynamicsInput& inpu
 
   SampledFriction out;
   out.spacing.resize(k);
-  for (int s = 0; s < k; ++s) out.spacing(s) = 2.0 * setup.breakaway(setup.stuck[static_cast<std::size_t>(s)]) / (points - 1);
+  for (int s = 0; s < k; ++s)
+    out.spacing(s) = 2.0 * setup.breakaway(setup.stuck[static_cast<std::size_t>(s)]) / (points - 1);
   out.g = -std::numeric_limits<double>::infinity();
   const int total = k == 1 ? points : points * points;
   for (int idx = 0; idx < total; ++idx) {

@@ -53,10 +53,10 @@ namespace zwang::testing {
 
 // The friction part of a problem, per dof (length spec.dof()).
 struct FrictionSetup {
-  std::vector<int> stuck;      // Θ₀, dof indices, ascending
-  Eigen::VectorXd breakaway;   // f_j ≥ 0
-  Eigen::VectorXd kinetic;     // f_c,j ≥ 0 (moving joints)
-  Eigen::VectorXd viscous;     // b_j ≥ 0 (moving joints)
+  std::vector<int> stuck;     // Θ₀, dof indices, ascending
+  Eigen::VectorXd breakaway;  // f_j ≥ 0
+  Eigen::VectorXd kinetic;    // f_c,j ≥ 0 (moving joints)
+  Eigen::VectorXd viscous;    // b_j ≥ 0 (moving joints)
   // −1: stuck on its lower limit, +1: on its upper limit, 0: free. Empty = all free.
   Eigen::VectorXi limit_side;
 };
@@ -64,27 +64,26 @@ struct FrictionSetup {
 // Friction data as the model would read it from the spec's URDF: breakaway =
 // kinetic = <dynamics friction>, damping = <dynamics damping>; Θ₀ = joints
 // with |q̇_j| ≤ velocity_tolerance; no limits.
-FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd& qd,
-                                    double velocity_tolerance = 1e-6);
+FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd& qd, double velocity_tolerance = 1e-6);
 
 // −f_c,j sign(q̇_j) − b_j q̇_j on the moving joints, 0 on the stuck ones.
 Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd& qd);
 
 struct BruteForceOptions {
-  double torque_tolerance = 1e-9;        // slack on |μ_j| ≤ f_j, × max(1, max f, max |μ|)
-  double acceleration_tolerance = 1e-10; // slack on the slip signs, × max(1, max |q̈|)
-  double singular_threshold = 1e-10;     // λ_min/λ_max of the augmented coupling matrix
+  double torque_tolerance = 1e-9;         // slack on |μ_j| ≤ f_j, × max(1, max f, max |μ|)
+  double acceleration_tolerance = 1e-10;  // slack on the slip signs, × max(1, max |q̈|)
+  double singular_threshold = 1e-10;      // λ_min/λ_max of the augmented coupling matrix
 };
 
 struct FrictionReference {
-  bool feasible = false;      // some pattern is valid
-  Eigen::VectorXd qdd;        // q̈*
-  Eigen::VectorXd mu;         // a valid μ* (per dof, 0 off Θ₀)
-  Eigen::VectorXd nu;         // the task's multipliers for that pattern
+  bool feasible = false;  // some pattern is valid
+  Eigen::VectorXd qdd;    // q̈*
+  Eigen::VectorXd mu;     // a valid μ* (per dof, 0 off Θ₀)
+  Eigen::VectorXd nu;     // the task's multipliers for that pattern
   Eigen::VectorXd tau_kinetic;
-  double gauss_dual = 0.0;    // g(μ*) = Z(q̈*) + μ*ᵀ W q̈*
-  std::string pattern;        // one char per stuck joint: 's' stick, '+' slip+, '-' slip−, 'L' stick beyond f at a limit
-  int patterns = 0;           // enumerated
+  double gauss_dual = 0.0;  // g(μ*) = Z(q̈*) + μ*ᵀ W q̈*
+  std::string pattern;  // one char per stuck joint: 's' stick, '+' slip+, '-' slip−, 'L' stick beyond f at a limit
+  int patterns = 0;     // enumerated
   int valid_patterns = 0;
   int singular_patterns = 0;  // skipped as rank deficient
   // Spread among the valid patterns (uniqueness checks): q̈ and g must agree;

@@ -104,9 +104,8 @@ KDL::Chain toKdlChain(const ChainSpec& spec) {
     // URDF's inertial-frame inertia into link axes.
     const Eigen::Matrix3d R = rpyToMatrix(child.inertial_rpy);
     const Eigen::Matrix3d I = R * child.inertia * R.transpose();
-    const KDL::RigidBodyInertia inertia(
-        child.mass, toKdl(child.com),
-        KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
+    const KDL::RigidBodyInertia inertia(child.mass, toKdl(child.com),
+                                        KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
     chain.addSegment(KDL::Segment(child.name, joint, origin, inertia));
   }
   return chain;
@@ -129,8 +128,9 @@ KdlHybridResult kdlHybridDynamics(const ChainSpec& spec, const DynamicsInput& in
   // segment. Measured in test_references.cpp ("KDL Vereshchagin and fixed
   // segments"). Use mergeFixedJoints first.
   if (hasFixedJoints(spec))
-    throw std::invalid_argument("kdlHybridDynamics: KDL's Vereshchagin solver cannot handle fixed joints; "
-                                "merge them first (mergeFixedJoints)");
+    throw std::invalid_argument(
+        "kdlHybridDynamics: KDL's Vereshchagin solver cannot handle fixed joints; "
+        "merge them first (mergeFixedJoints)");
   if (input.constraints.size() > 1)
     throw std::invalid_argument("kdlHybridDynamics: KDL takes one constraint, on the last link");
   const std::string& tip_name = spec.links.back().name;
@@ -150,14 +150,11 @@ KdlHybridResult kdlHybridDynamics(const ChainSpec& spec, const DynamicsInput& in
   // velocity ω, both in base axes.
   KDL::ChainFkSolverVel_recursive fk_vel(chain);
   std::vector<KDL::FrameVel> frames(ns);
-  if (fk_vel.JntToCart(KDL::JntArrayVel(q, qd), frames) < 0)
-    throw std::runtime_error("KDL velocity kinematics failed");
+  if (fk_vel.JntToCart(KDL::JntArrayVel(q, qd), frames) < 0) throw std::runtime_error("KDL velocity kinematics failed");
   auto rotation = [&](std::size_t link) {
     return link == 0 ? Eigen::Matrix3d::Identity() : toEigen(frames[link - 1].M.R);
   };
-  auto omega = [&](std::size_t link) {
-    return link == 0 ? Eigen::Vector3d::Zero() : toEigen(frames[link - 1].M.w);
-  };
+  auto omega = [&](std::size_t link) { return link == 0 ? Eigen::Vector3d::Zero() : toEigen(frames[link - 1].M.w); };
   auto origin_velocity = [&](std::size_t link) {
     return link == 0 ? Eigen::Vector3d::Zero() : toEigen(frames[link - 1].p.v);
   };

@@ -40,16 +40,16 @@ struct KdlHybridResult {
   Eigen::VectorXd tau_c;  // physical constraint torques J_tipᵀ (A ν), J from KDL
   std::vector<Vector6d> acc_world;  // classical [p̈; ω̇] of every link origin, world axes
   // --- KDL's own inputs and outputs, as passed / returned ---------------------
-  Matrix6Xd alpha;                        // unit constraint forces, base axes, at the tip origin
-  Eigen::VectorXd beta;                   // set points on KDL's spatial acceleration incl. −g
-  Vector6d root_acc = Vector6d::Zero();   // [−g; 0]
-  std::vector<Vector6d> f_ext;            // per segment, base axes, at the segment tip
-  Eigen::VectorXd nu_kdl;                 // getContraintForceMagnitude
-  Eigen::VectorXd constraint_torques_kdl; // CartToJnt's constraint_torques: Sᵀ (articulated E) ν
-  Eigen::VectorXd total_torques_kdl;      // getTotalTorque
-  std::vector<Vector6d> x_dotdot_kdl;     // getTransformedLinkAcceleration (ns+1 entries, [0] = root)
-  Eigen::MatrixXd jacobian_tip;           // ChainJntToJacSolver: base axes, tip origin, [v; ω] rows
-  int error = 0;                          // CartToJnt's return code
+  Matrix6Xd alpha;                         // unit constraint forces, base axes, at the tip origin
+  Eigen::VectorXd beta;                    // set points on KDL's spatial acceleration incl. −g
+  Vector6d root_acc = Vector6d::Zero();    // [−g; 0]
+  std::vector<Vector6d> f_ext;             // per segment, base axes, at the segment tip
+  Eigen::VectorXd nu_kdl;                  // getContraintForceMagnitude
+  Eigen::VectorXd constraint_torques_kdl;  // CartToJnt's constraint_torques: Sᵀ (articulated E) ν
+  Eigen::VectorXd total_torques_kdl;       // getTotalTorque
+  std::vector<Vector6d> x_dotdot_kdl;      // getTransformedLinkAcceleration (ns+1 entries, [0] = root)
+  Eigen::MatrixXd jacobian_tip;            // ChainJntToJacSolver: base axes, tip origin, [v; ω] rows
+  int error = 0;                           // CartToJnt's return code
 };
 
 // KDL's Vereshchagin solver on our problem. Accepts at most one constraint, on

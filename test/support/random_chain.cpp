@@ -77,7 +77,8 @@ Eigen::Matrix3d randomInertia(std::mt19937_64& rng, double mass) {
 }
 
 ChainSpec randomChain(std::mt19937_64& rng, const RandomChainOptions& options) {
-  const int n = uniformInt(rng, options.min_moving_joints, std::max(options.min_moving_joints, options.max_moving_joints));
+  const int n =
+      uniformInt(rng, options.min_moving_joints, std::max(options.min_moving_joints, options.max_moving_joints));
 
   // Joint sequence: maybe a fixed joint, then (moving joint, maybe a fixed joint) × n.
   std::vector<bool> is_fixed;
@@ -102,8 +103,8 @@ ChainSpec randomChain(std::mt19937_64& rng, const RandomChainOptions& options) {
       joint.type = uniform01(rng) < options.continuous_probability ? "continuous" : "revolute";
     }
     const double length = uniform(rng, 0.05, 0.5);
-    joint.xyz = length * (uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng)
-                                                                             : randomUnitVector(rng));
+    joint.xyz =
+        length * (uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng) : randomUnitVector(rng));
     joint.rpy = uniform01(rng) < 0.2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(randomVector(rng, 3, kPi));
     joint.axis = uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng) : randomUnitVector(rng);
     if (!joint.isFixed()) {

@@ -26,7 +26,7 @@ struct RandomChainOptions {
   double continuous_probability = 0.2;
   // Probability that a joint axis (and separately a joint offset) is along ±x, ±y or ±z.
   double axis_aligned_probability = 0.3;
-  bool rotor_inertia = true;  // random rotor inertias and gear ratios
+  bool rotor_inertia = true;                      // random rotor inertias and gear ratios
   double friction_min = 0.0, friction_max = 5.0;  // breakaway friction [N·m or N]
   double damping_min = 0.0, damping_max = 1.0;    // viscous damping
 };

@@ -10,7 +10,7 @@ namespace zwang::spatial {
 
 /// Spatial rigid-body inertia (m, h = m·c, Ī about the frame origin), as in the file comment.
 struct RigidInertia {
-  double mass = 0.0;  ///< m [kg]
+  double mass = 0.0;         ///< m [kg]
   Vec3 h = Vec3::Zero();     ///< first mass moment m·c
   Mat3 Ibar = Mat3::Zero();  ///< rotational inertia about the origin
 

@@ -18,7 +18,7 @@ namespace zwang::spatial {
 /// Plücker transform ᴮX_A, stored as the rotation E and the translation r of the file comment.
 struct Transform {
   Mat3 E = Mat3::Identity();  ///< E = ᴮR_A: takes A's components to B's.
-  Vec3 r = Vec3::Zero();  ///< r: the origin of B, expressed in A.
+  Vec3 r = Vec3::Zero();      ///< r: the origin of B, expressed in A.
 
   /// The identity (B = A).
   static Transform identity() { return {}; }

@@ -9,8 +9,8 @@
 
 namespace zwang {
 
-using Vec3 = Eigen::Vector3d;  ///< 3-vector: a position, or the linear or angular part of a spatial vector.
-using Mat3 = Eigen::Matrix3d;  ///< 3×3 matrix: a rotation or a rotational inertia.
+using Vec3 = Eigen::Vector3d;              ///< 3-vector: a position, or the linear or angular part of a spatial vector.
+using Mat3 = Eigen::Matrix3d;              ///< 3×3 matrix: a rotation or a rotational inertia.
 using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< Spatial vector, linear part first: motion [v; ω] or force [f; n].
 using Mat6 = Eigen::Matrix<double, 6, 6>;  ///< 6×6 spatial matrix: an inertia or a transform.
 
@@ -18,9 +18,15 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;  ///< 6×6 spatial matrix: an inertia 
 namespace spatial {
 
 /// The linear (first three) and angular (last three) parts of a spatial vector.
-template <class V> inline auto lin(V&& x) { return x.template head<3>(); }
+template <class V>
+inline auto lin(V&& x) {
+  return x.template head<3>();
+}
 /// The angular part (last three) of a spatial vector.
-template <class V> inline auto ang(V&& x) { return x.template tail<3>(); }
+template <class V>
+inline auto ang(V&& x) {
+  return x.template tail<3>();
+}
 
 /// The spatial vector [linear; angular].
 inline Vec6 stack(const Vec3& linear, const Vec3& angular) {

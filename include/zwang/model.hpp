@@ -42,7 +42,7 @@ struct Joint {
   double rotor_inertia = 0.0;            ///< d_j, reflected armature inertia [kg·m² or kg]
   double breakaway_friction = 0.0;       ///< f_j ≥ 0, static friction bound
   double kinetic_friction = 0.0;         ///< f_c,j ≥ 0, Coulomb friction while moving
-  double viscous_friction = 0.0;         ///< b_j ≥ 0, viscous friction coefficient (URDF <dynamics damping>)
+  double viscous_friction = 0.0;         ///< b_j ≥ 0, viscous friction coefficient (URDF `dynamics damping`)
   double lower = -std::numeric_limits<double>::infinity();  ///< position limits: lower [rad or m]
   double upper = std::numeric_limits<double>::infinity();   ///< position limits: upper [rad or m]
   /// Largest torque [N·m] or force [N] (URDF `<limit effort>`).

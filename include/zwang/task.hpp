@@ -25,26 +25,26 @@ enum class Expressed { Local, World, Aligned = World };
 /// A: 6×m, one unit constraint force [l; r] (linear part first) per column.
 using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// Options of the balance ν = 𝓛⁺ r of Algorithm 1's line 25 (docs/solver.md,
-// "Singular tasks"). 𝓛 is judged after equilibration, 𝓛̃ = E 𝓛 E with
-// E = diag(1/√𝓛_ii), so that rows in metres and radians, on heavy or light
-// links, weigh alike; its eigenvalues σ̃ lie in [0, m].
-//   σ̃ ≥ singular_threshold : solved exactly (every regular task);
-//   σ̃ ≤ rank_tolerance     : exact rank loss: no force along it, and the task
-//                            is met in the least-squares sense (rows' units);
-//   in between             : near-singular: the gain ramps linearly from 0 to
-//                            1/σ̃ (and the least-squares projection from full
-//                            to none), so ν stays bounded (at most
-//                            1/singular_threshold in 𝓛̃'s units) and
-//                            continuous as an arm passes through a singularity.
-// After the solve a row counts as met when |Aᵀ Ẍ − b| ≤ residual_tolerance ×
-// the size of the terms it is computed from (BalanceReport::consistent).
+/// Options of the balance ν = 𝓛⁺ r of Algorithm 1's line 25 (docs/solver.md,
+/// "Singular tasks"). 𝓛 is judged after equilibration, 𝓛̃ = E 𝓛 E with
+/// E = diag(1/√𝓛_ii), so that rows in metres and radians, on heavy or light
+/// links, weigh alike; its eigenvalues σ̃ lie in [0, m].
+///   σ̃ ≥ singular_threshold : solved exactly (every regular task);
+///   σ̃ ≤ rank_tolerance     : exact rank loss: no force along it, and the task
+///                            is met in the least-squares sense (rows' units);
+///   in between             : near-singular: the gain ramps linearly from 0 to
+///                            1/σ̃ (and the least-squares projection from full
+///                            to none), so ν stays bounded (at most
+///                            1/singular_threshold in 𝓛̃'s units) and
+///                            continuous as an arm passes through a singularity.
+/// After the solve a row counts as met when |Aᵀ Ẍ − b| ≤ residual_tolerance ×
+/// the size of the terms it is computed from (BalanceReport::consistent).
 struct BalanceOptions {
-  // Exact null directions come out at ~1e-15 (rounding) and regular ones of
-  // random chains above ~1e-3 (test_singular prints both): a wide gap.
-  double singular_threshold = 1e-6;
-  double rank_tolerance = 1e-11;
-  double residual_tolerance = 1e-9;
+  // Defaults: exact null directions come out at ~1e-15 (rounding) and regular
+  // ones of random chains above ~1e-3 (test_singular measures both): a wide gap.
+  double singular_threshold = 1e-6;  ///< equilibrated eigenvalues below it are near-singular (in (0, 1))
+  double rank_tolerance = 1e-11;     ///< at or below it: exact rank loss (in [0, singular_threshold))
+  double residual_tolerance = 1e-9;  ///< a row is met within this fraction of its terms' size (> 0)
 };
 
 /// BadOption naming the field when an option is out of range (every solve

@@ -19,26 +19,26 @@ namespace internal {
 struct FrictionScratch;
 }
 
-// How the balance of line 25 went (docs/solver.md, "Singular tasks"). The
-// eigenvalues meant here are those of the equilibrated 𝓛̃ (see BalanceOptions).
+/// How the balance of line 25 went (docs/solver.md, "Singular tasks"). The
+/// eigenvalues meant here are those of the equilibrated 𝓛̃ (see BalanceOptions).
 struct BalanceReport {
-  int rows = 0;  // m, the number of constraint rows
-  int rank = 0;  // m minus the directions of exact rank loss (σ̃ ≤ rank_tolerance)
-  // Frobenius condition number ‖𝓛̃‖_F ‖𝓛̃⁻¹‖_F of the equilibrated matrix
-  // (infinite when 𝓛 is singular): at least σ̃_max/σ̃_min and at most m times it.
+  int rows = 0;  ///< m, the number of constraint rows
+  int rank = 0;  ///< m minus the directions of exact rank loss (σ̃ ≤ rank_tolerance)
+  /// Frobenius condition number ‖𝓛̃‖_F ‖𝓛̃⁻¹‖_F of the equilibrated matrix
+  /// (infinite when 𝓛 is singular): at least σ̃_max/σ̃_min and at most m times it.
   double condition = 1.0;
-  // How far the most damped near-singular direction is from being solved
-  // exactly, in [0, 1): 1 − (σ̃ − rank_tolerance)/(singular_threshold −
-  // rank_tolerance); 0 when every direction was solved exactly or dropped as
-  // exact rank loss.
+  /// How far the most damped near-singular direction is from being solved
+  /// exactly, in [0, 1): 1 − (σ̃ − rank_tolerance)/(singular_threshold −
+  /// rank_tolerance); 0 when every direction was solved exactly or dropped as
+  /// exact rank loss.
   double damping = 0.0;
-  bool singular = false;  // some σ̃ below singular_threshold: a direction was dropped or damped
-  // ‖Aᵀ Ẍ − b‖₂ over the task's rows, in the rows' own units (m/s², rad/s²),
-  // measured on the final accelerations.
+  bool singular = false;  ///< some σ̃ below singular_threshold: a direction was dropped or damped
+  /// ‖Aᵀ Ẍ − b‖₂ over the task's rows, in the rows' own units (m/s², rad/s²),
+  /// measured on the final accelerations.
   double residual = 0.0;
-  // Every row met to within residual_tolerance of its terms' size. False for
-  // an inconsistent task (met in the least-squares sense only) and for a
-  // damped direction that had to give.
+  /// Every row met to within residual_tolerance of its terms' size. False for
+  /// an inconsistent task (met in the least-squares sense only) and for a
+  /// damped direction that had to give.
   bool consistent = true;
 };
 

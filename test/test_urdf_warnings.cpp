@@ -355,3 +355,83 @@ TEST_CASE("world is the root link's frame: a root turned +90 deg about x needs g
   REQUIRE(inverseDynamics(turned, turned_task, q, zero, zero, turned_ws));
   CHECK(relativeError(turned_ws.tau, upright_ws.tau) > 0.1);
 }
+
+TEST_CASE("a mimic joint on the chain is refused; mass on a moving side branch is warned", "[urdf][errors]") {
+  // base -j1-> l1 -fixed-> palm, palm -f1-> finger1 (leader), palm -f2-> finger2 (mimics f1)
+  const std::string gripper = R"(<robot name="gripper"><link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2" effort="10" velocity="3"/></joint>
+  <link name="l1"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="palm_joint" type="fixed"><parent link="l1"/><child link="palm"/><origin xyz="0.3 0 0"/></joint>
+  <link name="palm"/>
+  <joint name="f1" type="prismatic"><parent link="palm"/><child link="finger1"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.04" effort="10" velocity="1"/></joint>
+  <link name="finger1"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+  <joint name="f2" type="prismatic"><parent link="palm"/><child link="finger2"/><axis xyz="0 -1 0"/>
+    <limit lower="0" upper="0.04" effort="10" velocity="1"/><mimic joint="f1" multiplier="1" offset="0"/></joint>
+  <link name="finger2"><inertial><mass value="0.2"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+</robot>)";
+  UrdfOptions to_finger2;
+  to_finger2.tip = "finger2";
+  REQUIRE_THROWS_WITH(loadUrdfString(gripper, to_finger2),
+                      Contains("joint 'f2' on the chain mimics joint 'f1' (q = 1·q_f1 + 0)") &&
+                          Contains("choose a UrdfOptions::tip before it (e.g. 'palm')"));
+  UrdfOptions to_finger1;
+  to_finger1.tip = "finger1";
+  const Model m = loadUrdfString(gripper, to_finger1);  // the leader's chain: finger2 rides on l1, off the chain
+  REQUIRE(codes(m) == Codes{WarningCode::MassOffChain});
+  CHECK_THAT(m.warnings()[0].message, Contains("'finger2', 0.2 kg in all) behind moving joint 'f2' off the chain"));
+  CHECK_THROWS_WITH(loadUrdfString(
+                        gripper,
+                        [&] {
+    UrdfOptions o = to_finger1;
+    o.strict = true;
+    return o;
+                        }()),
+                    Contains("off the chain"));
+  UrdfOptions to_palm;
+  to_palm.tip = "palm";  // both fingers beyond the tip: that warning, not this one
+  CHECK(codes(loadUrdfString(gripper, to_palm)) == Codes{WarningCode::MassBeyondTip});
+}
+
+TEST_CASE("Baxter: each arm loads with the warnings its data calls for and solves; a mimic finger is refused",
+          "[urdf][warnings]") {
+  const std::string file = std::string(ZWANG_MODELS_DIR) + "/baxter.urdf";
+  for (const std::string side : {"left", "right"}) {
+    INFO(side << " arm");
+    UrdfOptions options;
+    options.tip = side + "_gripper";
+    const Model model = loadUrdfFile(file, options);
+    REQUIRE(model.dof() == 7);
+    // The gripper base's inertia (0.3 kg, moments 2e-8) is a placeholder, the
+    // gripper frame a point mass, the fingers (0.06 kg) lie beyond the tip;
+    // the other arm and the head hang off the fixed base: not warned.
+    CHECK(codes(model) == Codes{WarningCode::PlaceholderInertia, WarningCode::PointMass, WarningCode::MassBeyondTip});
+    // Holding the gripper still with 6 world rows at a bent pose: the task
+    // is met (the 7th joint's self-motion stays free) and τ_control
+    // reproduces q̈ through inverse dynamics (closure).
+    Task task(model);
+    task.addConstraint(options.tip, ConstraintMatrix::Identity(6, 6), Expressed::World);
+    Workspace ws(model, task);
+    Eigen::VectorXd q(7), zero = Eigen::VectorXd::Zero(7);
+    q << 0.3, -0.5, 0.2, 1.2, -0.3, 0.8, 0.1;
+    REQUIRE(solveHybridDynamics(model, task, q, zero, zero, ws));
+    CHECK(ws.solution.balance.consistent);
+    const int gripper = model.frameIndex(options.tip);
+    Vec6 a;
+    REQUIRE(frameAcceleration(model, ws, gripper, Expressed::World, a));
+    CHECK(a.norm() < 1e-10);
+    Task free_task(model);
+    Workspace id(model, free_task);
+    REQUIRE(inverseDynamics(model, free_task, q, zero, ws.solution.qdd, id));
+    CHECK((id.tau - ws.solution.tau_control).norm() < 1e-9 * (1.0 + id.tau.norm()));
+    REQUIRE(solveWithFriction(model, task, q, zero, zero, ws));  // every joint stuck
+    CHECK(ws.solution.balance.consistent);
+    REQUIRE(frameAcceleration(model, ws, gripper, Expressed::World, a));
+    CHECK(a.norm() < 1e-10);
+  }
+  UrdfOptions through_mimic;
+  through_mimic.tip = "r_gripper_r_finger_tip";
+  CHECK_THROWS_WITH(loadUrdfFile(file, through_mimic),
+                    Contains("joint 'r_gripper_r_finger_joint' on the chain mimics joint 'r_gripper_l_finger_joint'"));
+}

@@ -85,6 +85,7 @@ enum class WarningCode {
   TriangleInequality,  ///< principal moments with a + b < c (no real body has them)
   PlaceholderLimits,   ///< <limit lower == upper, effort == velocity == 0>: read as "no limits"
   MassBeyondTip,       ///< links behind a moving joint below the tip carry mass the chain ignores
+  MassOffChain,        ///< links behind a moving joint off the chain (a side branch) carry mass it ignores
   /// that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
   PayloadAttached,
   Urdfdom,  ///< urdfdom's own warning, passed on once

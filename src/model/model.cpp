@@ -59,6 +59,7 @@ const char* toString(WarningCode code) {
     case WarningCode::TriangleInequality: return "triangle_inequality";
     case WarningCode::PlaceholderLimits: return "placeholder_limits";
     case WarningCode::MassBeyondTip: return "mass_beyond_tip";
+    case WarningCode::MassOffChain: return "mass_off_chain";
     case WarningCode::PayloadAttached: return "payload_attached";
     case WarningCode::Urdfdom: return "urdfdom";
   }

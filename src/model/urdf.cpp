@@ -21,7 +21,9 @@
 // joints only (side branches, links below the tip, fixed parents of the root)
 // is a frame. Links connected through a moving joint that is not on the chain
 // are NOT part of the model: their mass is ignored, as KDL's tree→chain
-// conversion does. A <mimic> tag is ignored (the joint stays independent).
+// conversion does, with a warning when they ride on a moving body (beyond the
+// tip, or a side branch). A <mimic> joint on the chain is refused: a chain of
+// independent joints cannot follow a leader.
 #include "zwang/urdf.hpp"
 
 #include <console_bridge/console.h>
@@ -606,6 +608,63 @@ Transform lockedPlacement(const Reporter& report, const urdf::Joint& uj, double 
   return joint.transform(q);
 }
 
+// A <mimic> joint on the chain follows its leader (q = a·q_leader + b): a
+// serial chain of independent joints cannot keep that coupling, and treating
+// the joint as independent would be a silent wrong answer. Refused, with the
+// way around it.
+void refuseMimicOnChain(const Reporter& report, const std::vector<LinkPtr>& chain, const std::string& tip_option) {
+  for (std::size_t k = 1; k < chain.size(); ++k) {
+    const urdf::Joint& uj = *chain[k]->parent_joint;
+    if (!isMoving(uj) || !uj.mimic) continue;
+    report.fail("joint '" + uj.name + "' on the chain mimics joint '" + uj.mimic->joint_name +
+                "' (q = " + fmt(uj.mimic->multiplier) + "·q_" + uj.mimic->joint_name + " + " + fmt(uj.mimic->offset) +
+                "): a chain of independent joints cannot keep that coupling; choose a " + tip_option +
+                " before it (e.g. '" + chain[k - 1]->name + "')");
+  }
+}
+
+// Whether a link moves with the chain: a moving joint lies between it and the
+// chain's root (a branch off the fixed base never affects the dynamics).
+bool movesWithChain(const LinkPtr& link, const std::string& root) {
+  for (LinkPtr l = link; l && l->name != root; l = l->getParent())
+    if (l->parent_joint && isMoving(*l->parent_joint)) return true;
+  return false;
+}
+
+// Links behind a moving joint that leaves the chain above the tip body (a
+// side branch off a moving body, e.g. the other finger of a gripper) are not
+// in the model, though they would ride on it: say how much mass that is, as
+// for the mass beyond the tip.
+void warnMassOffChain(Placement& placement, const urdf::ModelInterface& model, const std::string& root) {
+  std::set<std::string> tip_body;
+  for (const LinkPtr& link : placement.tip_body) tip_body.insert(link->name);
+  std::vector<std::string> joints, links;
+  double mass = 0.0;
+  std::vector<LinkPtr> queue;
+  for (const std::string& name : placement.placed) {
+    if (tip_body.count(name)) continue;  // below the tip body: handleBeyondTip's business
+    const LinkPtr link = model.getLink(name);
+    if (!movesWithChain(link, root)) continue;
+    for (std::size_t k = 0; k < link->child_joints.size(); ++k)
+      if (isMoving(*link->child_joints[k]) && !placement.placed.count(link->child_links[k]->name)) {
+        joints.push_back(link->child_joints[k]->name);
+        queue.push_back(link->child_links[k]);
+      }
+  }
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const LinkPtr link = queue[head];
+    links.push_back(link->name);
+    if (link->inertial && std::isfinite(link->inertial->mass)) mass += link->inertial->mass;
+    for (const auto& child : link->child_links) queue.push_back(child);
+  }
+  if (mass <= 0.0) return;
+  placement.warnings.push_back(
+      {WarningCode::MassOffChain, std::to_string(links.size()) + (links.size() == 1 ? " link (" : " links (") +
+                                      nameList(links) + ", " + fmt(mass) + " kg in all) behind moving joint" +
+                                      (joints.size() == 1 ? " " : "s ") + nameList(joints) +
+                                      " off the chain (side branches) are not in the model: their mass is ignored"});
+}
+
 // Links behind moving joints below the tip body: the joint that leads to each
 // and the links, parents before children.
 struct BeyondTip {
@@ -718,9 +777,11 @@ Model load(const Reporter& report, const std::string& xml, const UrdfOptions& op
         (urdf_model->getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
   }
 
+  refuseMimicOnChain(report, chain, options.names.tip);
   ModelBuilder builder(urdf_model->getName(), root->name);
   addChain(report, builder, placement, chain, rotor);
   handleBeyondTip(report, builder, placement, tip_name, options);
+  warnMassOffChain(placement, *urdf_model, root->name);
   for (const ModelWarning& w : placement.warnings) builder.addWarning(w.code, w.message);
   builder.prefixWarnings(report.source() + ": ");
   Model model;

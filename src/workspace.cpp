@@ -24,13 +24,21 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   IAS.assign(bodies, Vec6::Zero());
   D.assign(bodies, 0.0);
   u.assign(bodies, 0.0);
-  SA.setZero(m, static_cast<Eigen::Index>(bodies));
-  Ahat.setZero(6, m);
-  U.setZero(m);
-  L.setZero(m, m);
-  L_scale.setZero(m);
-  A_body.setZero(6, m);
-  b_body.setZero(m);
+  const int columns = columnCapacity();
+  SA.setZero(columns, static_cast<Eigen::Index>(bodies));
+  Ahat.setZero(6, columns);
+  U.setZero(columns);
+  L.setZero(columns, columns);
+  L_scale.setZero(columns);
+  A_body.setZero(6, columns);
+  b_body.setZero(columns);
+  L_rows.setZero(m, m);
+  L_scale_rows.setZero(m);
+  nu_rows.setZero(m);
+  dU_rows.setZero(m, n);
+  dnu_rows.setZero(m, n);
+  row_error.setZero(m);
+  row_size.setZero(m);
   balance_factorisation.factor.setZero(m, m);
   balance_factorisation.eigenvalues.setZero(m);
   balance_factorisation.gain.setZero(m);
@@ -39,9 +47,10 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   balance_factorisation.near_null_weight.setZero(m);
   balance_factorisation.work.setZero(m);
   rhs.setZero(m);
-  nu.setZero(m);
+  nu.setZero(columns);
   a.assign(bodies, Vec6::Zero());
   f.assign(bodies, Vec6::Zero());
+  constraint_wrench.assign(bodies, Vec6::Zero());
   Ic.assign(bodies, Mat6::Zero());
   H.setZero(n, n);
   tau.setZero(n);
@@ -51,7 +60,7 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   friction.tau_friction.setZero(n);
   friction.dqdd_dmu.setZero(n, n);
   friction.stuck.reserve(static_cast<std::size_t>(n));
-  friction_scratch_ = std::make_unique<internal::FrictionScratch>(n, static_cast<int>(bodies), m);
+  friction_scratch_ = std::make_unique<internal::FrictionScratch>(n, static_cast<int>(bodies), columns);
 }
 
 Workspace::~Workspace() = default;

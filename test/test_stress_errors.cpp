@@ -209,11 +209,20 @@ TEST_CASE("errors: ModelBuilder and model lookups", "[errors]") {
              Contains("joint 'j1': a joint of that name exists already"));
   CHECK_THAT(modelError([] { ModelBuilder("m", "base").addJoint(revolute("j1"), "base", box(1.0)); }),
              Contains("joint 'j1': frame 'base' exists already"));
+  // A tree is built depth first: a branch off the base is fine, but going back
+  // into a completed branch (link1 after link2 has started another) is not.
+  CHECK(modelError([] {
+          ModelBuilder b("m", "base");
+          b.addJoint(revolute("j1"), "link1", box(1.0)).addJoint(revolute("j2"), "link2", box(1.0), "base");
+          (void)b.build();
+        }) == "(no ModelError)");
   CHECK_THAT(modelError([] {
                ModelBuilder b("m", "base");
                b.addJoint(revolute("j1"), "link1", box(1.0)).addJoint(revolute("j2"), "link2", box(1.0), "base");
+               b.addJoint(revolute("j3"), "link3", box(1.0), "link1");
              }),
-             Contains("joint 'j2': parent frame 'base' is not on the last body of the chain"));
+             Contains("joint 'j3': parent frame 'link1' is on a branch that is already complete (add joints depth "
+                      "first: the parent must be the last body added or one of its ancestors)"));
   j = revolute("j1");
   j.axis = Vec3::Zero();
   CHECK_THAT(addJoint(j, box(1.0)), Contains("joint 'j1': axis must be a finite non-zero vector"));

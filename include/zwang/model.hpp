@@ -1,11 +1,17 @@
 /// \file
-/// The robot model: a serial chain of 1-DOF joints with rigid bodies, immutable
-/// once built and safe to share between threads. Scratch memory lives in a
-/// Workspace (workspace.hpp); a Model never changes during a solve.
+/// The robot model: a kinematic tree of 1-DOF joints with rigid bodies (a
+/// serial chain is the tree without branches), immutable once built and safe to
+/// share between threads. Scratch memory lives in a Workspace (workspace.hpp); a
+/// Model never changes during a solve.
 ///
-/// Indexing: body 0 is the fixed base; joint j (0-based) moves body j+1 relative
-/// to body j. Fixed URDF joints are merged into their parent body at load time,
-/// but every link stays addressable as a Frame attached to a body.
+/// Indexing: body 0 is the fixed base; joint j (0-based) moves body j+1
+/// relative to its parent body parent(j+1) (for a chain, body j). Bodies are in
+/// depth-first order: every body comes after its parent, and the bodies of a
+/// subtree are the contiguous range [b, subtreeEnd(b)). The sweeps rely on that
+/// range: the constraints a body feels are those on its subtree, a contiguous
+/// block of columns (Task::columnRange). Fixed URDF joints are merged into
+/// their parent body at load time, but every link stays addressable as a Frame
+/// attached to a body.
 #pragma once
 
 #include <cmath>
@@ -33,7 +39,7 @@ enum class JointType { Revolute, Continuous, Prismatic };
 /// The URDF name of a joint type: "revolute", "continuous" or "prismatic".
 const char* toString(JointType type);
 
-/// One moving joint of the chain: its axis and placement, drive (rotor inertia), friction and limits.
+/// One moving joint of the tree: its axis and placement, drive (rotor inertia), friction and limits.
 struct Joint {
   std::string name;                      ///< unique among the model's joints
   JointType type = JointType::Revolute;  ///< revolute, continuous (no position limits) or prismatic
@@ -99,14 +105,14 @@ struct ModelWarning {
   std::string message;  ///< one line naming the source, the link or joint and the figures
 };
 
-/// A named frame (a URDF link) rigidly attached to a body of the chain.
+/// A named frame (a URDF link) rigidly attached to a body of the tree.
 struct Frame {
   std::string name;     ///< the URDF link name, unique among the frames
   int body = 0;         ///< the body it is rigidly attached to
   Transform placement;  ///< ᶠX_body
 };
 
-/// The robot: a chain of moving joints and rigid bodies, immutable once built (ModelBuilder, loadUrdfFile).
+/// The robot: a tree of moving joints and rigid bodies, immutable once built (ModelBuilder, loadUrdfFile).
 class Model {
  public:
   /// Number of moving joints n (the length of q, q̇, τ, q̈).
@@ -116,8 +122,18 @@ class Model {
   /// The robot's name (URDF `<robot name>`).
   const std::string& name() const { return name_; }
 
-  /// The moving joints in chain order.
+  /// The moving joints in the model's (depth-first) order: the order of q, q̇, τ and q̈.
   const std::vector<Joint>& joints() const { return joints_; }
+  /// The parent body of body b (−1 for the base, b = 0).
+  int parent(int b) const { return parents_[static_cast<std::size_t>(b)]; }
+  /// One past the last body of b's subtree: the subtree is [b, subtreeEnd(b)).
+  int subtreeEnd(int b) const { return subtree_end_[static_cast<std::size_t>(b)]; }
+  /// True when body `a` is body `b` or one of its ancestors (b lies in a's subtree).
+  bool supports(int a, int b) const { return a <= b && b < subtreeEnd(a); }
+  /// True when every body's parent is the body before it: a serial chain.
+  bool isChain() const { return is_chain_; }
+  /// The body joint j hangs from (0: the base).
+  int parentBodyOfJoint(int j) const { return parent(j + 1); }
   /// Joint j (0-based; throws std::out_of_range outside [0, dof())).
   const Joint& joint(int j) const { return joints_.at(static_cast<std::size_t>(j)); }
   /// Inertia of body b (b = 0 is the base, unused by the dynamics) in its own frame.
@@ -146,6 +162,9 @@ class Model {
   std::vector<RigidInertia> inertias_;  // bodyCount() entries
   std::vector<Frame> frames_;
   std::vector<int> body_frames_;
+  std::vector<int> parents_{-1};     // bodyCount() entries, parents_[0] = −1
+  std::vector<int> subtree_end_{1};  // bodyCount() entries
+  bool is_chain_ = true;
   std::vector<ModelWarning> warnings_;
 };
 
@@ -160,8 +179,10 @@ class ModelBuilder {
   explicit ModelBuilder(const Model& model);
 
   /// Append a moving joint whose child link is `child_frame`, with the child's
-  /// own inertia. The parent is the body of `parent_frame` (default: the last body
-  /// added; only the chain's last body may be extended).
+  /// own inertia. The parent is the body of `parent_frame` (default: the last
+  /// body added). Joints are added depth first: the parent must be the last
+  /// body added or one of its ancestors (ModelError otherwise), so that every
+  /// subtree is a contiguous range of bodies.
   ModelBuilder& addJoint(const Joint& joint, const std::string& child_frame, const RigidInertia& child_inertia,
                          const std::string& parent_frame = "");
   /// Attach a frame rigidly to an existing frame (a fixed URDF joint); its
@@ -178,7 +199,7 @@ class ModelBuilder {
   /// Set a joint's breakaway friction f_j, kinetic (Coulomb) friction f_c,j and viscous friction b_j (finite, ≥ 0).
   ModelBuilder& setFriction(const std::string& joint, double breakaway, double kinetic, double viscous);
 
-  /// Checks the whole chain (every moving joint must carry some inertia, every
+  /// Checks the whole tree (every moving joint must carry some inertia, every
   /// moving body's merged inertia is positive semi-definite to rounding) and
   /// returns the immutable model.
   Model build() const;

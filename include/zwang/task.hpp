@@ -1,6 +1,7 @@
 /// \file
 /// What a solve is asked to do, apart from the joint state: gravity, external
-/// wrenches and acceleration constraints Aᵀ Ẍ = b on any frames of the chain.
+/// wrenches and acceleration constraints Aᵀ Ẍ = b on any frames of the tree,
+/// absolute or relative to another frame.
 /// Build a Task once (this allocates); then change set points and wrench values
 /// every control cycle (this does not).
 #pragma once
@@ -19,8 +20,11 @@ namespace zwang {
 /// only of axes:
 ///   Local : the frame's own axes;
 ///   World : the world (base) axes, at the frame origin. KDL calls this
-///           "base-aligned"; `Aligned` is the same choice under that name.
-enum class Expressed { Local, World, Aligned = World };
+///           "base-aligned"; `Aligned` is the same choice under that name;
+///   Reference : for a relative constraint, the axes of the frame it is
+///           relative to (for anything else the reference is the world:
+///           the same as World).
+enum class Expressed { Local, World, Aligned = World, Reference };
 
 /// A: 6×m, one unit constraint force [l; r] (linear part first) per column.
 using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
@@ -67,6 +71,20 @@ class Task {
   /// The same, with the frame given by name (ModelError for an unknown name).
   int addConstraint(const std::string& frame, const ConstraintMatrix& A, Expressed expressed = Expressed::Local);
 
+  /// Constrain the acceleration of `frame` relative to `reference` (another
+  /// frame, on any body) along the columns of A: the second derivative of the
+  /// position of frame's origin and the derivative of the angular velocity, as
+  /// an observer riding on `reference` sees them (docs/solver.md, "Relative
+  /// constraints"). Zero set points with zero relative velocity keep the two
+  /// frames rigidly together: two hands holding a box. The constraint force is
+  /// +A ν on frame's body and −A ν on reference's. Axes: Local (frame's),
+  /// Reference (reference's) or World. ModelError for the same frame twice.
+  int addRelativeConstraint(int frame, int reference, const ConstraintMatrix& A,
+                            Expressed expressed = Expressed::Reference);
+  /// The same, with the frames given by name (ModelError for an unknown name).
+  int addRelativeConstraint(const std::string& frame, const std::string& reference, const ConstraintMatrix& A,
+                            Expressed expressed = Expressed::Reference);
+
   /// Apply a wrench [f; n] at `frame`'s origin. Starts at zero. Returns its index.
   int addWrench(int frame, Expressed expressed = Expressed::Local);
   /// The same, with the frame given by name (ModelError for an unknown name).
@@ -87,14 +105,18 @@ class Task {
   int wrenchCount() const { return static_cast<int>(wrenches_.size()); }
 
   // --- read by the solver -------------------------------------------------
-  /// The constraints on one frame, as the solver reads them.
+  /// The constraints on one frame, as the solver reads them. A relative
+  /// constraint appears twice: on the constrained frame's body, and (with
+  /// `reference_side`) on the reference frame's body, where its force is −A ν.
   struct ConstraintGroup {
-    int frame;            ///< frame index
-    int body;             ///< the body the frame rides on
-    Expressed expressed;  ///< axes of A's columns
-    int first_row;        ///< in the user's row order (b, ν)
-    int rows;             ///< number of rows (columns of A)
-    ConstraintMatrix A;   ///< 6 × rows
+    int frame;                    ///< frame index (of the constrained frame, on both sides)
+    int body;                     ///< the body this side's force acts on
+    Expressed expressed;          ///< axes of A's columns
+    int first_row;                ///< in the user's row order (b, ν)
+    int rows;                     ///< number of rows (columns of A)
+    ConstraintMatrix A;           ///< 6 × rows
+    int reference = -1;           ///< the frame a relative constraint refers to (−1: the world)
+    bool reference_side = false;  ///< this entry is the reference frame's side of a relative constraint
   };
   /// One wrench, as the solver reads it.
   struct AppliedWrench {
@@ -102,14 +124,26 @@ class Task {
     Expressed expressed;        ///< axes of value
     Vec6 value = Vec6::Zero();  ///< [f; n] at the frame origin
   };
-  /// Groups sorted by body, farthest from the base first, so that the
-  /// constraints acting on bodies i..N are always a leading block of columns
-  /// ("solver order"). `solver_row[k]` is the user row of solver column k.
+  /// Groups sorted by body, last body first ("solver order"): since the
+  /// bodies are in depth-first order, the columns acting on a body's subtree
+  /// are then a contiguous block (columnRange), and for a chain the columns
+  /// acting on bodies i..N a leading block.
   const std::vector<ConstraintGroup>& groups() const { return groups_; }
-  /// `solver_row[k]`: the user row of solver column k.
+  /// Number of solver columns: one per row, two for a row of a relative
+  /// constraint (one on each side).
+  int solverColumns() const { return static_cast<int>(solver_row_.size()); }
+  /// The user row of each solver column.
   const std::vector<int>& solverRowToUserRow() const { return solver_row_; }
-  /// Number of solver columns acting on body b or beyond (a leading block).
-  int activeColumns(int body) const { return active_.at(static_cast<std::size_t>(body)); }
+  /// Number of solver columns acting on bodies b, b+1, … (a leading block).
+  int activeColumns(int body) const { return active_[static_cast<std::size_t>(body)]; }
+  /// First solver column acting on body b's subtree; the block is
+  /// [firstColumn(b), activeColumns(b)).
+  int firstColumn(int body) const { return first_column_[static_cast<std::size_t>(body)]; }
+  /// True when some constraint is relative: then the balance works on rows,
+  /// each the sum of its solver columns (balanceRowOfColumn).
+  bool hasRelative() const { return has_relative_; }
+  /// The balance row of each solver column (the identity without relative constraints).
+  const std::vector<int>& balanceRowOfColumn() const { return balance_row_; }
   /// The wrenches, in the order of addWrench.
   const std::vector<AppliedWrench>& wrenches() const { return wrenches_; }
   /// Joint count of the model the task was made for (checked by every solve).
@@ -123,8 +157,12 @@ class Task {
   std::vector<std::string> frame_names_;  // copied, so the Task does not dangle
   std::vector<int> frame_bodies_;
   std::vector<ConstraintGroup> groups_;
+  std::vector<int> subtree_end_;  // per body, copied from the model
   std::vector<int> solver_row_;
+  std::vector<int> balance_row_;
   std::vector<int> active_;
+  std::vector<int> first_column_;
+  bool has_relative_ = false;
   std::vector<AppliedWrench> wrenches_;
   Eigen::VectorXd b_;
   void reorder();

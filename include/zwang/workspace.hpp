@@ -4,7 +4,7 @@
 /// thread: the Model is shared, the Workspace is not.
 ///
 /// The members are named after the report's Algorithm 1 (chapter 4.2); index i
-/// is a body (0 = the fixed base), joint i−1 moves body i.
+/// is a body (0 = the fixed base), joint i−1 moves body i (from its parent).
 #pragma once
 
 #include <memory>
@@ -98,6 +98,8 @@ class Workspace {
   int dof() const { return dof_; }
   /// The most constraint rows a task solved here may have.
   int constraintCapacity() const { return capacity_; }
+  /// The most solver columns: two per row, since a relative row has one on each side.
+  int columnCapacity() const { return 2 * capacity_; }
 
   Solution solution;        ///< the results of the last solve
   FrictionResult friction;  ///< filled by solveWithFriction
@@ -126,7 +128,7 @@ class Workspace {
   /// Featherstone's or Pinocchio's U = I^A S, which is IAS here).
   Eigen::VectorXd U;
   Eigen::VectorXd L_scale;  ///< Σ_i |S_i|²|A_i col|²/D_i: the size 𝓛's diagonal rounding is relative to
-  Eigen::MatrixXd L;        ///< 𝓛_0, the balance matrix of line 25 (capacity², lower triangle)
+  Eigen::MatrixXd L;        ///< 𝓛_0, the balance matrix of line 25 (solver columns², lower triangle)
 
   // --- the task in sweep form, solver column order (see Task::groups)
   ConstraintMatrix A_body;  ///< columns of each constraint, as unit forces on its body
@@ -134,12 +136,23 @@ class Workspace {
 
   // --- balance (line 25), src/dynamics/balance.cpp
   BalanceFactorisation balance_factorisation;  ///< the last balance's factorisation
-  Eigen::VectorXd rhs;                         ///< b − A_0ᵀẌ_0 − U_0
-  Eigen::VectorXd nu;                          ///< ν in solver order
+  Eigen::VectorXd rhs;                         ///< b − A_0ᵀẌ_0 − U_0, per balance row
+  Eigen::VectorXd nu;                          ///< ν per solver column (what the sweeps read)
+  /// With relative constraints the balance works on rows, each the sum of its
+  /// solver columns: 𝓛, its rounding scale, ν and the unit-torque columns per row.
+  Eigen::MatrixXd L_rows;
+  Eigen::VectorXd L_scale_rows;  ///< L_scale per balance row (relative constraints)
+  Eigen::VectorXd nu_rows;       ///< ν per balance row (relative constraints)
+  Eigen::MatrixXd dU_rows;       ///< −δU₀ per balance row and unit torque (relative constraints)
+  Eigen::MatrixXd dnu_rows;      ///< δν per balance row and unit torque (relative constraints)
+  Eigen::VectorXd row_error;     ///< Aᵀ Ẍ − b per balance row (taskResidual)
+  Eigen::VectorXd row_size;      ///< the size of the terms of each row's error (taskResidual)
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
   std::vector<Vec6> a;  ///< Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])
   std::vector<Vec6> f;  ///< accumulated forces (RNEA)
+  /// The constraint wrenches A ν on each body and its subtree (constraint torques)
+  std::vector<Vec6> constraint_wrench;
 
   // --- other algorithms
   std::vector<Mat6> Ic;  ///< composite inertias (CRBA)

@@ -19,7 +19,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   outwardAccelerations(model, task, ws, out.qdd);                  // lines 26–30
   taskResidual(task, ws);                                          // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
-  constraintTorques(model, task, ws, ws.nu.head(task.constraintRows()), out.tau_constraint);
+  constraintTorques(model, task, ws, ws.nu.head(task.solverColumns()), out.tau_constraint);
   out.tau_control = tau + out.tau_constraint;
   out.gauss = gaussFunction(model, task, out.qdd, tau, ws);
   return {};

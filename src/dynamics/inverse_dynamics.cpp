@@ -20,14 +20,14 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
   internal::outwardKinematics(model, q, qd, ws, true);
   ws.a[0] = internal::gravityAcceleration(task.gravity);  // gravity as base acceleration
   for (int i = 1; i <= N; ++i) {
-    ws.a[at(i)] = ws.a[at(i - 1)] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
+    ws.a[at(i)] = ws.a[at(model.parent(i))] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
     ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);
   }
   internal::applyExternalWrenches(model, task, ws);
   for (int i = 1; i <= N; ++i) ws.f[at(i)] = ws.I[at(i)] * ws.a[at(i)] + ws.Fbias[at(i)];
   for (int i = N; i >= 1; --i) {
     ws.tau[i - 1] = ws.S[at(i)].dot(ws.f[at(i)]) + model.joint(i - 1).rotor_inertia * qdd[i - 1];
-    if (i > 1) ws.f[at(i - 1)] += ws.f[at(i)];
+    if (model.parent(i) > 0) ws.f[at(model.parent(i))] += ws.f[at(i)];
   }
   return {};
 }
@@ -42,10 +42,14 @@ Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::Vecto
   internal::outwardKinematics(model, q, Eigen::VectorXd(), ws, true);
   for (int i = 1; i <= N; ++i) ws.Ic[at(i)] = ws.I[at(i)].matrix();
   for (int i = N; i >= 1; --i) {
-    if (i > 1) ws.Ic[at(i - 1)] += ws.Ic[at(i)];  // base coordinates: composite inertias add
+    if (model.parent(i) > 0) ws.Ic[at(model.parent(i))] += ws.Ic[at(i)];  // base coordinates: composite inertias add
     const Vec6 F = ws.Ic[at(i)] * ws.S[at(i)];
     ws.H(i - 1, i - 1) = ws.S[at(i)].dot(F) + model.joint(i - 1).rotor_inertia;
-    for (int j = i - 1; j >= 1; --j) ws.H(i - 1, j - 1) = ws.H(j - 1, i - 1) = ws.S[at(j)].dot(F);
+    // H_ij ≠ 0 only for the joints j supporting i (its ancestors); the rest of
+    // row i stays zero: the tree's sparsity, zero blocks between branches.
+    for (int j = i - 1; j >= 1; --j) ws.H(i - 1, j - 1) = ws.H(j - 1, i - 1) = 0.0;
+    for (int j = model.parent(i); j >= 1; j = model.parent(j))
+      ws.H(i - 1, j - 1) = ws.H(j - 1, i - 1) = ws.S[at(j)].dot(F);
   }
   return {};
 }

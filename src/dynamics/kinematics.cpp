@@ -11,8 +11,9 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
   const bool with_velocity = qd.size() == model.dof();
   for (int i = 1; i <= model.dof(); ++i) {
     const auto b = static_cast<std::size_t>(i);
+    const auto p = static_cast<std::size_t>(model.parent(i));
     const Joint& joint = model.joint(i - 1);
-    const Transform& X = ws.Xworld[b] = joint.transform(q[i - 1]) * ws.Xworld[b - 1];  // line 4: ⁱX₀
+    const Transform& X = ws.Xworld[b] = joint.transform(q[i - 1]) * ws.Xworld[p];  // line 4: ⁱX₀
     // S_i in base coordinates: [p × a; a] (revolute) or [a; 0] (prismatic),
     // a = ᵂR_i axis, p the body origin.
     const Vec3 a = X.E.transpose() * joint.axis;
@@ -23,7 +24,7 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
     if (with_inertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
     if (with_velocity) {
       const Vec6 vJ = ws.S[b] * qd[i - 1];
-      ws.v[b] = ws.v[b - 1] + vJ;                   // line 5
+      ws.v[b] = ws.v[p] + vJ;                       // line 5
       ws.c[b] = spatial::crossMotion(ws.v[b], vJ);  // line 6: Ṡ_i q̇_i = Ẋ_i × S_i q̇_i
     } else {
       ws.v[b].setZero();
@@ -124,10 +125,11 @@ Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const E
   if (Status s = checkFrame(model, frame); !s) return s;
   if (Status s = forwardKinematics(model, ws, q); !s) return s;
   // Column j: the frame-origin velocity of a unit rate of joint j, S_{j+1}
-  // (base coordinates) seen at the frame origin p, for the joints that move it.
+  // (base coordinates) seen at the frame origin p, for the joints that move
+  // it: those on the path from its body to the base.
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   J.setZero();
-  for (int i = 1; i <= model.frame(frame).body; ++i) {
+  for (int i = model.frame(frame).body; i >= 1; i = model.parent(i)) {
     const Vec6& S = ws.S[static_cast<std::size_t>(i)];
     Vec6 world;
     world << S.head<3>() + S.tail<3>().cross(X.r), S.tail<3>();

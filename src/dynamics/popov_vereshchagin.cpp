@@ -7,10 +7,21 @@
 //    and KDL apply −A ν). So 𝓛 below is the report's −𝓛 (positive
 //    semi-definite) and line 28 has −A ν where the report has +A ν;
 //  * constraints may sit on any bodies (the report's section 4.4 extension):
-//    A_i collects the unit constraint forces of every constraint on bodies
-//    i..N, and each body adds its own columns as the inward sweep reaches it.
+//    A_i collects the unit constraint forces of every constraint on body i's
+//    subtree, and each body adds its own columns as the inward sweep reaches it;
+//  * trees (the report treats chains): the bodies are in depth-first order,
+//    "i − 1" of the report is parent(i), a parent sums what all its children
+//    pass it (lines 16–18), and the columns of a subtree are one contiguous
+//    block [firstColumn(i), activeColumns(i)), so each column is projected in
+//    place by every joint between its body and the base. 𝓛 gets an entry only
+//    from the bodies two columns share: columns on different branches meet
+//    only at their common ancestors;
+//  * relative constraints (two frames on any bodies): each row is two solver
+//    columns, +A on the frame's body and −A on the reference's, swept
+//    independently; the balance adds the columns of each row (condensedBalance).
 #include "dynamics/popov_vereshchagin.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -32,7 +43,7 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
   if (task.modelDof() != model.dof() || task.modelFrames() != static_cast<int>(model.frames().size()))
     return Status::error(StatusCode::ModelMismatch, "task was made for another model (%d joints, %d frames)",
                          task.modelDof(), task.modelFrames());
-  if (task.constraintRows() > ws.constraintCapacity())
+  if (task.constraintRows() > ws.constraintCapacity() || task.solverColumns() > ws.columnCapacity())
     return Status::error(StatusCode::WorkspaceTooSmall,
                          "task has %d constraint rows, the workspace was made for at most %d", task.constraintRows(),
                          ws.constraintCapacity());
@@ -51,6 +62,40 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
 
 namespace {
 
+// One side of a relative constraint (Task::addRelativeConstraint) in body
+// form. The row constrains p̈_rel and ω̇_rel, the acceleration of frame a's
+// origin and angular velocity as seen riding on the reference frame r
+// (docs/solver.md, "Relative constraints"). With d = p_a − p_r, world axes:
+//   p̈_rel = (a_a − a_r)_lin + (α_a − α_r) × p_a + β_lin,
+//   β_lin = ω_a × v_a − ω_r × v_r − 2 ω_r × (v_a − v_r) + ω_r × (ω_r × d),
+//   ω̇_rel = α_a − α_r + ω_a × ω_r,
+// v_a, v_r the velocities of the two origins. So the column is A = [f; n + p_a × f]
+// on a's body and −A on r's, and b − f·β_lin − n·(ω_a × ω_r) is the set point
+// (kept on a's side; r's side has 0, the balance adds the two). Gravity
+// shifts both bodies' sweep accelerations alike and cancels.
+void relativeConstraintInBodyForm(const Model& model, const Task& task, const Task::ConstraintGroup& g, int col,
+                                  Workspace& ws) {
+  const Transform Xa = framePlacementInBase(model, ws, g.frame);
+  const Transform Xr = framePlacementInBase(model, ws, g.reference);
+  const Vec6& va = ws.v[at(model.frame(g.frame).body)];
+  const Vec6& vr = ws.v[at(model.frame(g.reference).body)];
+  const Vec3 wa = va.tail<3>(), wr = vr.tail<3>();
+  const Vec3 pa_dot = va.head<3>() + wa.cross(Xa.r), pr_dot = vr.head<3>() + wr.cross(Xr.r);
+  const Vec3 d = Xa.r - Xr.r;
+  const Vec3 beta_lin = wa.cross(pa_dot) - wr.cross(pr_dot) - 2.0 * wr.cross(pa_dot - pr_dot) + wr.cross(wr.cross(d));
+  const Vec3 beta_ang = wa.cross(wr);
+  const Mat3 R = g.expressed == Expressed::Local       ? Mat3(Xa.E.transpose())
+                 : g.expressed == Expressed::Reference ? Mat3(Xr.E.transpose())
+                                                       : Mat3::Identity();
+  const double sign = g.reference_side ? -1.0 : 1.0;
+  for (int k = 0; k < g.rows; ++k) {
+    const Vec3 f = R * g.A.col(k).head<3>(), n = R * g.A.col(k).tail<3>();
+    ws.A_body.col(col + k) << sign * f, sign * (n + Xa.r.cross(f));
+    const double b = task.targets()[g.first_row + k];
+    ws.b_body[col + k] = g.reference_side ? 0.0 : b - f.dot(beta_lin) - n.dot(beta_ang);
+  }
+}
+
 // The task's constraints as unit forces on their bodies in base coordinates,
 // and the set points b as the sweep sees them (b is the true classical
 // acceleration of the frame origin p: docs/conventions.md, "What a frame's
@@ -60,6 +105,11 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
   const std::vector<int>& user_row = task.solverRowToUserRow();
   int col = 0;
   for (const Task::ConstraintGroup& g : task.groups()) {
+    if (g.reference >= 0) {
+      relativeConstraintInBodyForm(model, task, g, col, ws);
+      col += g.rows;
+      continue;
+    }
     const Transform X = framePlacementInBase(model, ws, g.frame);  // ᶠX₀
     const Vec6& v = ws.v[at(g.body)];
     const Vec3 w = v.tail<3>();
@@ -92,15 +142,17 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
   const int N = model.dof();
-  const int m = task.constraintRows();
+  const int m = task.solverColumns();
   ws.U.head(m).setZero();  // U_N = 0
   ws.L_scale.head(m).setZero();
-  ws.L.topLeftCorner(m, m).setZero();   // 𝓛_N = 0 (only the lower triangle is kept)
-  ws.IA[at(N)] = ws.I[at(N)].matrix();  // line 9 for the last body
-  ws.FA[at(N)] = ws.Fbias[at(N)];       // line 8
-  ConstraintMatrix& A = ws.Ahat;        // A_i, updated in place
-  A.leftCols(task.activeColumns(N)) = ws.A_body.leftCols(task.activeColumns(N));  // body N's own constraints
+  ws.L.topLeftCorner(m, m).setZero();  // 𝓛_N = 0 (only the lower triangle is kept)
+  ConstraintMatrix& A = ws.Ahat;       // A_i, each column updated in place on its way to the base
+  A.leftCols(m) = ws.A_body.leftCols(m);
   for (int i = N; i >= 1; --i) {
+    if (model.subtreeEnd(i) == i + 1) {  // a leaf: lines 8–9, I^A = I, F^A = F_bias
+      ws.IA[at(i)] = ws.I[at(i)].matrix();
+      ws.FA[at(i)] = ws.Fbias[at(i)];
+    }
     const Joint& joint = model.joint(i - 1);
     const Vec6& S = ws.S[at(i)];
     const Mat6& IA = ws.IA[at(i)];
@@ -120,68 +172,117 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     const double u_D = u * inverse_D;
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
 
-    // Lines 19–21, one constraint column at a time.
-    const int k = task.activeColumns(i);
+    // Lines 19–21, one constraint column of the subtree at a time.
+    const int first = task.firstColumn(i), k = task.activeColumns(i);
     double* sA = ws.SA.col(i).data();
     const double SS_D = S.squaredNorm() * inverse_D;
-    for (int col = 0; col < k; ++col) {
+    for (int col = first; col < k; ++col) {
       sA[col] = S.dot(A.col(col));                         // (Sᵀ A_i)ᵀ
       ws.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
     }
-    for (int col = 0; col < k; ++col) {
+    for (int col = first; col < k; ++col) {
       const double sA_D = sA[col] * inverse_D;
       ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
       double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
       for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
-      A.col(col) -= IAS * sA_D;  // line 19: A_{i−1} = P^A A_i …
+      A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
     }
-    const int kp = task.activeColumns(i - 1);  // … then body i−1's own columns
-    A.middleCols(k, kp - k) = ws.A_body.middleCols(k, kp - k);
 
-    if (i > 1) {
-      Mat6& IA_parent = ws.IA[at(i - 1)];  // line 16: I^A_{i−1} = I_{i−1} + I^a_i, I^a = I^A − I^A S D⁻¹ Sᵀ I^A
+    // Lines 16–18: the parent p gets I^a_i = I^A − I^A S D⁻¹ Sᵀ I^A and
+    // F^a_i. The first child to arrive (the last in depth-first order: its
+    // subtree ends where p's does) starts p's sums from I_p and F_bias,p.
+    const int p = model.parent(i);
+    if (p > 0) {
+      Mat6& IA_parent = ws.IA[at(p)];
       const Vec6 IAS_D = IAS * inverse_D;
-      IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
-      ws.I[at(i - 1)].addTo(IA_parent);
-      ws.FA[at(i - 1)] = ws.Fbias[at(i - 1)] + pA + IAS * u_D;  // lines 17–18: F^A_{i−1} = F_bias + F^a_i
+      if (model.subtreeEnd(i) == model.subtreeEnd(p)) {
+        IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
+        ws.I[at(p)].addTo(IA_parent);
+        ws.FA[at(p)] = ws.Fbias[at(p)] + pA + IAS * u_D;
+      } else {
+        IA_parent.noalias() += IA - IAS.lazyProduct(IAS_D.transpose());
+        ws.FA[at(p)] += pA + IAS * u_D;
+      }
     }
   }
   return {};
 }
 
+namespace {
+
+// With relative constraints, each balance row is the sum of its solver
+// columns (the two sides): 𝓛_rows = Mᵀ 𝓛 M, and likewise U, L_scale, b and
+// A₀ᵀẌ₀, with M the 0/1 map of columns to rows. Into ws.L_rows (lower
+// triangle), ws.L_scale_rows and ws.rhs.
+void condensedBalance(const Task& task, Workspace& ws) {
+  const int columns = task.solverColumns(), m = task.constraintRows();
+  const std::vector<int>& row = task.balanceRowOfColumn();
+  ws.L_rows.topLeftCorner(m, m).setZero();
+  ws.L_scale_rows.head(m).setZero();
+  ws.rhs.head(m).setZero();
+  const Vec6 a0 = gravityAcceleration(task.gravity);
+  for (int q = 0; q < columns; ++q) {
+    const int rq = row[at(q)];
+    ws.L_scale_rows[rq] += ws.L_scale[q];
+    ws.rhs[rq] += ws.b_body[q] - ws.U[q] - ws.Ahat.col(q).dot(a0);
+    for (int p = q; p < columns; ++p) {  // 𝓛(p, q), p ≥ q, stands for (p, q) and (q, p)
+      const int rp = row[at(p)];
+      const double value = ws.L(p, q) * (p != q && rp == rq ? 2.0 : 1.0);
+      ws.L_rows(std::max(rp, rq), std::min(rp, rq)) += value;
+    }
+  }
+}
+
+// ν of each solver column from ν of its balance row (both sides carry the row's ν).
+void expandToColumns(const Task& task, const Eigen::Ref<const Eigen::MatrixXd>& rows,
+                     Eigen::Ref<Eigen::MatrixXd> columns) {
+  const std::vector<int>& row = task.balanceRowOfColumn();
+  for (int col = 0; col < task.solverColumns(); ++col) columns.row(col) = rows.row(row[at(col)]);
+}
+
+}  // namespace
+
 void balance(const Task& task, Workspace& ws) {
   const int m = task.constraintRows();
+  const bool condensed = task.hasRelative();
+  if (condensed) condensedBalance(task, ws);
+  Eigen::MatrixXd& L = condensed ? ws.L_rows : ws.L;
+  const Eigen::VectorXd& L_scale = condensed ? ws.L_scale_rows : ws.L_scale;
   // A row no joint can move (its row of G is zero: a constraint on the base,
   // or a direction through every joint axis) has 𝓛_rr = Σ (Sᵀa)²/D = 0 up to
   // the rounding of the Sᵀa products, ~ε²·L_scale. Make it exactly zero, so
   // the balance sees the singularity and gives the row ν = 0 (docs/solver.md).
   constexpr double kRounding = 1e4 * std::numeric_limits<double>::epsilon() * std::numeric_limits<double>::epsilon();
   for (int r = 0; r < m; ++r)
-    if (ws.L(r, r) <= kRounding * ws.L_scale[r]) {
-      for (int col = 0; col <= r; ++col) ws.L(r, col) = 0.0;
-      for (int row = r; row < m; ++row) ws.L(row, r) = 0.0;
+    if (L(r, r) <= kRounding * L_scale[r]) {
+      for (int col = 0; col <= r; ++col) L(r, col) = 0.0;
+      for (int row = r; row < m; ++row) L(row, r) = 0.0;
     }
-  ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);                                                // line 25 …
-  ws.rhs.head(m).noalias() -= ws.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
+  if (!condensed) {
+    ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);                                                // line 25 …
+    ws.rhs.head(m).noalias() -= ws.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
+  }
+  Eigen::VectorXd& nu = condensed ? ws.nu_rows : ws.nu;
   ws.solution.balance =
-      solveBalance(ws.L.topLeftCorner(m, m), ws.rhs.head(m), ws.nu.head(m), ws.balance_factorisation, task.balance);
+      solveBalance(L.topLeftCorner(m, m), ws.rhs.head(m), nu.head(m), ws.balance_factorisation, task.balance);
+  if (condensed) expandToColumns(task, ws.nu_rows.head(m), ws.nu);
 }
 
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
   ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
   for (int i = 1; i <= model.dof(); ++i) {
-    const Vec6& a_parent = ws.a[at(i - 1)];
-    const int k = task.activeColumns(i);
-    const double constraint = ws.SA.col(i).head(k).dot(ws.nu.head(k));                    // Sᵀ A_i ν
-    qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(a_parent) + constraint) / ws.D[at(i)];  // line 28
-    ws.a[at(i)] = a_parent + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                      // line 29
+    const Vec6& a_parent = ws.a[at(model.parent(i))];
+    const int first = task.firstColumn(i), k = task.activeColumns(i) - first;
+    const double constraint = ws.SA.col(i).segment(first, k).dot(ws.nu.segment(first, k));  // Sᵀ A_i ν
+    qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(a_parent) + constraint) / ws.D[at(i)];    // line 28
+    ws.a[at(i)] = a_parent + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                        // line 29
   }
 }
 
 void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd) {
   ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
   for (int i = 1; i <= model.dof(); ++i)
-    ws.a[at(i)] = ws.a[at(i - 1)] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];  // line 29
+    ws.a[at(i)] = ws.a[at(model.parent(i))] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];  // line 29
 }
 
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
@@ -189,45 +290,59 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
                        Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da) {
   // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
   // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
-  // Column c is zero outward of its joint s_c, so the inward sweep at body i
-  // works on the columns with s_c ≥ i: a suffix c ≥ first, since the joints
-  // ascend.
+  // Column c is zero except on the path from its joint's body s_c to the
+  // base, so the inward sweep at body i works on the columns whose body lies
+  // in i's subtree [i, subtreeEnd(i)): a contiguous run of c, since the joints
+  // ascend. dF.col(c) carries δF^a from the path's last body to the next.
   const int N = model.dof();
-  const int m = task.constraintRows();
+  const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(joints.size());
+  const auto firstAtOrAfter = [&joints](int body) {
+    return static_cast<Eigen::Index>(
+        std::lower_bound(joints.begin(), joints.end(), body, [](int j, int b) { return bodyOfJoint(j) < b; }) -
+        joints.begin());
+  };
   dU.setZero();
-  dF.setZero();  // δF^A arriving at body i from its child, per column
-  Eigen::Index first = k;
+  dF.setZero();
+  du.setZero();
   for (int i = N; i >= 1; --i) {
-    while (first > 0 && bodyOfJoint(joints[static_cast<std::size_t>(first - 1)]) >= i) --first;
+    const Eigen::Index c_begin = firstAtOrAfter(i), c_end = firstAtOrAfter(model.subtreeEnd(i));
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
     const double inverse_D = 1.0 / ws.D[at(i)];
-    const int ki = task.activeColumns(i);
-    for (Eigen::Index c = 0; c < first; ++c) du(i, c) = 0.0;
-    for (Eigen::Index c = first; c < k; ++c) {
+    const int first = task.firstColumn(i), ki = task.activeColumns(i);
+    for (Eigen::Index c = c_begin; c < c_end; ++c) {
       const double du_ic = (bodyOfJoint(joints[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
       du(i, c) = du_ic;
       const double du_D = du_ic * inverse_D;
-      for (int r = 0; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
-      dF.col(c) += IAS * du_D;                                      // lines 17–18
+      for (int r = first; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
+      dF.col(c) += IAS * du_D;                                          // lines 17–18
     }
   }
-  du.row(0).setZero();
-  dU.topRows(m) *= -1.0;  // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
-  balanceApplyColumns(ws.balance_factorisation, dU.topRows(m), dnu.topRows(m), ws.balance_factorisation.work.head(m));
-  da.setZero();
-  for (int i = 1; i <= N; ++i) {  // lines 28–29 for the differences
-    const Vec6& S = ws.S[at(i)];
-    const Vec6& IAS = ws.IAS[at(i)];
-    const double inverse_D = 1.0 / ws.D[at(i)];
-    const int ki = task.activeColumns(i);
-    for (Eigen::Index c = 0; c < k; ++c) {
+  dU.topRows(m) *= -1.0;     // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+  if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
+    const int rows = task.constraintRows();
+    auto dU_rows = ws.dU_rows.topLeftCorner(rows, k);
+    dU_rows.setZero();
+    for (int col = 0; col < m; ++col) dU_rows.row(task.balanceRowOfColumn()[at(col)]) += dU.row(col);
+    auto dnu_rows = ws.dnu_rows.topLeftCorner(rows, k);
+    balanceApplyColumns(ws.balance_factorisation, dU_rows, dnu_rows, ws.balance_factorisation.work.head(rows));
+    expandToColumns(task, dnu_rows, dnu.topRows(m));
+  } else {
+    balanceApplyColumns(ws.balance_factorisation, dU.topRows(m), dnu.topRows(m), ws.balance_factorisation.work.head(m));
+  }
+  // Lines 28–29 for the differences: δẌ per body, one column at a time (the
+  // bodies' δẌ hang from their parents'; da holds one column's).
+  for (Eigen::Index c = 0; c < k; ++c) {
+    for (int i = 1; i <= N; ++i) {
+      const int first = task.firstColumn(i), ki = task.activeColumns(i);
       double constraint = 0.0;
-      for (int r = 0; r < ki; ++r) constraint += ws.SA(r, i) * dnu(r, c);
-      const double dq = (du(i, c) - IAS.dot(da.col(c)) + constraint) * inverse_D;
+      for (int r = first; r < ki; ++r) constraint += ws.SA(r, i) * dnu(r, c);
+      const int p = model.parent(i);
+      const double parent_dot = p > 0 ? ws.IAS[at(i)].dot(da.col(p)) : 0.0;
+      const double dq = (du(i, c) - parent_dot + constraint) / ws.D[at(i)];
       dqdd(i - 1, c) = dq;
-      da.col(c) += S * dq;
+      da.col(i) = (p > 0 ? Vec6(da.col(p)) : Vec6::Zero()) + ws.S[at(i)] * dq;
     }
   }
 }
@@ -249,40 +364,50 @@ void taskResidual(const Task& task, Workspace& ws) {
   // the error is within residual_tolerance of the size of what it is computed
   // from: the accelerations it reads, its set point, and the balance's
   // right-hand side (what the constraint force had to correct).
+  // A relative row sums its two columns' terms (the balance's rows).
   const int m = task.constraintRows();
   BalanceReport& report = ws.solution.balance;
-  double sum2 = 0.0;
-  bool met = true;
+  auto error = ws.row_error.head(m);
+  auto size = ws.row_size.head(m);
+  error.setZero();
+  size.setZero();
+  const std::vector<int>& row = task.balanceRowOfColumn();
   int col = 0;
   for (const Task::ConstraintGroup& g : task.groups()) {
     const Vec6& a = ws.a[at(g.body)];
     for (int k = 0; k < g.rows; ++k, ++col) {
       const auto A = ws.A_body.col(col);
-      const double error = A.dot(a) - ws.b_body[col];
-      const double size = A.cwiseAbs().dot(a.cwiseAbs()) + std::abs(ws.b_body[col]) + std::abs(ws.rhs[col]);
-      sum2 += error * error;
-      met = met && std::abs(error) <= task.balance.residual_tolerance * size;
+      const int r = row[at(col)];
+      error[r] += A.dot(a) - ws.b_body[col];
+      size[r] += A.cwiseAbs().dot(a.cwiseAbs()) + std::abs(ws.b_body[col]);
     }
   }
-  report.residual = m > 0 ? std::sqrt(sum2) : 0.0;
+  bool met = true;
+  for (int r = 0; r < m; ++r)
+    met = met && std::abs(error[r]) <= task.balance.residual_tolerance * (size[r] + std::abs(ws.rhs[r]));
+  report.residual = m > 0 ? error.norm() : 0.0;
   report.consistent = met;
 }
 
-void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
+void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c) {
   // The wrenches A ν of each body's own constraints, summed inward and
   // projected on each joint: the physical torque (docs/solver.md, "Constraint torques: why not eq. 4.4").
+  // On a tree each body carries its own wrenches and its children's: the
+  // body's slot of `carried` collects them, then passes them to the parent.
   const int N = model.dof();
   if (task.constraintRows() == 0) {
     tau_c.setZero();
     return;
   }
-  Vec6 carried = Vec6::Zero();
+  std::vector<Vec6>& carried = ws.constraint_wrench;
+  for (int i = 1; i <= N; ++i) {  // body i's own columns: those on bodies ≥ i but not ≥ i + 1
+    const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
+    carried[at(i)].noalias() = ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+  }
   for (int i = N; i >= 1; --i) {
-    const int k_below = i < N ? task.activeColumns(i + 1) : 0;
-    const int k = task.activeColumns(i);
-    carried.noalias() += ws.A_body.middleCols(k_below, k - k_below) * nu_solver.segment(k_below, k - k_below);
-    tau_c[i - 1] = ws.S[at(i)].dot(carried);
+    tau_c[i - 1] = ws.S[at(i)].dot(carried[at(i)]);
+    if (model.parent(i) > 0) carried[at(model.parent(i))] += carried[at(i)];
   }
 }
 
@@ -314,7 +439,8 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
 void publishNu(const Task& task, Workspace& ws) {
   const int m = task.constraintRows();
   if (ws.solution.nu.size() != m) ws.solution.nu.resize(m);  // only when the task's size changed
-  for (int col = 0; col < m; ++col) ws.solution.nu[task.solverRowToUserRow()[at(col)]] = ws.nu[col];
+  // Both columns of a relative row carry the row's ν: either may write it.
+  for (int col = 0; col < task.solverColumns(); ++col) ws.solution.nu[task.solverRowToUserRow()[at(col)]] = ws.nu[col];
 }
 
 }  // namespace zwang::internal

@@ -45,8 +45,8 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 
 // k extra right-hand sides through the same sweeps, all at once: column c is
 // a unit torque at joint joints[c] (ascending), everything else zero. Gives
-// δν (dnu: m × k, solver order) and δq̈ = ∂q̈/∂τ_joint (dqdd: n × k); du
-// (bodies × k), dF, da (6 × k) and dU (m × k) are scratch. Needs inwardSweep
+// δν (dnu: solver columns × k) and δq̈ = ∂q̈/∂τ_joint (dqdd: n × k); du
+// (bodies × k), dF (6 × k), da (6 × bodies) and dU (solver columns × k) are scratch. Needs inwardSweep
 // and balance first. O((N + m²)·k): the sensitivity K_Θ of the friction
 // extension, as matrix–row products over the k columns rather than k sweeps.
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
@@ -60,8 +60,8 @@ void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out);
 // met, into ws.solution.balance.
 void taskResidual(const Task& task, Workspace& ws);
 
-// τ_c = Σ J_iᵀ A_i ν_i for ν in solver order (one inward pass of the wrenches A ν).
-void constraintTorques(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
+// τ_c = Σ J_iᵀ A_i ν_i for ν per solver column (one inward pass of the wrenches A ν).
+void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c);
 
 // Gauss function of the true accelerations ws.a − [−g; 0], with joint torques `tau`.

@@ -117,7 +117,7 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
 Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
                                const Eigen::Ref<const Eigen::VectorXd>& qd, const std::vector<int>& stuck,
                                Workspace& ws, FrictionScratch& fs) {
-  const int m = task.constraintRows();
+  const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(stuck.size());
   outwardSweep(model, task, q, qd, ws);
   if (Status s = inwardSweep(model, task, fs.tau_effective, ws); !s) return s;
@@ -126,7 +126,7 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   fs.nu0.head(m) = ws.nu.head(m);
   if (k > 0)
     unitTorqueColumns(model, task, ws, stuck, fs.du.leftCols(k), fs.dU.topLeftCorner(m, k), fs.dnu.topLeftCorner(m, k),
-                      fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da.leftCols(k));
+                      fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da);
   return {};
 }
 
@@ -173,9 +173,9 @@ QpReport maximiseDual(const Workspace& ws, const std::vector<int>& stuck, const 
 // ---- When μ* is not unique: what each stuck joint's motor would carry at the
 // QP's maximiser without friction, h = τ + τ_c(μ*) − μ*, and the margin box.
 void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                            const std::vector<int>& stuck, const FrictionOptions& options, const Workspace& ws,
+                            const std::vector<int>& stuck, const FrictionOptions& options, Workspace& ws,
                             FrictionScratch& fs) {
-  const int m = task.constraintRows();
+  const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(stuck.size());
   fs.nu_first.head(m) = fs.nu0.head(m);  // ν(μ*) by superposition
   fs.nu_first.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * fs.mu.head(k);
@@ -192,7 +192,7 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
 // superposition), then Ẍ from q̈ (line 29). With nothing stuck, μ* is
 // empty and the μ = 0 sweep already gave it.
 void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index k, Workspace& ws, FrictionScratch& fs) {
-  const int m = task.constraintRows();
+  const int m = task.solverColumns();
   Solution& out = ws.solution;
   out.qdd = fs.qdd0;
   if (k == 0) return;
@@ -247,7 +247,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
                          Workspace& ws, const FrictionOptions& options) noexcept {
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   if (Status s = checkOptions(model, options); !s) return s;
-  const int m = task.constraintRows();
+  const int m = task.solverColumns();
   FrictionScratch& fs = ws.frictionScratch();
   FrictionResult& fr = ws.friction;
   Solution& out = ws.solution;

@@ -10,7 +10,7 @@
 namespace zwang::internal {
 
 struct FrictionScratch {
-  FrictionScratch(int dof, int bodies, int capacity)
+  FrictionScratch(int dof, int bodies, int capacity)  // capacity: solver columns
       : breakaway(dof),
         kinetic(dof),
         viscous(dof),
@@ -24,7 +24,7 @@ struct FrictionScratch {
         dnu(capacity, dof),
         dqdd(dof, dof),
         dF(6, dof),
-        da(6, dof),
+        da(6, bodies),
         K(dof, dof),
         qdd0_stuck(dof),
         mu(dof),
@@ -43,12 +43,13 @@ struct FrictionScratch {
 
   // ∂q̈/∂μ in the same sweeps
   Eigen::VectorXd qdd0;  // q̈(μ = 0)
-  Eigen::VectorXd nu0;   // ν(μ = 0), solver order
+  Eigen::VectorXd nu0;   // ν(μ = 0), per solver column
   Eigen::MatrixXd du;    // bodies × k: δu_i per unit torque (sweep scratch)
   Eigen::MatrixXd dU;    // capacity × k: δU₀ per unit torque
   Eigen::MatrixXd dnu;   // capacity × k: δν per unit torque
   Eigen::MatrixXd dqdd;  // dof × k: δq̈ per unit torque
-  Matrix6X dF, da;       // 6 × k: δF^A and δẌ per unit torque (sweep scratch)
+  Matrix6X dF;           // 6 × k: δF^A per unit torque (sweep scratch)
+  Matrix6X da;           // 6 × bodies: δẌ of one unit torque (sweep scratch)
 
   // The maximiser: min ½ μᵀ K_ΘΘ μ − μᵀ q̈_Θ(0) over Λ
   Eigen::MatrixXd K;           // K_ΘΘ = rows Θ of −∂q̈/∂μ
@@ -59,7 +60,7 @@ struct FrictionScratch {
   // When μ* is not unique
   Eigen::VectorXd margin_limit;          // margin · f_j on Θ₀
   Eigen::VectorXd effort_offset;         // h = τ + τ_c(μ*) − μ* on Θ₀: the motor torque without friction
-  Eigen::VectorXd nu_first;              // ν at the maximiser returned by the QP (solver order)
+  Eigen::VectorXd nu_first;              // ν at the maximiser returned by the QP (per solver column)
   Eigen::VectorXd tau_constraint_first;  // τ_c at that maximiser
   MaximiserChoiceScratch choice;
 

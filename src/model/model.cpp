@@ -164,10 +164,16 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
     if (j.name == joint_in.name) throw ModelError(where + ": a joint of that name exists already");
   if (model_.hasFrame(child_frame)) throw ModelError(where + ": frame '" + child_frame + "' exists already");
   const int last_body = model_.bodyCount() - 1;
+  int parent_body = last_body;
   if (!parent_frame.empty()) {
-    const int parent_body = model_.frame(model_.frameIndex(parent_frame)).body;
-    if (parent_body != last_body)
-      throw ModelError(where + ": parent frame '" + parent_frame + "' is not on the last body of the chain");
+    parent_body = model_.frame(model_.frameIndex(parent_frame)).body;
+    // Depth first: the parent is on the path from the last body to the base, so
+    // that every subtree stays a contiguous range of bodies (model.hpp).
+    int b = last_body;
+    while (b > parent_body) b = model_.parent(b);
+    if (b != parent_body)
+      throw ModelError(where + ": parent frame '" + parent_frame + "' is on a branch that is already complete (add " +
+                       "joints depth first: the parent must be the last body added or one of its ancestors)");
   }
   Joint joint = joint_in;
   if (!joint.axis.allFinite() || joint.axis.norm() < 1e-9)
@@ -201,6 +207,10 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
   model_.joints_.push_back(joint);
   model_.inertias_.push_back(child_inertia);
   const int body = model_.bodyCount() - 1;
+  model_.parents_.push_back(parent_body);
+  model_.subtree_end_.push_back(body + 1);
+  for (int a = parent_body; a >= 0; a = model_.parent(a)) model_.subtree_end_[static_cast<std::size_t>(a)] = body + 1;
+  model_.is_chain_ = model_.is_chain_ && parent_body == body - 1;
   model_.frames_.push_back(Frame{child_frame, body, Transform{}});
   model_.body_frames_.push_back(static_cast<int>(model_.frames_.size()) - 1);
   return *this;
@@ -272,15 +282,17 @@ Model ModelBuilder::build() const {
     validate::rigidInertia("body of link '" + link + "' (with the links welded to it)",
                            model_.inertias_[static_cast<std::size_t>(b)]);
   }
-  // A moving body must carry inertia somewhere at or beyond it (or its joint a
-  // rotor inertia), or its acceleration is undetermined. The last body is the
-  // one the chain leaves bare most often, so check from the tip inward.
-  double mass_beyond = 0.0;
+  // A moving body must carry inertia somewhere in its subtree (or its joint a
+  // rotor inertia), or its acceleration is undetermined. The leaves are the
+  // bodies left bare most often, so check from the leaves inward.
+  std::vector<double> mass_beyond(static_cast<std::size_t>(model_.bodyCount()), 0.0);
   for (int j = model_.dof() - 1; j >= 0; --j) {
-    const RigidInertia& I = model_.inertias_[static_cast<std::size_t>(j + 1)];
-    mass_beyond += I.mass + I.Ibar.trace();
+    const auto body = static_cast<std::size_t>(j + 1);
+    const RigidInertia& I = model_.inertias_[body];
+    mass_beyond[body] += I.mass + I.Ibar.trace();
+    mass_beyond[static_cast<std::size_t>(model_.parent(j + 1))] += mass_beyond[body];
     const Joint& joint = model_.joints_[static_cast<std::size_t>(j)];
-    if (mass_beyond <= 0.0 && joint.rotor_inertia <= 0.0) {
+    if (mass_beyond[body] <= 0.0 && joint.rotor_inertia <= 0.0) {
       const std::string link =
           model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(j + 1)])].name;
       throw ModelError("link '" + link + "': zero mass on a moving body with nothing beyond it (joint '" + joint.name +

@@ -11,6 +11,7 @@ Task::Task(const Model& model) : dof_(model.dof()), frames_(static_cast<int>(mod
     frame_names_.push_back(f.name);
     frame_bodies_.push_back(f.body);
   }
+  for (int b = 0; b < model.bodyCount(); ++b) subtree_end_.push_back(model.subtreeEnd(b));
   reorder();
 }
 
@@ -41,6 +42,29 @@ int Task::addConstraint(const std::string& frame, const ConstraintMatrix& A, Exp
   return addConstraint(lookup(frame_names_, frame), A, expressed);
 }
 
+int Task::addRelativeConstraint(int frame, int reference, const ConstraintMatrix& A, Expressed expressed) {
+  if (reference < 0 || reference >= frames_)
+    throw ModelError("task: reference frame index " + std::to_string(reference) + " out of range");
+  if (reference == frame)
+    throw ModelError("task: a relative constraint on frame '" + frame_names_[static_cast<std::size_t>(frame)] +
+                     "' needs another frame to refer to, not itself");
+  const int first = addConstraint(frame, A, expressed);  // checks frame and A, sorts
+  for (ConstraintGroup& g : groups_)
+    if (g.first_row == first) g.reference = reference;
+  ConstraintGroup side =
+      *std::find_if(groups_.begin(), groups_.end(), [first](const ConstraintGroup& g) { return g.first_row == first; });
+  side.body = frame_bodies_[static_cast<std::size_t>(reference)];
+  side.reference_side = true;
+  groups_.push_back(side);
+  reorder();
+  return first;
+}
+
+int Task::addRelativeConstraint(const std::string& frame, const std::string& reference, const ConstraintMatrix& A,
+                                Expressed expressed) {
+  return addRelativeConstraint(lookup(frame_names_, frame), lookup(frame_names_, reference), A, expressed);
+}
+
 int Task::addWrench(int frame, Expressed expressed) {
   if (frame < 0 || frame >= frames_) throw ModelError("task: frame index " + std::to_string(frame) + " out of range");
   wrenches_.push_back(AppliedWrench{frame, expressed, Vec6::Zero()});
@@ -52,20 +76,30 @@ int Task::addWrench(const std::string& frame, Expressed expressed) {
 }
 
 void Task::reorder() {
-  // Farthest body first (stable: equal bodies keep the user's order), so the
-  // constraints felt by body i — those on bodies i..N — are a leading block.
+  // Last body first (stable: equal bodies keep the user's order). The bodies
+  // are in depth-first order, so body b's subtree [b, end) owns the columns
+  // between those on bodies ≥ end and those on bodies ≥ b: a contiguous block.
   std::stable_sort(groups_.begin(), groups_.end(),
                    [](const ConstraintGroup& a, const ConstraintGroup& b) { return a.body > b.body; });
+  has_relative_ =
+      std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.reference_side; });
   solver_row_.clear();
+  balance_row_.clear();
   for (const ConstraintGroup& g : groups_)
-    for (int k = 0; k < g.rows; ++k) solver_row_.push_back(g.first_row + k);
-  active_.assign(static_cast<std::size_t>(dof_ + 1), 0);
-  for (int body = 0; body <= dof_; ++body) {
-    int count = 0;
+    for (int k = 0; k < g.rows; ++k) {
+      // With relative constraints the balance works on the user's rows (each
+      // the sum of its sides); otherwise on the solver columns themselves.
+      balance_row_.push_back(has_relative_ ? g.first_row + k : static_cast<int>(solver_row_.size()));
+      solver_row_.push_back(g.first_row + k);
+    }
+  const auto bodies = static_cast<std::size_t>(dof_ + 1);
+  active_.assign(bodies + 1, 0);  // active_[N + 1] = 0: no body beyond the last
+  for (std::size_t body = 0; body <= bodies; ++body)
     for (const ConstraintGroup& g : groups_)
-      if (g.body >= body) count += g.rows;
-    active_[static_cast<std::size_t>(body)] = count;
-  }
+      if (static_cast<std::size_t>(g.body) >= body) active_[body] += g.rows;
+  first_column_.assign(bodies, 0);
+  for (std::size_t body = 0; body < bodies; ++body)
+    first_column_[body] = active_[static_cast<std::size_t>(subtree_end_[body])];
 }
 
 Status checkBalanceOptions(const BalanceOptions& o) {

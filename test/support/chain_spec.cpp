@@ -39,6 +39,15 @@ void ChainSpec::check() const {
     if (!joint.isFixed() && std::abs(joint.axis.norm() - 1.0) > 1e-12)
       throw std::invalid_argument(where + "joint " + joint.name + " axis is not a unit vector");
   }
+  for (std::size_t k = 0; k < joints.size(); ++k)
+    if (parentLink(k) > static_cast<int>(k))
+      throw std::invalid_argument(where + "joint " + joints[k].name + " has a parent after its child");
+}
+
+bool ChainSpec::isChain() const {
+  for (std::size_t k = 0; k < joints.size(); ++k)
+    if (parentLink(k) != static_cast<int>(k)) return false;
+  return true;
 }
 
 Eigen::Matrix3d rpyToMatrix(const Eigen::Vector3d& rpy) {

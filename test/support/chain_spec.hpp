@@ -39,6 +39,9 @@ struct JointSpec {
   double friction = 0.0, damping = 0.0;                           // <dynamics>
   double rotor_inertia = 0.0;                                     // <drake:rotor_inertia>; 0: no <transmission>
   double gear_ratio = 1.0;                                        // <drake:gear_ratio>
+  // Index into ChainSpec::links of the parent link; −1: links[k] for joints[k]
+  // (a chain). The child of joints[k] is always links[k + 1].
+  int parent = -1;
 
   bool isFixed() const { return type == "fixed"; }
   bool isPrismatic() const { return type == "prismatic"; }
@@ -46,8 +49,11 @@ struct JointSpec {
   double reflectedInertia() const { return isFixed() ? 0.0 : rotor_inertia * gear_ratio * gear_ratio; }
 };
 
-// A serial chain: joints[k] connects parent links[k] to child links[k+1], so
-// links.size() == joints.size() + 1 and links[0] is the fixed base link.
+// A serial chain or a tree: joints[k] connects the parent link
+// links[parentLink(k)] (links[k] unless the joint names another) to the child
+// links[k + 1], so links.size() == joints.size() + 1 and links[0] is the fixed
+// base link. A parent always comes before its child; a tree is depth first
+// when each parent is on the path from links[k] to the base (isDepthFirst).
 struct ChainSpec {
   std::string name = "chain";
   std::vector<LinkSpec> links;
@@ -55,6 +61,10 @@ struct ChainSpec {
 
   // Number of non-fixed joints (the length of q).
   int dof() const;
+  // Index into `links` of joints[k]'s parent link.
+  int parentLink(std::size_t k) const { return joints[k].parent < 0 ? static_cast<int>(k) : joints[k].parent; }
+  // True when no joint names a parent other than the previous link.
+  bool isChain() const;
   // Indices into `joints` of the non-fixed joints, in chain order; the k-th
   // entry is the joint whose position is q(k).
   std::vector<int> movingJoints() const;

@@ -30,9 +30,9 @@ void checkSizes(const ChainSpec& spec, const Eigen::VectorXd& q, const Eigen::Ve
 }
 
 // ⁰R_link of link i (used to turn local components into world ones).
-Eigen::Matrix3d axesRotation(const DenseKinematics& kin, int link, Axes axes) {
-  if (axes == Axes::World) return Eigen::Matrix3d::Identity();
-  return kin.poses[static_cast<std::size_t>(link)].linear();
+Eigen::Matrix3d axesRotation(const DenseKinematics& kin, int link, Axes axes, int reference = -1) {
+  if (axes == Axes::World || (axes == Axes::Reference && reference < 0)) return Eigen::Matrix3d::Identity();
+  return kin.poses[static_cast<std::size_t>(axes == Axes::Reference ? reference : link)].linear();
 }
 
 // A wrench [f; n] acting at the link origin p, components per `axes`, as a
@@ -61,6 +61,42 @@ std::vector<Vector6d> externalWrenches(const ChainSpec& spec, const DenseKinemat
 Vector6d classicalFromSpatial(const Eigen::Vector3d& p, const Vector6d& v, const Vector6d& a) {
   const Eigen::Vector3d pdot = lin(v) + ang(v).cross(p);
   return stack(lin(a) + ang(a).cross(p) + ang(v).cross(pdot), ang(a));
+}
+
+// The rows of a relative constraint (dense_reference.hpp, ConstraintInput):
+// with a = J q̈ + J̇ q̇ and the classical acceleration of a point p on a link
+// p̈ = a_O + α × p + ω × ṗ, each term of p̈_rel and ω̇_rel splits into a part
+// linear in q̈ (into G) and a known part (into γ, with the opposite sign).
+void relativeRows(const ChainSpec& spec, const DenseKinematics& kin, const ConstraintInput& c, int first_row,
+                  Eigen::MatrixXd& G, Eigen::VectorXd& gamma) {
+  const auto a = static_cast<std::size_t>(spec.linkIndex(c.link));
+  const auto r = static_cast<std::size_t>(spec.linkIndex(c.relative_to));
+  const Eigen::Vector3d pa = kin.poses[a].translation(), pr = kin.poses[r].translation();
+  const Eigen::Vector3d wa = ang(kin.v[a]), wr = ang(kin.v[r]);
+  const Eigen::Vector3d pa_dot = lin(kin.v[a]) + wa.cross(pa), pr_dot = lin(kin.v[r]) + wr.cross(pr);
+  const Eigen::Vector3d d = pa - pr, d_dot = pa_dot - pr_dot;
+  const long n = static_cast<long>(kin.reflected.size());
+  // p̈ of a point p on link i: [1, −[p]×] (J_i q̈ + J̇_i q̇) + ω_i × ṗ.
+  auto pointRows = [](const Eigen::MatrixXd& J, const Eigen::Vector3d& p) -> Eigen::MatrixXd {
+    return J.topRows(3) - skew3(p) * J.bottomRows(3);
+  };
+  auto pointBias = [](const Vector6d& bias, const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return lin(bias) - p.cross(ang(bias));
+  };
+  // p̈_rel = p̈_a − p̈_r − α_r × d − 2 ω_r × ḋ + ω_r × (ω_r × d), and −α_r × d = [d]× α_r.
+  const Eigen::MatrixXd G_lin = pointRows(kin.J[a], pa) - pointRows(kin.J[r], pr) + skew3(d) * kin.J[r].bottomRows(3);
+  const Eigen::Vector3d k_lin = pointBias(kin.bias[a], pa) + wa.cross(pa_dot) - pointBias(kin.bias[r], pr) -
+                                wr.cross(pr_dot) + d.cross(ang(kin.bias[r])) - 2.0 * wr.cross(d_dot) +
+                                wr.cross(wr.cross(d));
+  // ω̇_rel = α_a − α_r − ω_r × (ω_a − ω_r).
+  const Eigen::MatrixXd G_ang = kin.J[a].bottomRows(3) - kin.J[r].bottomRows(3);
+  const Eigen::Vector3d k_ang = ang(kin.bias[a]) - ang(kin.bias[r]) - wr.cross(wa - wr);
+  const Eigen::Matrix3d R = axesRotation(kin, static_cast<int>(a), c.axes, static_cast<int>(r));
+  for (Eigen::Index col = 0; col < c.A.cols(); ++col) {
+    const Eigen::Vector3d f = R * lin(Vector6d(c.A.col(col))), m = R * ang(Vector6d(c.A.col(col)));
+    G.row(first_row + col) = (f.transpose() * G_lin + m.transpose() * G_ang).leftCols(n);
+    gamma(first_row + col) = c.b(col) - f.dot(k_lin) - m.dot(k_ang);
+  }
 }
 
 double conditionNumber(const Eigen::MatrixXd& M) {
@@ -123,14 +159,15 @@ DenseKinematics denseKinematics(const ChainSpec& spec, const Eigen::VectorXd& q,
   for (std::size_t k = 0; k < spec.joints.size(); ++k) {
     const JointSpec& joint = spec.joints[k];
     // URDF: the joint frame sits at (xyz, rpy) in the parent link frame.
-    Eigen::Isometry3d joint_frame = kin.poses[k];
+    const auto parent = static_cast<std::size_t>(spec.parentLink(k));
+    Eigen::Isometry3d joint_frame = kin.poses[parent];
     joint_frame.translate(joint.xyz);
     joint_frame.rotate(rpyToMatrix(joint.rpy));
 
     Eigen::Isometry3d child = joint_frame;
-    kin.J[k + 1] = kin.J[k];
-    kin.v[k + 1] = kin.v[k];
-    kin.bias[k + 1] = kin.bias[k];
+    kin.J[k + 1] = kin.J[parent];
+    kin.v[k + 1] = kin.v[parent];
+    kin.bias[k + 1] = kin.bias[parent];
     if (!joint.isFixed()) {
       kin.dof_of_joint[k] = dof;
       kin.reflected(dof) = joint.reflectedInertia();
@@ -212,6 +249,11 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
     const Eigen::Vector3d p = kin.poses[li].translation();
     const Eigen::Vector3d omega = ang(kin.v[li]);
     const Eigen::Vector3d pdot = lin(kin.v[li]) + omega.cross(p);
+    if (!c.relative_to.empty()) {
+      relativeRows(spec, kin, c, row, out.G, out.gamma);
+      row += static_cast<int>(c.A.cols());
+      continue;
+    }
     for (Eigen::Index col = 0; col < c.A.cols(); ++col, ++row) {
       const Vector6d A_world = wrenchAtWorldOrigin(kin, link, c.A.col(col), c.axes);
       const Eigen::Vector3d l = lin(A_world);

@@ -37,7 +37,8 @@ using Matrix6Xd = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 // Which axes the components of a link-attached quantity use. Either way it
 // refers to the link ORIGIN (a wrench acts there, an acceleration is that of the
 // origin); `World` is what docs/conventions.md also calls "aligned".
-enum class Axes { Local, World };
+// Reference: for a relative constraint, the reference link's axes.
+enum class Axes { Local, World, Reference };
 
 // A wrench [f; n] applied to `link` at its origin.
 struct WrenchInput {
@@ -48,11 +49,20 @@ struct WrenchInput {
 
 // Aᵀ Ẍ = b on `link`: A is 6×m (columns [l; r]), b the m set points in terms of
 // the true classical acceleration of the link origin.
+//
+// With `relative_to` (another link r): the acceleration of link's origin and
+// angular velocity as seen riding on r, in world axes
+//   p̈_rel = d̈ − α_r × d − 2 ω_r × ḋ + ω_r × (ω_r × d),   d = p − p_r,
+//   ω̇_rel = α − α_r − ω_r × (ω − ω_r),
+// (the derivatives in r's frame of R_rᵀ d and R_rᵀ(ω − ω_r), turned back to
+// world axes), dotted with the columns; the wrench A ν acts on link and −A ν
+// on r, both at link's origin.
 struct ConstraintInput {
   std::string link;
   Matrix6Xd A;
   Eigen::VectorXd b;
   Axes axes = Axes::Local;
+  std::string relative_to;  // empty: absolute (relative to the world)
 };
 
 struct DynamicsInput {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -301,16 +302,17 @@ SampledFriction sampledFriction(const ChainSpec& spec, const DynamicsInput& inpu
   return out;
 }
 
-FrictionDraw randomFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, int min_stuck, int max_stuck,
-                                int max_rows) {
+namespace {
+
+// The problem, state and stuck set of a friction draw on a given spec.
+FrictionDraw frictionDrawOn(std::mt19937_64& rng, ChainSpec spec, int min_stuck, int max_stuck, int max_rows,
+                            double relative_probability) {
   FrictionDraw d;
-  RandomChainOptions chain;
-  chain.min_moving_joints = min_dof;
-  chain.max_moving_joints = max_dof;
-  d.spec = randomChain(rng, chain);
+  d.spec = std::move(spec);
   const int n = d.spec.dof();
   RandomProblemOptions problem;
   problem.max_constraint_rows = std::min(max_rows, n);  // more rows than joints can never be met
+  problem.relative_probability = relative_probability;
   d.input = randomProblem(rng, d.spec, problem);
   const std::vector<int> moving = d.spec.movingJoints();
   for (int j = 0; j < n; ++j) {
@@ -332,6 +334,26 @@ FrictionDraw randomFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, 
   for (int j : stuck) d.input.qd(j) = 0.0;
   d.setup = frictionSetupFromSpec(d.spec, d.input.qd);
   return d;
+}
+
+}  // namespace
+
+FrictionDraw randomFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, int min_stuck, int max_stuck,
+                                int max_rows) {
+  RandomChainOptions chain;
+  chain.min_moving_joints = min_dof;
+  chain.max_moving_joints = max_dof;
+  ChainSpec spec = randomChain(rng, chain);
+  return frictionDrawOn(rng, std::move(spec), min_stuck, max_stuck, max_rows, 0.0);
+}
+
+FrictionDraw randomTreeFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, int max_stuck, int max_rows,
+                                    double relative_probability) {
+  RandomTreeOptions tree;
+  tree.min_moving_joints = min_dof;
+  tree.max_moving_joints = max_dof;
+  ChainSpec spec = randomTree(rng, tree);
+  return frictionDrawOn(rng, std::move(spec), 1, max_stuck, max_rows, relative_probability);
 }
 
 bool wellPosed(const DenseResult& dense, int rows, double max_condition) {

@@ -135,6 +135,10 @@ struct FrictionDraw {
 };
 FrictionDraw randomFrictionDraw(std::mt19937_64& rng, int min_dof = 2, int max_dof = 7, int min_stuck = 1,
                                 int max_stuck = 5, int max_rows = 6);
+// The same on a random tree (randomTree), with constraints relative to
+// another link with the given probability.
+FrictionDraw randomTreeFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, int max_stuck, int max_rows,
+                                    double relative_probability);
 
 // The task itself is well posed (as test_dense filters): H and the coupling
 // matrix conditioned below max_condition and every constraint row independent

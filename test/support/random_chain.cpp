@@ -76,6 +76,50 @@ Eigen::Matrix3d randomInertia(std::mt19937_64& rng, double mass) {
   return 0.5 * (I + I.transpose());  // exactly symmetric
 }
 
+namespace {
+
+// A joint of the given kind with a random placement, axis, limits, friction
+// and rotor (shared by randomChain and randomTree).
+JointSpec randomJoint(std::mt19937_64& rng, const RandomChainOptions& options, const std::string& name, bool fixed) {
+  JointSpec joint;
+  joint.name = name;
+  if (fixed) {
+    joint.type = "fixed";
+  } else if (uniform01(rng) < options.prismatic_probability) {
+    joint.type = "prismatic";
+  } else {
+    joint.type = uniform01(rng) < options.continuous_probability ? "continuous" : "revolute";
+  }
+  const double length = uniform(rng, 0.05, 0.5);
+  joint.xyz =
+      length * (uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng) : randomUnitVector(rng));
+  joint.rpy = uniform01(rng) < 0.2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(randomVector(rng, 3, kPi));
+  joint.axis = uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng) : randomUnitVector(rng);
+  if (!joint.isFixed()) {
+    if (joint.isPrismatic()) {
+      joint.lower = -uniform(rng, 0.1, 1.0);
+      joint.upper = uniform(rng, 0.1, 1.0);
+    } else if (joint.type == "revolute") {
+      joint.lower = -uniform(rng, 0.5, kPi);
+      joint.upper = uniform(rng, 0.5, kPi);
+    }
+    joint.effort = uniform(rng, 10.0, 300.0);
+    joint.velocity = uniform(rng, 1.0, 5.0);
+    joint.friction = uniform(rng, options.friction_min, options.friction_max);
+    joint.damping = uniform(rng, options.damping_min, options.damping_max);
+    if (options.rotor_inertia && uniform01(rng) < 0.8) {
+      joint.rotor_inertia = uniform(rng, 1e-5, 0.05);
+      joint.gear_ratio = uniform(rng, 1.0, 100.0);
+      // Keep the reflected inertia rotor·ratio² at most 0.5 (ratio stays ≥ √10).
+      const double reflected = joint.rotor_inertia * joint.gear_ratio * joint.gear_ratio;
+      if (reflected > 0.5) joint.gear_ratio = std::sqrt(0.5 / joint.rotor_inertia);
+    }
+  }
+  return joint;
+}
+
+}  // namespace
+
 ChainSpec randomChain(std::mt19937_64& rng, const RandomChainOptions& options) {
   const int n =
       uniformInt(rng, options.min_moving_joints, std::max(options.min_moving_joints, options.max_moving_joints));
@@ -93,42 +137,43 @@ ChainSpec randomChain(std::mt19937_64& rng, const RandomChainOptions& options) {
   spec.links.push_back(randomLink(rng, "base"));
   for (std::size_t k = 0; k < is_fixed.size(); ++k) {
     const std::string index = std::to_string(k + 1);
-    JointSpec joint;
-    joint.name = "joint" + index;
-    if (is_fixed[k]) {
-      joint.type = "fixed";
-    } else if (uniform01(rng) < options.prismatic_probability) {
-      joint.type = "prismatic";
-    } else {
-      joint.type = uniform01(rng) < options.continuous_probability ? "continuous" : "revolute";
-    }
-    const double length = uniform(rng, 0.05, 0.5);
-    joint.xyz =
-        length * (uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng) : randomUnitVector(rng));
-    joint.rpy = uniform01(rng) < 0.2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(randomVector(rng, 3, kPi));
-    joint.axis = uniform01(rng) < options.axis_aligned_probability ? randomAxisAligned(rng) : randomUnitVector(rng);
-    if (!joint.isFixed()) {
-      if (joint.isPrismatic()) {
-        joint.lower = -uniform(rng, 0.1, 1.0);
-        joint.upper = uniform(rng, 0.1, 1.0);
-      } else if (joint.type == "revolute") {
-        joint.lower = -uniform(rng, 0.5, kPi);
-        joint.upper = uniform(rng, 0.5, kPi);
-      }
-      joint.effort = uniform(rng, 10.0, 300.0);
-      joint.velocity = uniform(rng, 1.0, 5.0);
-      joint.friction = uniform(rng, options.friction_min, options.friction_max);
-      joint.damping = uniform(rng, options.damping_min, options.damping_max);
-      if (options.rotor_inertia && uniform01(rng) < 0.8) {
-        joint.rotor_inertia = uniform(rng, 1e-5, 0.05);
-        joint.gear_ratio = uniform(rng, 1.0, 100.0);
-        // Keep the reflected inertia rotor·ratio² at most 0.5 (ratio stays ≥ √10).
-        const double reflected = joint.rotor_inertia * joint.gear_ratio * joint.gear_ratio;
-        if (reflected > 0.5) joint.gear_ratio = std::sqrt(0.5 / joint.rotor_inertia);
-      }
-    }
+    JointSpec joint = randomJoint(rng, options, "joint" + index, is_fixed[k]);
     spec.joints.push_back(joint);
     spec.links.push_back(randomLink(rng, "link" + index));
+  }
+  spec.check();
+  return spec;
+}
+
+ChainSpec randomTree(std::mt19937_64& rng, const RandomTreeOptions& options) {
+  const int n =
+      uniformInt(rng, options.min_moving_joints, std::max(options.min_moving_joints, options.max_moving_joints));
+  const int branching = uniformInt(rng, options.min_branching, std::max(options.min_branching, options.max_branching));
+  ChainSpec spec;
+  spec.name = "random_tree";
+  spec.links.push_back(randomLink(rng, "base"));
+  std::vector<int> children(1, 0);
+  std::vector<int> path{0};  // links from the base to the last one added: where a depth-first tree may grow
+  int moving = 0;
+  while (moving < n) {
+    // Start a new branch: go back up the path to an earlier link that may
+    // still take a child; otherwise grow from the last link.
+    const std::vector<int> grow_here = path;
+    if (branching > 1 && path.size() > 1 && uniform01(rng) < options.branch_probability)
+      path.resize(static_cast<std::size_t>(uniformInt(rng, 1, static_cast<int>(path.size()) - 1)));
+    while (path.size() > 1 && children[static_cast<std::size_t>(path.back())] >= branching) path.pop_back();
+    if (children[static_cast<std::size_t>(path.back())] >= branching) path = grow_here;  // the last link has none
+    const int parent = path.back();
+    const bool fixed = uniform01(rng) < options.joints.fixed_joint_probability;
+    const std::string index = std::to_string(spec.joints.size() + 1);
+    JointSpec joint = randomJoint(rng, options.joints, "joint" + index, fixed);
+    joint.parent = parent;
+    spec.joints.push_back(joint);
+    spec.links.push_back(randomLink(rng, "link" + index));
+    ++children[static_cast<std::size_t>(parent)];
+    children.push_back(0);
+    path.push_back(static_cast<int>(spec.links.size()) - 1);
+    if (!fixed) ++moving;
   }
   spec.check();
   return spec;

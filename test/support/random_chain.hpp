@@ -56,4 +56,19 @@ Eigen::Matrix3d randomInertia(std::mt19937_64& rng, double mass);
 // 0.05–0.5 m, random COMs and inertias; reflected rotor inertias ≤ 0.5.
 ChainSpec randomChain(std::mt19937_64& rng, const RandomChainOptions& options = {});
 
+struct RandomTreeOptions {
+  RandomChainOptions joints;  // joint kinds, friction, rotor inertias (moving-joint counts below)
+  int min_moving_joints = 2;
+  int max_moving_joints = 30;
+  int min_branching = 1;  // the most children any link may have, drawn per tree in [min, max]
+  int max_branching = 4;
+  double branch_probability = 0.4;  // that a joint starts a new branch off an earlier link of the path
+};
+
+// A random kinematic tree in depth-first order (ChainSpec with parents): links
+// "base", "link1", …, joints "joint1", …, each link with at most `branching`
+// children, fixed joints anywhere (also as parents of moving ones). Masses,
+// offsets and joints as randomChain.
+ChainSpec randomTree(std::mt19937_64& rng, const RandomTreeOptions& options = {});
+
 }  // namespace zwang::testing

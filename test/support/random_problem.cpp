@@ -57,20 +57,70 @@ DynamicsInput randomProblem(std::mt19937_64& rng, const ChainSpec& spec, const R
     for (int k = 0; k < here; ++k) c.A.col(k) = randomColumn(rng);
     c.b = randomVector(rng, here, 3.0);
     c.axes = uniform01(rng) < 0.5 ? Axes::Local : Axes::World;
+    if (options.relative_probability > 0.0 && uniform01(rng) < options.relative_probability) {
+      c.relative_to = randomLink(rng, spec);
+      if (c.relative_to == c.link) c.relative_to = spec.links[0].name;  // the base: an absolute row in disguise
+      const double axes = uniform01(rng);
+      c.axes = axes < 1.0 / 3 ? Axes::Local : axes < 2.0 / 3 ? Axes::World : Axes::Reference;
+    }
     in.constraints.push_back(c);
   }
   return in;
 }
 
-Model modelFromSpec(const ChainSpec& spec) { return loadUrdfString(toUrdf(spec)); }
+Model modelFromSpec(const ChainSpec& spec) {
+  return spec.isChain() ? loadUrdfString(toUrdf(spec)) : modelFromSpecByBuilder(spec);
+}
+
+Model modelFromSpecByBuilder(const ChainSpec& spec) {
+  // What the spec means (chain_spec.hpp): the joint frame at (xyz, rpy) in the
+  // parent link, the child link frame = joint frame moved by q, the link's
+  // inertia about its COM in the frame (com, inertial_rpy).
+  ModelBuilder builder(spec.name, spec.links[0].name);
+  for (std::size_t k = 0; k < spec.joints.size(); ++k) {
+    const JointSpec& js = spec.joints[k];
+    const LinkSpec& child = spec.links[k + 1];
+    const std::string& parent = spec.links[static_cast<std::size_t>(spec.parentLink(k))].name;
+    const Eigen::Matrix3d R_inertial = rpyToMatrix(child.inertial_rpy);
+    const RigidInertia inertia =
+        RigidInertia::fromMassComInertia(child.mass, child.com, R_inertial * child.inertia * R_inertial.transpose());
+    const Transform placement = Transform::fromPose(rpyToMatrix(js.rpy), js.xyz);
+    if (js.isFixed()) {
+      builder.addFixedFrame(child.name, parent, placement, inertia);
+      continue;
+    }
+    Joint joint;
+    joint.name = js.name;
+    joint.type = js.isPrismatic()          ? JointType::Prismatic
+                 : js.type == "continuous" ? JointType::Continuous
+                                           : JointType::Revolute;
+    joint.axis = js.axis;
+    joint.placement = placement;
+    joint.rotor_inertia = js.reflectedInertia();
+    joint.breakaway_friction = js.friction;
+    joint.kinetic_friction = js.friction;
+    joint.viscous_friction = js.damping;
+    if (joint.type != JointType::Continuous) {
+      joint.lower = js.lower;
+      joint.upper = js.upper;
+    }
+    joint.effort_limit = js.effort;
+    joint.velocity_limit = js.velocity;
+    builder.addJoint(joint, child.name, inertia, parent);
+  }
+  return builder.build();
+}
 
 Task taskFromInput(const Model& model, const DynamicsInput& input) {
   Task task(model);
   task.gravity = input.gravity;
-  auto expressed = [](Axes axes) { return axes == Axes::Local ? Expressed::Local : Expressed::World; };
+  auto expressed = [](Axes axes) {
+    return axes == Axes::Local ? Expressed::Local : axes == Axes::World ? Expressed::World : Expressed::Reference;
+  };
   for (const WrenchInput& w : input.wrenches) task.wrench(task.addWrench(w.link, expressed(w.axes))) = w.wrench;
   for (const ConstraintInput& c : input.constraints) {
-    const int first = task.addConstraint(c.link, c.A, expressed(c.axes));
+    const int first = c.relative_to.empty() ? task.addConstraint(c.link, c.A, expressed(c.axes))
+                                            : task.addRelativeConstraint(c.link, c.relative_to, c.A, expressed(c.axes));
     task.targets().segment(first, c.b.size()) = c.b;
   }
   return task;

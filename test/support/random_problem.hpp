@@ -15,6 +15,7 @@ struct RandomProblemOptions {
   int max_wrenches = 2;
   bool end_effector_only = false;  // all constraint rows on the last link (KDL's case)
   double gravity_probability = 0.8;
+  double relative_probability = 0.0;  // that a constraint is relative to another random link (or the base)
 };
 
 // q, q̇, τ, gravity, wrenches and constraints drawn for `spec`. Constraint
@@ -22,8 +23,11 @@ struct RandomProblemOptions {
 // targets and wrenches of a few units.
 DynamicsInput randomProblem(std::mt19937_64& rng, const ChainSpec& spec, const RandomProblemOptions& options = {});
 
-// The chain through the URDF loader (writer → loader: both are exercised).
+// The chain through the URDF loader (writer → loader: both are exercised); a
+// tree through the ModelBuilder (modelFromSpecByBuilder).
 Model modelFromSpec(const ChainSpec& spec);
+// The spec built joint by joint with the ModelBuilder, as the URDF loader would.
+Model modelFromSpecByBuilder(const ChainSpec& spec);
 
 // The same problem as a zwang Task (rows in the same order).
 Task taskFromInput(const Model& model, const DynamicsInput& input);

@@ -89,7 +89,7 @@ std::string toUrdf(const ChainSpec& spec) {
       << "<robot name=\"" << xmlEscape(spec.name) << "\" xmlns:drake=\"http://drake.mit.edu\">\n";
   for (const LinkSpec& link : spec.links) writeLink(out, link);
   for (std::size_t k = 0; k < spec.joints.size(); ++k)
-    writeJoint(out, spec.joints[k], spec.links[k], spec.links[k + 1]);
+    writeJoint(out, spec.joints[k], spec.links[static_cast<std::size_t>(spec.parentLink(k))], spec.links[k + 1]);
   for (const JointSpec& joint : spec.joints)
     if (!joint.isFixed() && joint.rotor_inertia > 0.0) writeTransmission(out, joint);
   out << "</robot>\n";

@@ -49,14 +49,24 @@ struct Hash {
   void add(double x) { add(&x, sizeof x); }
 };
 
+// Shared by every thread (a solve only reads its Task).
 struct Tasks {
   Task free_task, constrained;
-  explicit Tasks(const Model& model) : free_task(model), constrained(model) {
-    constrained.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
-    ConstraintMatrix elbow = ConstraintMatrix::Zero(6, 1);
-    elbow(2, 0) = 1.0;
-    constrained.addConstraint("panda_link4", elbow, Expressed::World);
-    constrained.targets()[2] = 0.5;
+  Eigen::VectorXd home;  // the posture the inputs vary around
+  explicit Tasks(const Model& model) : free_task(model), constrained(model), home(model.dof()) {
+    if (model.name() == "panda") {
+      constrained.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
+      ConstraintMatrix elbow = ConstraintMatrix::Zero(6, 1);
+      elbow(2, 0) = 1.0;
+      constrained.addConstraint("panda_link4", elbow, Expressed::World);
+      constrained.targets()[2] = 0.5;
+      home << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
+    } else {  // the dual arm: the left hand held in the world, and the two hands held together
+      constrained.addConstraint(model.bodyFrame(8), ConstraintMatrix::Identity(6, 3), Expressed::World);
+      constrained.addRelativeConstraint(model.bodyFrame(8), model.bodyFrame(15), ConstraintMatrix::Identity(6, 6));
+      constrained.targets()[2] = 0.5;
+      home << 0.0, 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785, 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
+    }
   }
 };
 
@@ -67,17 +77,17 @@ struct Outcome {
 };
 
 // The same sequence of solves on every thread; inputs vary with the index.
-Outcome run(const Model& model, long solves) {
-  Tasks tasks(model);
+Outcome run(const Model& model, const Tasks& tasks, long solves) {
   Workspace ws(model, tasks.constrained);
-  Eigen::VectorXd q(7), qd(7), tau(7), home(7);
-  home << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  const int n = model.dof();
+  Eigen::VectorXd q(n), qd(n), tau(n);
+  const Eigen::VectorXd& home = tasks.home;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
   FrictionOptions options;
   Hash hash;
   Outcome out;
   for (long i = 0; i < solves; ++i) {
-    for (int j = 0; j < 7; ++j) {
+    for (int j = 0; j < n; ++j) {
       q[j] = home[j] + 0.3 * std::sin(0.001 * static_cast<double>(i) + j);  // inside the Panda's limits
       tau[j] = 2.0 * std::cos(0.002 * static_cast<double>(i) * (j + 1));
     }
@@ -110,11 +120,38 @@ Outcome run(const Model& model, long solves) {
 
 }  // namespace
 
+namespace {
+// A tree: two Panda arms (the bodies of panda.urdf) on a torso that turns
+// about z, mounted 0.25 m to either side.
+zwang::Model dualPanda(const zwang::Model& panda) {
+  ModelBuilder builder("dual_panda", "base");
+  Joint torso;
+  torso.name = "torso";
+  builder.addJoint(torso, "torso_link", RigidInertia::fromMassComInertia(15.0, Vec3(0, 0, 0.3), Mat3::Identity()));
+  for (const char* side : {"left", "right"}) {
+    std::string parent = "torso_link";
+    for (int j = 0; j < panda.dof(); ++j) {
+      Joint joint = panda.joint(j);
+      joint.name = std::string(side) + "_" + joint.name;
+      if (j == 0)
+        joint.placement = joint.placement * Transform::translation(Vec3(0, side[0] == 'l' ? 0.25 : -0.25, 0.5));
+      const std::string link = std::string(side) + "_" + panda.frame(panda.bodyFrame(j + 1)).name;
+      builder.addJoint(joint, link, panda.inertia(j + 1), parent);
+      parent = link;
+    }
+  }
+  return builder.build();
+}
+}  // namespace
+
 TEST_CASE("8 threads share one model, each with its own workspace: results identical to one thread") {
-  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  const bool tree = GENERATE(false, true);
+  const Model panda = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  const Model model = tree ? dualPanda(panda) : panda;
+  const Tasks tasks(model);
   const long solves = solvesPerThread();
   REQUIRE(solves > 0);
-  const Outcome reference = run(model, solves);
+  const Outcome reference = run(model, tasks, solves);
   INFO("first failure: " << reference.first_failure);
   CHECK(reference.failures == 0);
 
@@ -122,7 +159,7 @@ TEST_CASE("8 threads share one model, each with its own workspace: results ident
   std::vector<std::thread> threads;
   for (int t = 0; t < kThreads; ++t)
     threads.emplace_back(
-        [&model, &outcomes, solves, t] { outcomes[static_cast<std::size_t>(t)] = run(model, solves); });
+        [&model, &tasks, &outcomes, solves, t] { outcomes[static_cast<std::size_t>(t)] = run(model, tasks, solves); });
   for (std::thread& thread : threads) thread.join();
   for (int t = 0; t < kThreads; ++t) {
     INFO("thread " << t);
@@ -130,7 +167,7 @@ TEST_CASE("8 threads share one model, each with its own workspace: results ident
     CHECK(outcomes[static_cast<std::size_t>(t)].hash == reference.hash);
   }
   std::printf(
-      "threads: %d x %ld solves on one shared Panda model, every thread bit-identical to the single-thread run"
+      "threads: %d x %ld solves on one shared %s model, every thread bit-identical to the single-thread run"
       " (hash %016llx)\n",
-      kThreads, solves, static_cast<unsigned long long>(reference.hash));
+      kThreads, solves, tree ? "dual-arm (15-joint tree)" : "Panda", static_cast<unsigned long long>(reference.hash));
 }

@@ -257,3 +257,31 @@ TEST_CASE("trees: friction matches the brute-force enumeration of stick/slip pat
   CHECK(states[2] + states[3] > 50);
   CHECK(with_relative > 30);
 }
+
+TEST_CASE("trees: bad relative constraints are refused with the reason", "[trees]") {
+  std::mt19937_64 rng(3);
+  const ChainSpec spec = randomTree(rng);
+  const Model model = modelFromSpec(spec);
+  Task task(model);
+  const ConstraintMatrix A = ConstraintMatrix::Identity(6, 3);
+  const std::string link = spec.links[1].name;
+  auto message = [&](auto&& f) -> std::string {
+    try {
+      f();
+    } catch (const ModelError& e) {
+      return e.what();
+    }
+    return "(no ModelError)";
+  };
+  CHECK(message([&] { task.addRelativeConstraint(link, link, A); }) ==
+        "task: a relative constraint on frame '" + link + "' needs another frame to refer to, not itself");
+  CHECK(message([&] { task.addRelativeConstraint(link, "no_such_link", A); }) ==
+        "task: the model has no frame 'no_such_link'");
+  CHECK(message([&] { task.addRelativeConstraint("no_such_link", link, A); }) ==
+        "task: the model has no frame 'no_such_link'");
+  CHECK(message([&] { task.addRelativeConstraint(1, 99999, A); }) == "task: reference frame index 99999 out of range");
+  CHECK(task.constraintRows() == 0);  // nothing half-added
+  // And a good one works, relative to the base as well as to another link.
+  CHECK(task.addRelativeConstraint(link, spec.links[0].name, A) == 0);
+  CHECK(task.solverColumns() == 6);
+}

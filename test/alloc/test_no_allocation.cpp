@@ -1,9 +1,12 @@
 // Once the workspace exists, the hot-path calls make no heap allocation.
 #include <catch2/catch.hpp>
+#include <random>
 #include <type_traits>
 
 #include "counting_malloc.hpp"
 #include "support/bad_inputs.hpp"
+#include "support/random_chain.hpp"
+#include "support/random_problem.hpp"
 #include "zwang/zwang.hpp"
 
 using namespace zwang;
@@ -338,4 +341,36 @@ TEST_CASE("a frame index out of range: every kinematics accessor returns a Statu
   CHECK(pose.translation() == Eigen::Vector3d(7, 7, 7));
   CHECK(v == marker);
   CHECK(a == marker);
+}
+
+TEST_CASE("a tree with constraints on two branches and a relative constraint allocates nothing (plain and friction)") {
+  std::mt19937_64 rng(5);
+  zwang::testing::RandomTreeOptions options;
+  options.min_moving_joints = options.max_moving_joints = 12;
+  options.min_branching = 3;
+  const zwang::testing::ChainSpec spec = zwang::testing::randomTree(rng, options);
+  const Model model = zwang::testing::modelFromSpec(spec);
+  REQUIRE_FALSE(model.isChain());
+  Task task(model);
+  const int last = static_cast<int>(model.frames().size()) - 1;
+  task.addConstraint(last, ConstraintMatrix::Identity(6, 3), Expressed::World);
+  task.addRelativeConstraint(model.bodyFrame(3), model.bodyFrame(model.bodyCount() - 1),
+                             ConstraintMatrix::Identity(6, 2));
+  Workspace ws(model, task);
+  Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(12, -0.5, 0.7), qd = Eigen::VectorXd::Constant(12, 0.3),
+                  tau = Eigen::VectorXd::Constant(12, 1.0);
+  for (int j = 0; j < 12; j += 3) qd[j] = 0.0;                // some joints stuck
+  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));  // warm
+  REQUIRE(solveWithFriction(model, task, q, qd, tau, ws));
+  bool all_ok = true;
+  const long count = allocationsDuring([&] {
+    for (int k = 0; k < 10; ++k) {
+      task.targets()[0] = 0.1 * k;
+      all_ok = solveHybridDynamics(model, task, q, qd, tau, ws).ok() && all_ok;
+      all_ok = solveWithFriction(model, task, q, qd, tau, ws).ok() && all_ok;
+      all_ok = inverseDynamics(model, task, q, qd, tau, ws).ok() && all_ok;
+    }
+  });
+  CHECK(all_ok);
+  CHECK(count == 0);
 }

@@ -72,7 +72,7 @@ RigidInertia body(FuzzedDataProvider& in) {
   return RigidInertia::fromMassComInertia(mass, com, mass > 0.0 ? I : Mat3::Zero());
 }
 
-struct Chain {
+struct Chain {  // a chain or a tree, built depth first
   Model model;
   std::vector<std::string> frames;
 };
@@ -82,7 +82,10 @@ bool buildChain(FuzzedDataProvider& in, Chain& out) {
   try {
     ModelBuilder builder("fuzz", "base");
     out.frames = {"base"};
+    std::vector<std::string> path{"base"};  // the link frames back to the base: where a depth-first tree may grow
     for (int j = 0; j < n; ++j) {
+      if (path.size() > 1 && in.ConsumeProbability<double>() < 0.3)  // a new branch off an earlier link
+        path.resize(in.ConsumeIntegralInRange<std::size_t>(1, path.size() - 1));
       Joint joint;
       joint.name = "j" + std::to_string(j);
       const int type = in.ConsumeIntegralInRange(0, 2);
@@ -98,8 +101,9 @@ bool buildChain(FuzzedDataProvider& in, Chain& out) {
         joint.upper = logUniform(in, 1e-3, 3.0, 0.1);
       }
       const std::string link = "link" + std::to_string(j + 1);
-      builder.addJoint(joint, link, body(in));
+      builder.addJoint(joint, link, body(in), path.back());
       out.frames.push_back(link);
+      path.push_back(link);
       if (in.ConsumeProbability<double>() < 0.2) {
         const std::string tool = "tool" + std::to_string(j + 1);
         builder.addFixedFrame(tool, link, Transform::fromPose(rotation(in), logUniform(in, 1e-3, 10.0) * direction(in)),
@@ -192,7 +196,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     rows -= here;
     const ConstraintMatrix A = constraintColumns(in, here, previous);
     const int frame = in.ConsumeIntegralInRange(0, frames - 1);  // 0: the fixed base (singular)
-    task.addConstraint(frame, A, in.ConsumeBool() ? Expressed::Local : Expressed::World);
+    const int reference = in.ConsumeIntegralInRange(-1, frames - 1);
+    const int axes = in.ConsumeIntegralInRange(0, 2);
+    const Expressed expressed = axes == 0 ? Expressed::Local : axes == 1 ? Expressed::World : Expressed::Reference;
+    if (reference >= 0 && reference != frame)  // relative to another frame, on any branch
+      task.addRelativeConstraint(frame, reference, A, expressed);
+    else
+      task.addConstraint(frame, A, expressed);
     previous = &task.groups().back().A;
   }
   for (Eigen::Index r = 0; r < task.targets().size(); ++r) task.targets()[r] = signedLog(in, 1e-3, 1e3);

@@ -149,7 +149,13 @@ def tree_section(w, medians, counters, ctx):
     w("hangs from body ⌊(v − 1)/b⌋ (0: the base, which has b children), the branching-factor trees of")
     w("Featherstone's benchmarks, numbered depth first as the model requires (`tree_hd_*/N=…,b=…`; b = 1 is")
     w("the chain itself, timed again in the same run). *6 rows*: the deepest leaf held still in world axes.")
-    w("A leaf of a balanced tree has few joints above it (depth: b = 2 3–7, b = 4 2–4 for N = 7…128): with")
+    depths = []
+    for b in TREE_BRANCHING:
+        d = [counters[tree_name("m6", n, b)].get("depth", 0) for n in TREE_SIZES if tree_name("m6", n, b) in counters]
+        if d:
+            depths.append(f"b = {b} {min(d):.0f}–{max(d):.0f}")
+    w("A leaf of a balanced tree has few joints above it (" + ", ".join(depths) + f" for N = {TREE_SIZES[0]}…"
+      f"{TREE_SIZES[-1]}): with")
     w("fewer than 6 the six rows cannot all be met (balance rank = depth), and the solve takes the balance's")
     w("least-squares path (eigen-decomposition instead of Cholesky), which costs more than the tree saves on")
     w("small N. *Per body*: time / N. *ratio*: tree / chain at the same N (the same per body).")

@@ -94,6 +94,8 @@ enum class WarningCode {
   MassOffChain,        ///< links behind a moving joint off the chain (a side branch) carry mass it ignores
   /// that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
   PayloadAttached,
+  /// a mimic joint was locked (UrdfOptions::mimic = MimicJoints::Lock); a note, strict mode lets it pass
+  MimicLocked,
   Urdfdom,  ///< urdfdom's own warning, passed on once
 };
 /// "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.

@@ -1,5 +1,5 @@
 /// \file
-/// Loading a chain from URDF (via urdfdom).
+/// Loading a model (a whole tree, a subtree or a chain) from URDF (via urdfdom).
 #pragma once
 
 #include <map>
@@ -9,13 +9,40 @@
 
 namespace zwang {
 
-/// Which chain to load from the URDF, and rotor inertias it does not state.
+/// What the loader does with a URDF `<mimic>` joint (q = multiplier · q_leader +
+/// offset) among the joints it loads. zwang does not model the coupling yet;
+/// loading such a joint as an independent one would be a silent wrong answer,
+/// so the default refuses it. A later `Model` choice (the joint follows its
+/// leader) is meant to become the default.
+enum class MimicJoints {
+  /// ModelError naming the joint and its leader (the default).
+  Refuse,
+  /// Weld each mimic joint (and the links behind it) to its parent link at
+  /// UrdfOptions::locked_positions[joint], by default at the position its leader
+  /// at rest implies: multiplier · q_leader + offset with q_leader =
+  /// locked_positions[leader] if that is given, else 0 (so `offset`). Each
+  /// locked joint is noted with a MimicLocked warning (strict mode lets it pass).
+  Lock,
+};
+
+/// What to load from the URDF, and rotor inertias it does not state.
+///
+/// * No tip: the whole tree below `root` (default: the URDF's root link),
+///   every moving joint of it, bodies in depth-first order: a depth-first walk
+///   over the links from the root, each link's children taken in the
+///   byte-wise order of the names of the joints that lead to them (urdfdom's
+///   own order). A tree that does not branch into moving joints is a chain and
+///   loads exactly as the chain to its unique leaf.
+/// * `root` and `tip`: the chain from `root` to `tip`; moving joints off that
+///   path are not in the model (MassOffChain, MassBeyondTip, attach_beyond_tip).
+///
+/// Fixed joints are merged into their parent body, and every link that is
+/// loaded, or welded to one that is, is a named frame (also the links welded
+/// above the root).
 struct UrdfOptions {
-  /// The chain runs from `root` down to `tip`. Empty root: the URDF's root link.
-  /// Empty tip: allowed only when the tree below root does not branch into moving
-  /// joints (the unique leaf is used).
+  /// The model starts at this link (its base, body 0). Empty: the URDF's root link.
   std::string root;
-  /// The tip link; see root.
+  /// The tip link of a chain from root to tip; empty: the whole tree below root (see above).
   std::string tip;
   /// Rotor (armature) inertia per joint name, overriding the URDF's
   /// `<transmission>/<actuator>/<drake:rotor_inertia>` · `<drake:gear_ratio>`².
@@ -23,22 +50,29 @@ struct UrdfOptions {
   /// Refuse doubtful data: every ModelWarning the load would record (point
   /// masses, placeholder inertias or limits, triangle-inequality violations,
   /// mass beyond the tip, urdfdom's warnings) becomes a ModelError instead
-  /// (PayloadAttached, a note on what attach_beyond_tip did, is let pass).
+  /// (PayloadAttached and MimicLocked, notes on what attach_beyond_tip and
+  /// MimicJoints::Lock did, are let pass).
   bool strict = false;
   /// Links behind moving joints below the tip (a gripper's fingers) are not on
   /// the chain. false: their mass is ignored, with a MassBeyondTip warning.
   /// true: they are welded to the tip body as a rigid payload, each of those
-  /// joints locked at locked_positions[joint] (default 0), and become frames.
+  /// joints locked at locked_positions[joint] (default 0; a mimic joint's default
+  /// is as for MimicJoints::Lock), and become frames.
   bool attach_beyond_tip = false;
-  /// Position of each locked joint beyond the tip, by name (default 0); see attach_beyond_tip.
+  /// Mimic joints among the loaded ones: refused (default) or locked; see MimicJoints.
+  MimicJoints mimic = MimicJoints::Refuse;
+  /// Position of each locked joint, by name: the joints beyond the tip
+  /// (attach_beyond_tip) and the mimic joints (MimicJoints::Lock). Any other
+  /// name is a ModelError.
   std::map<std::string, double> locked_positions;
   /// How the caller spells these options, for the hints in messages (the CLI
   /// says "--tip", Python "tip=").
   struct Names {
-    std::string tip = "UrdfOptions::tip";                              ///< the name of the tip option
-    std::string rotor_inertia = "UrdfOptions::rotor_inertia";          ///< the name of the rotor_inertia option
-    std::string attach_beyond_tip = "UrdfOptions::attach_beyond_tip";  ///< the name of the attach_beyond_tip option
-  } names;                                                             ///< see Names
+    std::string tip = "UrdfOptions::tip";                               ///< the name of the tip option
+    std::string rotor_inertia = "UrdfOptions::rotor_inertia";           ///< the name of the rotor_inertia option
+    std::string attach_beyond_tip = "UrdfOptions::attach_beyond_tip";   ///< the name of the attach_beyond_tip option
+    std::string lock_mimic = "UrdfOptions::mimic = MimicJoints::Lock";  ///< how to ask for MimicJoints::Lock
+  } names;                                                              ///< see Names
 };
 
 /// Throw ModelError with a message naming the file (or "<string>"), the link or

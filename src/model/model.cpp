@@ -61,6 +61,7 @@ const char* toString(WarningCode code) {
     case WarningCode::MassBeyondTip: return "mass_beyond_tip";
     case WarningCode::MassOffChain: return "mass_off_chain";
     case WarningCode::PayloadAttached: return "payload_attached";
+    case WarningCode::MimicLocked: return "mimic_locked";
     case WarningCode::Urdfdom: return "urdfdom";
   }
   return "unknown";

@@ -14,16 +14,21 @@
 //  3. TinyXML again for what urdfdom drops: <transmission> elements with
 //     Drake's rotor-inertia tags.
 //
-// The chain runs from the root link to the tip link through revolute,
-// continuous, prismatic and fixed joints. Fixed joints become frames and
-// their links' inertias are merged into the body they are welded to. Besides
-// the chain's own links, every link connected to a chain link through fixed
-// joints only (side branches, links below the tip, fixed parents of the root)
-// is a frame. Links connected through a moving joint that is not on the chain
-// are NOT part of the model: their mass is ignored, as KDL's tree→chain
+// What is loaded (urdf.hpp, UrdfOptions): without a tip, the whole tree below
+// the root link, walked depth first with each link's children in the order of
+// their joints' names; with a tip, the chain from the root link to the tip
+// link (a tree that does not branch into moving joints is such a chain, to its
+// unique leaf, and is loaded by the same code as before trees). Revolute,
+// continuous and prismatic joints become the model's joints; fixed joints
+// become frames and their links' inertias are merged into the body they are
+// welded to. Every link connected to a loaded link through fixed joints only
+// (side branches, links below the tip, fixed parents of the root) is a frame.
+// For a chain, links connected through a moving joint that is not on it are
+// NOT part of the model: their mass is ignored, as KDL's tree→chain
 // conversion does, with a warning when they ride on a moving body (beyond the
-// tip, or a side branch). A <mimic> joint on the chain is refused: a chain of
-// independent joints cannot follow a leader.
+// tip, or a side branch). A <mimic> joint among the loaded ones is refused (a
+// model of independent joints cannot follow a leader), or welded at the
+// position its leader at rest implies with MimicJoints::Lock.
 #include "zwang/urdf.hpp"
 
 #include <console_bridge/console.h>
@@ -162,6 +167,8 @@ void checkAllNumbers(const Reporter& report, const TiXmlElement* robot) {
       checkNumbers(report, who + "<limit>", joint->FirstChildElement("limit"), attr, 1);
     for (const char* attr : {"friction", "damping"})
       checkNumbers(report, who + "<dynamics>", joint->FirstChildElement("dynamics"), attr, 1);
+    for (const char* attr : {"multiplier", "offset"})
+      checkNumbers(report, who + "<mimic>", joint->FirstChildElement("mimic"), attr, 1);
   }
 }
 
@@ -395,8 +402,7 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
     case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
     default:
       report.fail(who + " (parent '" + uj.parent_link_name + "', child '" + uj.child_link_name + "'): type " +
-                  typeName(uj.type) +
-                  " is not supported on the chain (only revolute, continuous, prismatic and fixed joints are)");
+                  typeName(uj.type) + " is not supported (only revolute, continuous, prismatic and fixed joints are)");
   }
 
   joint.placement = placementOf(uj);
@@ -432,27 +438,108 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
 }
 
 // ---------------------------------------------------------------------------
-// Choosing the chain
+// Mimic joints
 
 using LinkPtr = urdf::LinkConstSharedPtr;
 
-bool hasMovingJointBelow(const urdf::Link& link) {
-  for (const auto& j : link.child_joints) {
-    if (isMoving(*j)) return true;
+// A moving joint that MimicJoints::Lock welds: it is not a degree of freedom.
+bool isLockedMimic(const urdf::Joint& joint, const UrdfOptions& options) {
+  return isMoving(joint) && joint.mimic && options.mimic == MimicJoints::Lock;
+}
+
+// A joint that becomes a joint of the model (moving, and not locked).
+bool isDegreeOfFreedom(const urdf::Joint& joint, const UrdfOptions& options) {
+  return isMoving(joint) && !isLockedMimic(joint, options);
+}
+
+std::string mimicLaw(const urdf::Joint& uj) {
+  return "q = " + fmt(uj.mimic->multiplier) + "·q_" + uj.mimic->joint_name + " + " + fmt(uj.mimic->offset);
+}
+
+// Where a locked mimic joint is welded: locked_positions[joint], else the
+// position its leader at rest implies, multiplier · q_leader + offset with
+// q_leader = locked_positions[leader] (default 0).
+double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const UrdfOptions& options) {
+  if (const auto given = options.locked_positions.find(uj.name); given != options.locked_positions.end())
+    return given->second;
+  const auto leader = options.locked_positions.find(uj.mimic->joint_name);
+  const double q_leader = leader == options.locked_positions.end() ? 0.0 : leader->second;
+  const double q = uj.mimic->multiplier * q_leader + uj.mimic->offset;
+  if (!std::isfinite(q))
+    report.fail("joint '" + uj.name + "' (" + mimicLaw(uj) + "): the position to lock it at is not finite");
+  return q;
+}
+
+// A <mimic> joint follows its leader (q = a·q_leader + b). zwang does not model
+// that coupling yet, and an independent joint in its place would be a silent
+// wrong answer: refused (MimicJoints::Refuse), with the ways around it.
+// `chain_before` is the link before it on a chain (empty in a tree).
+[[noreturn]] void refuseMimic(const Reporter& report, const urdf::Joint& uj, const UrdfOptions& options,
+                              const std::string& chain_before) {
+  const std::string lock = options.names.lock_mimic +
+                           " to weld it at q = " + fmt(mimicLockPosition(report, uj, options)) +
+                           " (its position when '" + uj.mimic->joint_name + "' is at rest)";
+  if (!chain_before.empty())
+    report.fail("joint '" + uj.name + "' on the chain mimics joint '" + uj.mimic->joint_name + "' (" + mimicLaw(uj) +
+                "): mimic joints are not modelled yet and a chain of independent joints cannot keep that coupling; "
+                "choose a " +
+                options.names.tip + " before it (e.g. '" + chain_before + "') or set " + lock);
+  report.fail("joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" + mimicLaw(uj) +
+              "): mimic joints are not modelled yet, and loading it as an independent joint would be a silent "
+              "wrong answer; set " +
+              lock + ", or choose a " + options.names.tip + " for a chain without it");
+}
+
+// A note on a locked mimic joint (MimicLocked, which strict mode lets pass).
+ModelWarning mimicLockedNote(const urdf::Joint& uj, double q, const UrdfOptions& options) {
+  return {WarningCode::MimicLocked, "joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" +
+                                        mimicLaw(uj) + "): locked at q = " + fmt(q) + " (" + options.names.lock_mimic +
+                                        "; mimic joints are not modelled yet), link '" + uj.child_link_name +
+                                        "' welded to link '" + uj.parent_link_name + "'"};
+}
+
+// ᶜX_p of a joint locked at position q (revolute and continuous turn about the
+// axis, prismatic slides along it; other types stay at their origin).
+Transform lockedPlacement(const Reporter& report, const urdf::Joint& uj, double q) {
+  if (q == 0.0 ||
+      (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS && uj.type != urdf::Joint::PRISMATIC))
+    return placementOf(uj);
+  std::vector<ModelWarning> ignored;
+  const Joint joint = makeJoint(report, uj, {}, ignored);
+  return joint.transform(q);
+}
+
+// ---------------------------------------------------------------------------
+// Choosing what to load: a chain, or the whole tree below the root
+
+// The links of the subtree below `root` (root first, parents before children).
+std::vector<LinkPtr> subtreeLinks(const LinkPtr& root) {
+  std::vector<LinkPtr> links{root};
+  for (std::size_t head = 0; head < links.size(); ++head)
+    for (const auto& child : links[head]->child_links) links.push_back(child);
+  return links;
+}
+
+// Whether some link below `root` has two or more children that lead to moving
+// joints: then the subtree is a tree, not a chain.
+bool branchesIntoMovingJoints(const LinkPtr& root) {
+  const std::vector<LinkPtr> links = subtreeLinks(root);
+  std::map<const urdf::Link*, bool> moving_below;             // a moving joint at or below the link's child joints
+  for (auto it = links.rbegin(); it != links.rend(); ++it) {  // children before parents
+    const urdf::Link& link = **it;
+    int leading = 0;
+    for (std::size_t k = 0; k < link.child_joints.size(); ++k)
+      leading += isMoving(*link.child_joints[k]) || moving_below[link.child_links[k].get()] ? 1 : 0;
+    if (leading > 1) return true;
+    moving_below[&link] = leading > 0;
   }
-  for (const auto& child : link.child_links)
-    if (hasMovingJointBelow(*child)) return true;
   return false;
 }
 
-void collectLeaves(const urdf::Link& link, std::vector<std::string>& leaves) {
-  if (link.child_links.empty()) leaves.push_back(link.name);
-  for (const auto& child : link.child_links) collectLeaves(*child, leaves);
-}
-
-// The links from root to tip (root first).
+// The links from root to tip (root first). No tip: the unique leaf of the
+// branch that leads to moving joints (only called when there is one).
 std::vector<LinkPtr> chainLinks(const Reporter& report, const urdf::ModelInterface& model, const LinkPtr& root,
-                                const std::string& tip_name, const std::string& tip_option) {
+                                const std::string& tip_name) {
   std::vector<LinkPtr> path;
   if (!tip_name.empty()) {
     const LinkPtr tip = model.getLink(tip_name);
@@ -469,23 +556,22 @@ std::vector<LinkPtr> chainLinks(const Reporter& report, const urdf::ModelInterfa
       return names.empty() ? std::string("none") : nameList(names);
     }() + ")");
   }
-  // No tip given: follow the single branch that leads to moving joints.
+  // No tip: follow the single branch that leads to moving joints.
+  const std::vector<LinkPtr> links = subtreeLinks(root);
+  std::set<const urdf::Link*> moving_below;
+  for (auto it = links.rbegin(); it != links.rend(); ++it)
+    for (std::size_t k = 0; k < (*it)->child_joints.size(); ++k)
+      if (isMoving(*(*it)->child_joints[k]) || moving_below.count((*it)->child_links[k].get()))
+        moving_below.insert(it->get());
   LinkPtr link = root;
   path.push_back(link);
   for (;;) {
-    std::vector<LinkPtr> branches;
-    for (std::size_t k = 0; k < link->child_joints.size(); ++k) {
-      const auto& child = link->child_links[k];
-      if (isMoving(*link->child_joints[k]) || hasMovingJointBelow(*child)) branches.push_back(child);
-    }
-    if (branches.empty()) return path;
-    if (branches.size() > 1) {
-      std::vector<std::string> candidates;
-      for (const LinkPtr& b : branches) collectLeaves(*b, candidates);
-      report.fail("no tip link given and the tree branches into moving joints at link '" + link->name +
-                  "'; candidate tips: " + nameList(candidates) + " (set " + tip_option + ")");
-    }
-    link = branches.front();
+    LinkPtr next;
+    for (std::size_t k = 0; k < link->child_joints.size() && !next; ++k)
+      if (isMoving(*link->child_joints[k]) || moving_below.count(link->child_links[k].get()))
+        next = link->child_links[k];
+    if (!next) return path;
+    link = next;
     path.push_back(link);
   }
 }
@@ -537,20 +623,35 @@ std::map<std::string, double> rotorInertias(const Reporter& report, const TiXmlE
   return rotor;
 }
 
+// Every rotor_inertia override names a joint of the model (`moving`, described by `what`).
+void checkRotorNames(const Reporter& report, const urdf::ModelInterface& urdf_model, const UrdfOptions& options,
+                     const std::vector<std::string>& moving, const std::string& what) {
+  for (const auto& entry : options.rotor_inertia) {
+    if (std::find(moving.begin(), moving.end(), entry.first) != moving.end()) continue;
+    report.fail(
+        options.names.rotor_inertia + " names joint '" + entry.first + "', which is not a moving joint of " + what +
+        " (its joints: " + nameList(moving) + ")" +
+        (urdf_model.getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
+  }
+}
+
 // Links placed into the builder, and the ones on the last body (the tip body).
 struct Placement {
   std::set<std::string> placed;
   std::vector<LinkPtr> tip_body;
-  std::vector<ModelWarning> warnings;  // the loader's own (limits, beyond the tip, urdfdom)
+  std::vector<std::string> locked_mimic;  // mimic joints welded by MimicJoints::Lock
+  std::vector<ModelWarning> warnings;     // the loader's own (limits, beyond the tip, locks, urdfdom)
 };
 
 // Every link welded to `anchor` (down, and up off the root), breadth first.
-void addWelded(const Reporter& report, ModelBuilder& builder, Placement& placement, const LinkPtr& anchor,
-               bool on_base) {
+// `down_from_anchor` false: only what is welded above the anchor (and hangs
+// off those links), the anchor's own subtree being loaded otherwise.
+void addWelded(const Reporter& report, ModelBuilder& builder, Placement& placement, const LinkPtr& anchor, bool on_base,
+               bool down_from_anchor = true) {
   std::vector<LinkPtr> queue{anchor};
   for (std::size_t head = 0; head < queue.size(); ++head) {
     const LinkPtr from = queue[head];
-    for (std::size_t k = 0; k < from->child_joints.size(); ++k) {
+    for (std::size_t k = 0; k < from->child_joints.size() && (head > 0 || down_from_anchor); ++k) {
       const auto& joint = from->child_joints[k];
       const LinkPtr child = from->child_links[k];
       if (isMoving(*joint) || placement.placed.count(child->name)) continue;
@@ -572,9 +673,20 @@ void addWelded(const Reporter& report, ModelBuilder& builder, Placement& placeme
   }
 }
 
+// A mimic joint welded by MimicJoints::Lock: its child link becomes a frame of the parent's body.
+void addLockedMimic(const Reporter& report, ModelBuilder& builder, Placement& placement, const urdf::Joint& uj,
+                    const urdf::Link& child, bool on_base, const UrdfOptions& options) {
+  const double q = mimicLockPosition(report, uj, options);
+  const Transform X = lockedPlacement(report, uj, q);
+  const RigidInertia inertia = linkInertia(report, child, on_base);
+  report.builder([&] { builder.addFixedFrame(child.name, uj.parent_link_name, X, inertia); });
+  placement.locked_mimic.push_back(uj.name);
+  placement.warnings.push_back(mimicLockedNote(uj, q, options));
+}
+
 // The chain links in order; after each, the links welded to it.
 void addChain(const Reporter& report, ModelBuilder& builder, Placement& placement, const std::vector<LinkPtr>& chain,
-              const std::map<std::string, double>& rotor) {
+              const std::map<std::string, double>& rotor, const UrdfOptions& options) {
   for (const LinkPtr& link : chain) placement.placed.insert(link->name);
   bool on_base = true;  // until the first moving joint
   placement.tip_body = {chain.front()};
@@ -582,12 +694,14 @@ void addChain(const Reporter& report, ModelBuilder& builder, Placement& placemen
   for (std::size_t k = 1; k < chain.size(); ++k) {
     const LinkPtr& link = chain[k];
     const urdf::Joint& uj = *link->parent_joint;
-    if (isMoving(uj)) {
+    if (isDegreeOfFreedom(uj, options)) {
       on_base = false;
       placement.tip_body.clear();
       const Joint joint = makeJoint(report, uj, rotor, placement.warnings);
       const RigidInertia inertia = linkInertia(report, *link, on_base);
       report.builder([&] { builder.addJoint(joint, link->name, inertia, uj.parent_link_name); });
+    } else if (isLockedMimic(uj, options)) {
+      addLockedMimic(report, builder, placement, uj, *link, on_base, options);
     } else {
       const RigidInertia inertia = linkInertia(report, *link, on_base);
       report.builder([&] { builder.addFixedFrame(link->name, uj.parent_link_name, placementOf(uj), inertia); });
@@ -597,37 +711,60 @@ void addChain(const Reporter& report, ModelBuilder& builder, Placement& placemen
   }
 }
 
-// ᶜX_p of a joint locked at position q (revolute and continuous turn about the
-// axis, prismatic slides along it; other types stay at their origin).
-Transform lockedPlacement(const Reporter& report, const urdf::Joint& uj, double q) {
-  if (q == 0.0 ||
-      (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS && uj.type != urdf::Joint::PRISMATIC))
-    return placementOf(uj);
-  std::vector<ModelWarning> ignored;
-  const Joint joint = makeJoint(report, uj, {}, ignored);
-  return joint.transform(q);
-}
-
-// A <mimic> joint on the chain follows its leader (q = a·q_leader + b): a
-// serial chain of independent joints cannot keep that coupling, and treating
-// the joint as independent would be a silent wrong answer. Refused, with the
-// way around it.
-void refuseMimicOnChain(const Reporter& report, const std::vector<LinkPtr>& chain, const std::string& tip_option) {
-  for (std::size_t k = 1; k < chain.size(); ++k) {
-    const urdf::Joint& uj = *chain[k]->parent_joint;
-    if (!isMoving(uj) || !uj.mimic) continue;
-    report.fail("joint '" + uj.name + "' on the chain mimics joint '" + uj.mimic->joint_name +
-                "' (q = " + fmt(uj.mimic->multiplier) + "·q_" + uj.mimic->joint_name + " + " + fmt(uj.mimic->offset) +
-                "): a chain of independent joints cannot keep that coupling; choose a " + tip_option +
-                " before it (e.g. '" + chain[k - 1]->name + "')");
+// The whole tree below `root`: depth first over the links, each link's
+// children in the byte-wise order of their joints' names (urdfdom's own
+// order, made explicit here), so that every moving joint's parent body is the
+// last body added or one of its ancestors (ModelBuilder::addJoint). Before it,
+// the links welded above the root. Explicit stack: no recursion, whatever the depth.
+void addTree(const Reporter& report, ModelBuilder& builder, Placement& placement, const LinkPtr& root,
+             const std::map<std::string, double>& rotor, const UrdfOptions& options, std::vector<std::string>& moving) {
+  placement.placed.insert(root->name);
+  addWelded(report, builder, placement, root, true, false);
+  struct Pending {
+    urdf::JointConstSharedPtr joint;
+    LinkPtr child;
+    bool parent_on_base;
+  };
+  std::vector<Pending> stack;
+  const auto pushChildren = [&stack](const urdf::Link& link, bool on_base) {
+    std::vector<std::size_t> order(link.child_joints.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&link](std::size_t a, std::size_t b) {
+      return link.child_joints[a]->name < link.child_joints[b]->name;
+    });
+    for (auto k = order.rbegin(); k != order.rend(); ++k)
+      stack.push_back({link.child_joints[*k], link.child_links[*k], on_base});
+  };
+  pushChildren(*root, true);
+  while (!stack.empty()) {
+    const Pending next = stack.back();
+    stack.pop_back();
+    const urdf::Joint& uj = *next.joint;
+    const urdf::Link& child = *next.child;
+    bool on_base = next.parent_on_base;
+    if (isMoving(uj) && uj.mimic && options.mimic == MimicJoints::Refuse) refuseMimic(report, uj, options, "");
+    if (isDegreeOfFreedom(uj, options)) {
+      on_base = false;
+      const Joint joint = makeJoint(report, uj, rotor, placement.warnings);
+      const RigidInertia inertia = linkInertia(report, child, on_base);
+      report.builder([&] { builder.addJoint(joint, child.name, inertia, uj.parent_link_name); });
+      moving.push_back(uj.name);
+    } else if (isLockedMimic(uj, options)) {
+      addLockedMimic(report, builder, placement, uj, child, on_base, options);
+    } else {
+      const RigidInertia inertia = linkInertia(report, child, on_base);
+      report.builder([&] { builder.addFixedFrame(child.name, uj.parent_link_name, placementOf(uj), inertia); });
+    }
+    placement.placed.insert(child.name);
+    pushChildren(child, on_base);
   }
 }
 
 // Whether a link moves with the chain: a moving joint lies between it and the
 // chain's root (a branch off the fixed base never affects the dynamics).
-bool movesWithChain(const LinkPtr& link, const std::string& root) {
+bool movesWithChain(const LinkPtr& link, const std::string& root, const UrdfOptions& options) {
   for (LinkPtr l = link; l && l->name != root; l = l->getParent())
-    if (l->parent_joint && isMoving(*l->parent_joint)) return true;
+    if (l->parent_joint && isDegreeOfFreedom(*l->parent_joint, options)) return true;
   return false;
 }
 
@@ -635,7 +772,8 @@ bool movesWithChain(const LinkPtr& link, const std::string& root) {
 // side branch off a moving body, e.g. the other finger of a gripper) are not
 // in the model, though they would ride on it: say how much mass that is, as
 // for the mass beyond the tip.
-void warnMassOffChain(Placement& placement, const urdf::ModelInterface& model, const std::string& root) {
+void warnMassOffChain(Placement& placement, const urdf::ModelInterface& model, const std::string& root,
+                      const UrdfOptions& options) {
   std::set<std::string> tip_body;
   for (const LinkPtr& link : placement.tip_body) tip_body.insert(link->name);
   std::vector<std::string> joints, links;
@@ -644,7 +782,7 @@ void warnMassOffChain(Placement& placement, const urdf::ModelInterface& model, c
   for (const std::string& name : placement.placed) {
     if (tip_body.count(name)) continue;  // below the tip body: handleBeyondTip's business
     const LinkPtr link = model.getLink(name);
-    if (!movesWithChain(link, root)) continue;
+    if (!movesWithChain(link, root, options)) continue;
     for (std::size_t k = 0; k < link->child_joints.size(); ++k)
       if (isMoving(*link->child_joints[k]) && !placement.placed.count(link->child_links[k]->name)) {
         joints.push_back(link->child_joints[k]->name);
@@ -689,6 +827,26 @@ BeyondTip findBeyondTip(const Placement& placement) {
   return beyond;
 }
 
+// Every locked_positions entry names a joint that was locked (`beyond`: the
+// moving joints beyond the tip, empty for a tree; and the locked mimic joints).
+void checkLockedPositions(const Reporter& report, const UrdfOptions& options, const std::vector<std::string>& beyond,
+                          const std::vector<std::string>& mimic, bool chain) {
+  for (const auto& [name, q] : options.locked_positions) {
+    const bool known = std::find(beyond.begin(), beyond.end(), name) != beyond.end() ||
+                       std::find(mimic.begin(), mimic.end(), name) != mimic.end();
+    if (known && std::isfinite(q)) continue;
+    const auto list = [](const std::vector<std::string>& names) {
+      return names.empty() ? std::string("none") : nameList(names);
+    };
+    const std::string head = "locked position for joint '" + name + "' (" + fmt(q) + "): not a finite position of ";
+    if (chain && mimic.empty())
+      report.fail(head + "a moving joint beyond the tip (those joints: " + list(beyond) + ")");
+    if (!chain) report.fail(head + "a locked mimic joint (those joints: " + list(mimic) + ")");
+    report.fail(head + "a locked joint (moving joints beyond the tip: " + list(beyond) +
+                "; locked mimic joints: " + list(mimic) + ")");
+  }
+}
+
 // Report the mass beyond the tip, or weld it to the tip body as a payload.
 void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& placement, const std::string& tip,
                      const UrdfOptions& options) {
@@ -698,11 +856,7 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
     links.push_back(link->name);
     if (isMoving(*joint)) joints.push_back(joint->name);
   }
-  for (const auto& entry : options.locked_positions)
-    if (std::find(joints.begin(), joints.end(), entry.first) == joints.end() || !std::isfinite(entry.second))
-      report.fail("locked position for joint '" + entry.first + "' (" + fmt(entry.second) +
-                  "): not a finite position of a moving joint beyond the tip (those joints: " +
-                  (joints.empty() ? std::string("none") : nameList(joints)) + ")");
+  checkLockedPositions(report, options, joints, placement.locked_mimic, true);
   if (beyond.links.empty() || (beyond.mass <= 0.0 && !options.attach_beyond_tip)) return;
   const std::string what = std::to_string(links.size()) + " link" + (links.size() == 1 ? "" : "s") + " (" +
                            nameList(links) + ", " + fmt(beyond.mass) + " kg in all) behind moving joint" +
@@ -717,8 +871,10 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
   }
   for (const auto& [joint, link] : beyond.links) {
     const auto locked = options.locked_positions.find(joint->name);
-    const Transform X =
-        lockedPlacement(report, *joint, locked == options.locked_positions.end() ? 0.0 : locked->second);
+    const double q = locked != options.locked_positions.end() ? locked->second
+                     : isMoving(*joint) && joint->mimic       ? mimicLockPosition(report, *joint, options)
+                                                              : 0.0;
+    const Transform X = lockedPlacement(report, *joint, q);
     const RigidInertia inertia = linkInertia(report, *link, false);
     const std::string& name = link->name;  // clang 14: a lambda cannot capture structured bindings
     const std::string& parent = joint->parent_link_name;
@@ -729,19 +885,56 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
        what + (links.size() == 1 ? " is" : " are") + " welded to the tip body as a payload, those joints locked"});
 }
 
-// Strict mode: every warning about the data is an error. PayloadAttached only
-// reports what attach_beyond_tip was asked to do, so it does not count.
+// Strict mode: every warning about the data is an error. PayloadAttached and
+// MimicLocked only report what the options asked for, so they do not count.
 void refuseWarnings(const Reporter& report, const Model& model) {
   std::string all;
   std::size_t count = 0;
   for (const ModelWarning& w : model.warnings()) {
-    if (w.code == WarningCode::PayloadAttached) continue;
+    if (w.code == WarningCode::PayloadAttached || w.code == WarningCode::MimicLocked) continue;
     all += (all.empty() ? "" : "; ") + w.message.substr(report.source().size() + 2);  // without the "<source>: " prefix
     ++count;
   }
   if (count > 0)
     report.fail("refused in strict mode (" + std::to_string(count) + " warning" + (count == 1 ? "" : "s") +
                 "): " + all);
+}
+
+// The chain from `root` to the tip (options.tip, or the unique leaf of a tree
+// that does not branch into moving joints).
+void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, const LinkPtr& root,
+               const std::map<std::string, double>& rotor, const UrdfOptions& options, ModelBuilder& builder,
+               Placement& placement) {
+  const std::vector<LinkPtr> chain = chainLinks(report, urdf_model, root, options.tip);
+  const std::string tip_name = chain.back()->name;
+  std::vector<std::string> moving;  // moving joints of the chain
+  std::size_t locked = 0;
+  for (std::size_t k = 1; k < chain.size(); ++k) {
+    const urdf::Joint& uj = *chain[k]->parent_joint;
+    if (isMoving(uj) && uj.mimic && options.mimic == MimicJoints::Refuse)
+      refuseMimic(report, uj, options, chain[k - 1]->name);
+    if (isDegreeOfFreedom(uj, options)) moving.push_back(uj.name);
+    if (isLockedMimic(uj, options)) ++locked;
+  }
+  if (moving.empty())
+    report.fail("the chain from root link '" + root->name + "' to tip link '" + tip_name + "' has no moving joint" +
+                (locked ? " (its mimic joints are locked)" : ""));
+  checkRotorNames(report, urdf_model, options, moving, "the chain from '" + root->name + "' to '" + tip_name + "'");
+  addChain(report, builder, placement, chain, rotor, options);
+  handleBeyondTip(report, builder, placement, tip_name, options);
+  warnMassOffChain(placement, urdf_model, root->name, options);
+}
+
+// The whole tree below `root` (no tip, and it branches into moving joints).
+void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, const LinkPtr& root,
+              const std::map<std::string, double>& rotor, const UrdfOptions& options, ModelBuilder& builder,
+              Placement& placement) {
+  std::vector<std::string> moving;
+  addTree(report, builder, placement, root, rotor, options, moving);
+  if (moving.empty())
+    report.fail("the tree below root link '" + root->name + "' has no moving joint (its mimic joints are locked)");
+  checkRotorNames(report, urdf_model, options, moving, "the tree below '" + root->name + "'");
+  checkLockedPositions(report, options, {}, placement.locked_mimic, false);
 }
 
 Model load(const Reporter& report, const std::string& xml, const UrdfOptions& options) {
@@ -760,28 +953,12 @@ Model load(const Reporter& report, const std::string& xml, const UrdfOptions& op
     report.fail("root link '" + options.root + "' not found (links: " + nameList(allLinkNames(*urdf_model)) + ")");
   if (!options.tip.empty() && !urdf_model->getLink(options.tip))
     report.fail("tip link '" + options.tip + "' not found (links: " + nameList(allLinkNames(*urdf_model)) + ")");
-  const std::vector<LinkPtr> chain = chainLinks(report, *urdf_model, root, options.tip, options.names.tip);
-  const std::string tip_name = chain.back()->name;
 
-  std::vector<std::string> moving;  // moving joints of the chain
-  for (std::size_t k = 1; k < chain.size(); ++k)
-    if (isMoving(*chain[k]->parent_joint)) moving.push_back(chain[k]->parent_joint->name);
-  if (moving.empty())
-    report.fail("the chain from root link '" + root->name + "' to tip link '" + tip_name + "' has no moving joint");
-  for (const auto& entry : options.rotor_inertia) {
-    if (std::find(moving.begin(), moving.end(), entry.first) != moving.end()) continue;
-    report.fail(
-        options.names.rotor_inertia + " names joint '" + entry.first +
-        "', which is not a moving joint of the chain from '" + root->name + "' to '" + tip_name +
-        "' (chain joints: " + nameList(moving) + ")" +
-        (urdf_model->getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
-  }
-
-  refuseMimicOnChain(report, chain, options.names.tip);
   ModelBuilder builder(urdf_model->getName(), root->name);
-  addChain(report, builder, placement, chain, rotor);
-  handleBeyondTip(report, builder, placement, tip_name, options);
-  warnMassOffChain(placement, *urdf_model, root->name);
+  if (options.tip.empty() && branchesIntoMovingJoints(root))
+    loadTree(report, *urdf_model, root, rotor, options, builder, placement);
+  else
+    loadChain(report, *urdf_model, root, rotor, options, builder, placement);
   for (const ModelWarning& w : placement.warnings) builder.addWarning(w.code, w.message);
   builder.prefixWarnings(report.source() + ": ");
   Model model;

@@ -231,43 +231,14 @@ std::unique_ptr<Problem> pandaProblem() {
   return p;
 }
 
-// The dual-arm robot, models/dual_panda.urdf, as one tree: the URDF loader's
-// whole tree when it loads trees; until then composed from two chains of the
-// same file, base → left_tool0 (torso and left arm) and base → right_tool0,
-// the right arm's joints, bodies and frames re-added under the torso with the
-// ModelBuilder. (The composed model keeps the left chain's warning that the
-// right arm's mass is off the chain; it is not: the dynamics have all of it.)
-Model loadDualPanda(const std::string& path, std::string* how) {
-  try {
-    Model whole = loadUrdfFile(path);
-    *how = "loadUrdfFile, the whole tree";
-    return whole;
-  } catch (const ModelError&) {  // the loader loads chains only: compose the tree
-  }
-  UrdfOptions options;
-  options.root = "base";
-  options.tip = "left_tool0";
-  const Model left = loadUrdfFile(path, options);
-  options.tip = "right_tool0";
-  const Model right = loadUrdfFile(path, options);
-  ModelBuilder builder(left);
-  const auto linkOf = [&right](int body) { return right.frame(right.bodyFrame(body)).name; };
-  for (int b = 2; b < right.bodyCount(); ++b)  // body 1, the torso, is the left chain's
-    builder.addJoint(right.joint(b - 1), linkOf(b), right.inertia(b), linkOf(right.parent(b)));
-  for (const Frame& f : right.frames())
-    if (f.body >= 2 && f.name != linkOf(f.body)) builder.addFixedFrame(f.name, linkOf(f.body), f.placement);
-  *how = "two chains of the URDF (base to left_tool0, base to right_tool0) joined under torso_link by ModelBuilder";
-  return builder.build();
-}
-
 // The dual arm holding a box 0.5 m in front of the torso: the hands (tool0) at
 // (0.5, ±0.15, 0.35) m, pointing at each other — the grasp that
 // `python3 models/make_dual_panda.py --check` solves for (rounded to 4 digits).
-std::unique_ptr<Problem> dualPandaProblem(std::string* how) {
+std::unique_ptr<Problem> dualPandaProblem() {
   const std::string path = std::string(ZWANG_BENCH_MODELS_DIR) + "/dual_panda.urdf";
   auto p = std::make_unique<Problem>();
   p->label = "dual_panda";
-  p->model = loadDualPanda(path, how);
+  p->model = loadUrdfFile(path);  // the whole tree (no tip)
   p->n = p->model.dof();
   if (p->n != 15 || p->model.isChain()) throw std::runtime_error("dual_panda: not a 15-joint tree");
   p->q.resize(p->n);
@@ -726,13 +697,12 @@ std::string fmt(double x) {
 int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Problem>> problems, trees;
   std::unique_ptr<Problem> dual;
-  std::string dual_how;
   try {
     for (int n : {1, 2, 4, 7, 16, 32, 64, 128}) problems.push_back(randomProblemOfSize(n));
     problems.push_back(pandaProblem());
     for (int n : {7, 16, 32, 64, 128})
       for (int b : {1, 2, 4}) trees.push_back(treeProblemOfSize(n, b));
-    dual = dualPandaProblem(&dual_how);
+    dual = dualPandaProblem();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "zwang_bench: %s\n", e.what());
     return 1;
@@ -751,7 +721,6 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("zwang_cxx_flags", ZWANG_BENCH_FLAGS);
   benchmark::AddCustomContext("zwang_build_type", ZWANG_BENCH_BUILD_TYPE);
   benchmark::AddCustomContext("zwang_chain_seed", std::to_string(kSeed));
-  benchmark::AddCustomContext("zwang_dual_panda_model", dual_how);
   benchmark::AddCustomContext("zwang_dual_panda_hands", dualPandaHands(*dual));
 
   auto reg = [](const std::string& family, const Problem& p, auto&& fn) {

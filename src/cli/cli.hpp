@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -109,9 +110,11 @@ struct ExpectedModel {
 std::optional<ReportCommand> startReportCommand(const std::string& command, int argc, char** argv,
                                                 const std::string& default_out, const ExpectedModel& expected);
 // Unless --no-plots: write `script` to OUT/script_name, run gnuplot on it there
-// and say "wrote OUT/<pngs> (gnuplot, script <script_name>)".
-void writePlots(const ReportCommand& report, const std::string& script_name, const std::string& script,
-                const std::string& pngs);
+// and say "wrote OUT/<pngs> (gnuplot, script <script_name>)". run_gnuplot
+// false: write the script only (gnuplot has already failed once, and said so).
+// False when there are no plots although they were asked for.
+bool writePlots(const ReportCommand& report, const std::string& script_name, const std::string& script,
+                const std::string& pngs, bool run_gnuplot = true);
 // kExitOk, or kExitError after "zwang: <command>: a result disagrees with
 // <reference> (see the check column)" on stderr.
 int reportExitCode(const ReportCommand& report, bool all_ok, const std::string& reference);
@@ -121,5 +124,12 @@ int commandSolve(int argc, char** argv);
 int commandInfo(int argc, char** argv);
 int commandScenarios(int argc, char** argv);
 int commandEnergy(int argc, char** argv);
+// The second part of `zwang energy` (energy_dual.cpp): the dual arm holding a
+// box. Loads models/dual_panda.urdf, solves and checks every posture (CliError
+// when something cannot be solved), writing nothing; the function it returns
+// prints the tables and writes dual_energy.csv and dual_energy.gp into
+// report.out (running gnuplot on it when its argument is true), and returns
+// false when a check failed.
+std::function<bool(bool)> prepareDualArmEnergy(const ReportCommand& report);
 
 }  // namespace zwang::cli

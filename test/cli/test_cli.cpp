@@ -746,6 +746,8 @@ TEST_CASE("energy regenerates the committed CSV within 1e-12", "[energy]") {
   if (cli_test::fileExists("/usr/bin/gnuplot") || cli_test::fileExists("/usr/local/bin/gnuplot")) {
     CHECK(cli_test::fileExists(out + "/panda_energy.png"));
     CHECK(cli_test::fileExists(out + "/panda_energy_joints.png"));
+    CHECK(cli_test::fileExists(out + "/dual_energy.png"));
+    CHECK(cli_test::fileExists(out + "/dual_energy_joints.png"));
   }
 
   // Independently of the tool: G(q) by RNEA, and the effort-minimising friction.
@@ -779,6 +781,104 @@ TEST_CASE("energy regenerates the committed CSV within 1e-12", "[energy]") {
   }
 }
 
+// The dual arm holding a box (docs/evaluation.md, "The dual arm holding a
+// box"): docs/energy/dual_energy.csv is what the tool computes, and what the
+// physics says: q̈ = 0 holds G'(q), the gravity torques with the box's weight
+// (half on each hand); friction takes min(|G'_j|, margin·f_j) off each joint;
+// the hands hold the box (0.3 m apart, facing each other).
+TEST_CASE("energy: the dual arm holding a box regenerates the committed CSV within 1e-12", "[energy]") {
+  const std::string out = cli_test::scratchDir() + "/energy-dual";
+  const Run r = run({"energy", "--out", out, "--no-plots"});
+  INFO("stdout: " << r.out << "\nstderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK_FALSE(contains(r.out, "MISMATCH"));
+  CHECK(contains(r.out, "check: rank 15 in every solve"));
+  std::string header_new, header_old;
+  const auto fresh = readEnergyCsv(out + "/dual_energy.csv", header_new);
+  const auto committed = readEnergyCsv(std::string(ZWANG_ENERGY_DIR) + "/dual_energy.csv", header_old);
+  CHECK(header_new.rfind("pose,variant,q1,", 0) == 0);
+  CHECK(header_new == header_old);
+  REQUIRE(fresh.size() == 15);  // 5 postures × 3 variants
+  REQUIRE(committed.size() == fresh.size());
+  constexpr std::size_t kValues = 15 * 3 + 3 + 6;  // q, tau, mu; norm, sq, abs_sum; the loop's wrench
+  double worst = 0.0;
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    CHECK(fresh[i].pose == committed[i].pose);
+    CHECK(fresh[i].variant == committed[i].variant);
+    REQUIRE(fresh[i].values.size() == kValues);
+    REQUIRE(committed[i].values.size() == kValues);
+    for (std::size_t k = 0; k < kValues; ++k)
+      worst = std::max(worst, std::abs(fresh[i].values[k] - committed[i].values[k]) /
+                                  std::max(1.0, std::abs(committed[i].values[k])));
+  }
+  CHECK(worst <= 1e-12);
+
+  // Independently of the tool: the grasp, G'(q) by RNEA with the box's weight
+  // on the hands, and the effort-minimising friction.
+  const zwang::Model model = zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/dual_panda.urdf");
+  REQUIRE(model.dof() == 15);
+  zwang::Task box(model);
+  const zwang::Vec6 half_weight = (zwang::Vec6() << 0.0, 0.0, -0.5 * 3.0 * 9.81, 0.0, 0.0, 0.0).finished();
+  box.wrench(box.addWrench("left_tool0", zwang::Expressed::World)) = half_weight;
+  box.wrench(box.addWrench("right_tool0", zwang::Expressed::World)) = half_weight;
+  zwang::Workspace ws(model, 0);
+  for (std::size_t i = 0; i < fresh.size(); i += 3) {
+    INFO(fresh[i].pose);
+    const std::vector<double>& v = fresh[i].values;
+    const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(v.data(), 15), zero = Eigen::VectorXd::Zero(15);
+    for (int j = 0; j < 15; ++j) {
+      CHECK(q[j] > model.joint(j).lower + 0.2);
+      CHECK(q[j] < model.joint(j).upper - 0.2);
+    }
+    Eigen::Isometry3d left, right;
+    REQUIRE(zwang::forwardKinematics(model, ws, q));
+    REQUIRE(zwang::framePose(model, ws, model.frameIndex("left_tool0"), left));
+    REQUIRE(zwang::framePose(model, ws, model.frameIndex("right_tool0"), right));
+    CHECK((left.translation() - right.translation()).norm() == Approx(0.3).margin(1e-9));
+    // facing each other along the line between them, x axes down
+    const Eigen::Vector3d across = (right.translation() - left.translation()).normalized();
+    CHECK((left.linear().col(2) - across).norm() < 1e-9);
+    CHECK((right.linear().col(2) + across).norm() < 1e-9);
+    CHECK((left.linear().col(0) - Eigen::Vector3d(0, 0, -1)).norm() < 1e-9);
+    CHECK((right.linear().col(0) - Eigen::Vector3d(0, 0, -1)).norm() < 1e-9);
+    REQUIRE(zwang::inverseDynamics(model, box, q, zero, zero, ws));
+    const Eigen::VectorXd gravity = ws.tau;
+    const double margins[3] = {0.0, 0.5, 1.0};
+    for (int variant = 0; variant < 3; ++variant) {
+      const std::vector<double>& w = fresh[i + variant].values;
+      double sq = 0.0;
+      for (int j = 0; j < 15; ++j) {
+        const double f = margins[variant] * model.joint(j).breakaway_friction;
+        const double expected = std::copysign(std::max(0.0, std::abs(gravity[j]) - f), gravity[j]);
+        CHECK(w[15 + j] == Approx(expected).margin(1e-9));
+        CHECK(w[15 + j] - w[30 + j] == Approx(gravity[j]).margin(1e-9));
+        CHECK(std::abs(w[30 + j]) <= f + 1e-12);
+        sq += w[15 + j] * w[15 + j];
+      }
+      CHECK(w[46] == Approx(sq).epsilon(1e-12));
+      CHECK(w[45] == Approx(std::sqrt(sq)).epsilon(1e-12));
+    }
+    CHECK(fresh[i + 2].values[46] < fresh[i + 1].values[46]);
+    CHECK(fresh[i + 1].values[46] < fresh[i].values[46]);
+  }
+}
+
+TEST_CASE("energy: a models directory without dual_panda.urdf writes nothing", "[energy]") {
+  const std::string models = cli_test::scratchDir() + "/panda-only-models";
+  const std::string out = cli_test::scratchDir() + "/en-panda-only";
+  std::filesystem::create_directories(models);
+  std::filesystem::copy_file(std::string(ZWANG_MODELS_DIR) + "/panda.urdf", models + "/panda.urdf",
+                             std::filesystem::copy_options::overwrite_existing);
+  const Run r = run({"energy", "--models", models, "--out", out, "--no-plots"});
+  checkOneLineError(r, 1);
+  CHECK(contains(r.err, "zwang: energy: "));
+  CHECK(contains(r.err, "dual_panda.urdf"));
+  CHECK(contains(r.err, "(use --models DIR)"));
+  CHECK_FALSE(cli_test::fileExists(out + "/panda_energy.csv"));
+  CHECK_FALSE(cli_test::fileExists(out + "/dual_energy.csv"));
+}
+
 TEST_CASE("energy without gnuplot keeps the CSV and says so", "[energy]") {
   const std::string out = cli_test::scratchDir() + "/energy-nognuplot";
   const std::string empty_bin = cli_test::scratchDir() + "/empty-bin-energy";
@@ -790,6 +890,9 @@ TEST_CASE("energy without gnuplot keeps the CSV and says so", "[energy]") {
   CHECK(cli_test::fileExists(out + "/panda_energy.csv"));
   CHECK(cli_test::fileExists(out + "/energy.gp"));
   CHECK_FALSE(cli_test::fileExists(out + "/panda_energy.png"));
+  CHECK(cli_test::fileExists(out + "/dual_energy.csv"));
+  CHECK(cli_test::fileExists(out + "/dual_energy.gp"));
+  CHECK_FALSE(cli_test::fileExists(out + "/dual_energy.png"));
   const Run quiet = run({"energy", "--out", out + "-csv", "--no-plots"}, {{"PATH", empty_bin}});
   CHECK(quiet.exit_code == 0);
   CHECK(quiet.err.empty());

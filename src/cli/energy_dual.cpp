@@ -1,0 +1,532 @@
+// The second scenario of `zwang energy` (docs/evaluation.md, "The dual arm
+// holding a box"): models/dual_panda.urdf (a torso turning about z, two Panda
+// arms; 15 joints) holding a rigid box between its hands, standing still.
+//
+// The box: 3 kg, 0.3 m wide (y, between the hands) × 0.2 m deep × 0.2 m high,
+// uniform, so its centre of mass is midway between the two tool0 origins,
+// which grip the centres of its side faces. Its weight is carried by the
+// hands; the split between them is statically indeterminate (any internal
+// force can be added), and we take the symmetric one: (0, 0, −m g/2), world
+// axes, at each tool0 origin. Their moments about the box's centre cancel
+// (±0.15 m lever arms, equal forces), so it is the box's wrench exactly, and
+// the least-norm split of it: the box itself feels no squeeze.
+//
+// The task holds everything still, 15 independent rows on 15 joints:
+//   6 rows  left_tool0 relative to right_tool0 (reference axes): the closed loop;
+//   6 rows  right_tool0 fixed in the world (world axes);
+//   1 row   torso_link angular z (= q̈ of the torso);
+//   2 rows  left_/right_panda_link1 angular z, own axes (= q̈₁ of each arm, the
+//           elbow self-motion, as the Panda scenario locks it).
+// Then q̈ = 0 and, as for the Panda,
+//   plain (solveHybridDynamics): τ_control = G'(q) = RNEA(q, 0, 0) with the
+//     box's wrenches;
+//   friction-aware (solveWithFriction, all joints stuck): the least-effort
+//     maximiser, |τ_control,j| = max(0, |G'_j| − margin·f_j).
+// The postures are solved at startup by damped least squares on each arm
+// (frameJacobian, from the grasp pose of make_dual_panda.py --check): every
+// one is checked (hand error, joint-limit distance) before anything is solved.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "zwang/zwang.hpp"
+
+namespace zwang::cli {
+
+namespace {
+
+constexpr int kDof = 15;
+constexpr double kBoxMass = 3.0;             // [kg]
+constexpr double kGrip = 0.15;               // half the box's width: the hands at ±kGrip [m]
+constexpr double kLimitDistance = 0.2;       // every joint at least this far inside its limits [rad]
+constexpr double kCheckTolerance = 1e-9;     // the checks: torques [N·m], accelerations [rad/s²]
+constexpr double kPostureTolerance = 1e-10;  // hand position [m] and orientation [rad] after the IK
+
+struct Posture {
+  const char* name;
+  const char* what;
+  double torso;   // torso angle [rad]
+  double box[3];  // the box's centre in the torso frame [m]
+};
+
+// The box's centre in the torso frame (x forward, y left, z up) and the torso angle.
+const Posture kPostures[] = {
+    {"grasp", "make_dual_panda.py --check: box 0.5 m in front, 0.35 m up", 0.0, {0.5, 0.0, 0.35}},
+    {"box_high", "box raised to 0.55 m", 0.0, {0.5, 0.0, 0.55}},
+    {"box_low_close", "box lower and closer: 0.4 m in front, 0.2 m up", 0.0, {0.4, 0.0, 0.2}},
+    {"box_left", "box shifted 0.15 m to the left, 0.45 m in front", 0.0, {0.45, 0.15, 0.35}},
+    {"torso_turned", "the grasp with the torso turned 0.6 rad to the left", 0.6, {0.5, 0.0, 0.35}},
+};
+
+// The seed of the IK: make_dual_panda.py --check's grasp (left arm, right arm).
+const double kSeed[2][7] = {{-0.0597, 0.9013, 0.2395, -2.0689, -0.7983, 2.8788, -0.6992},
+                            {-0.1724, 0.8639, -0.0690, -2.1175, 0.3159, 2.9720, 1.0418}};
+
+struct Variant {
+  const char* name;
+  double margin;  // < 0: the plain solver
+};
+const Variant kVariants[] = {{"plain", -1.0}, {"friction_margin_0.5", 0.5}, {"friction_margin_1", 1.0}};
+constexpr int kVariantCount = 3;
+
+struct Effort {
+  Eigen::VectorXd tau, mu;
+  Vec6 loop = Vec6::Zero();  // ν of the relative rows: the wrench on the left hand, right_tool0's axes
+  double norm = 0, sq = 0, abs_sum = 0;
+};
+
+struct PostureResult {
+  Eigen::VectorXd q, gravity;  // G'(q): RNEA with the box's wrenches
+  Eigen::Vector3d left, right;
+  double ik_error = 0, limit_distance = 0;
+  Effort variant[kVariantCount];
+  int rank = 0;
+  double worst_qdd = 0, worst_closed_form = 0, worst_closure = 0, worst_torso_internal = 0;
+  bool ok = false;
+};
+
+std::string fmt(double x, const char* format = "%.4g") {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, format, std::abs(x) < 1e-12 ? 0.0 : x);
+  return buffer;
+}
+
+// A check's residual, as it is (fmt shows |x| < 1e-12 as 0).
+std::string small(double x) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.1e", x);
+  return buffer;
+}
+
+Eigen::Matrix3d rotZ(double angle) { return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+// The world pose a hand must have: at the box's side, z axis towards the box
+// (−y for the left hand, +y for the right, torso axes), x axis down.
+Eigen::Isometry3d handTarget(const Posture& posture, double side) {
+  const Eigen::Matrix3d torso = rotZ(posture.torso);
+  Eigen::Matrix3d R;
+  const Eigen::Vector3d z = torso * Eigen::Vector3d(0.0, -side, 0.0), x(0.0, 0.0, -1.0);
+  R.col(0) = x;
+  R.col(1) = z.cross(x);
+  R.col(2) = z;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = R;
+  pose.translation() = torso * Eigen::Vector3d(posture.box[0], posture.box[1] + side * kGrip, posture.box[2]);
+  return pose;
+}
+
+// Damped least squares on one arm's seven joints (columns first..first+6),
+// the rest of q fixed; deterministic (fixed seed, fixed iteration rule).
+double reachHand(const Model& model, Workspace& ws, Eigen::VectorXd& q, int frame, int first,
+                 const Eigen::Isometry3d& target, const std::string& where) {
+  Eigen::MatrixXd J(6, model.dof());
+  Eigen::Isometry3d pose;
+  Vec6 e;
+  for (int iteration = 0; iteration < 500; ++iteration) {
+    Status s = frameJacobian(model, ws, q, frame, Expressed::World, J);
+    if (s) s = framePose(model, ws, frame, pose);
+    if (!s) throw CliError(kExitError, where + s.message);
+    const Eigen::AngleAxisd rotation(target.linear() * pose.linear().transpose());
+    e << target.translation() - pose.translation(), rotation.angle() * rotation.axis();
+    if (e.norm() < 1e-13) break;
+    const Eigen::Matrix<double, 6, 7> Ja = J.middleCols(first, 7);
+    const double damping = e.norm() > 1e-3 ? 1e-2 : 1e-6;
+    const Eigen::Matrix<double, 6, 6> JJt =
+        Ja * Ja.transpose() + damping * damping * Eigen::Matrix<double, 6, 6>::Identity();
+    q.segment(first, 7) += Ja.transpose() * JJt.ldlt().solve(e);
+  }
+  return e.norm();
+}
+
+Eigen::VectorXd solvePosture(const Model& model, const Posture& posture, PostureResult& r) {
+  Workspace ws(model);
+  Eigen::VectorXd q(kDof);
+  q[0] = posture.torso;
+  for (int k = 0; k < 7; ++k) q[1 + k] = kSeed[0][k], q[8 + k] = kSeed[1][k];
+  const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
+  r.ik_error = std::max(reachHand(model, ws, q, model.frameIndex("left_tool0"), 1, handTarget(posture, 1.0), where),
+                        reachHand(model, ws, q, model.frameIndex("right_tool0"), 8, handTarget(posture, -1.0), where));
+  r.limit_distance = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < kDof; ++j)
+    r.limit_distance = std::min({r.limit_distance, q[j] - model.joint(j).lower, model.joint(j).upper - q[j]});
+  if (!(r.ik_error < kPostureTolerance) || !(r.limit_distance > kLimitDistance))
+    throw CliError(kExitError, where + "the hands do not reach the box within the joint limits (error " +
+                                   fmt(r.ik_error) + ", closest limit " + fmt(r.limit_distance) + " rad)");
+  return q;
+}
+
+// τ_c = Σ Jᵀ A ν from the frames' Jacobians, independently of the solver's sweeps.
+Eigen::VectorXd constraintTorques(const Model& model, Workspace& ws, const Eigen::VectorXd& q,
+                                  const Eigen::VectorXd& nu) {
+  const int left = model.frameIndex("left_tool0"), right = model.frameIndex("right_tool0");
+  Eigen::MatrixXd JL(6, kDof), JR(6, kDof), J(6, kDof);
+  Eigen::Isometry3d pl, pr;
+  Status s = frameJacobian(model, ws, q, left, Expressed::World, JL);
+  if (s) s = frameJacobian(model, ws, q, right, Expressed::World, JR);
+  if (s) s = framePose(model, ws, left, pl);
+  if (s) s = framePose(model, ws, right, pr);
+  if (!s) throw CliError(kExitError, std::string("energy: dual arm: ") + s.message);
+  // The relative rows: [f; n] in right_tool0's axes, +on the left hand, −on the
+  // right arm at the same point (the left hand's origin, carried by the right body).
+  Vec6 w;
+  w << pr.linear() * nu.segment<3>(0), pr.linear() * nu.segment<3>(3);
+  const Eigen::Vector3d d = pl.translation() - pr.translation();
+  Eigen::Matrix3d dx;
+  dx << 0, -d.z(), d.y(), d.z(), 0, -d.x(), -d.y(), d.x(), 0;
+  Eigen::MatrixXd JRa = JR;
+  JRa.topRows(3) -= dx * JR.bottomRows(3);
+  Eigen::VectorXd tau = (JL - JRa).transpose() * w;
+  tau += JR.transpose() * nu.segment<6>(6);  // right_tool0, world axes
+  const char* locks[] = {"torso_link", "left_panda_link1", "right_panda_link1"};
+  for (int k = 0; k < 3; ++k) {
+    if (const Status t = frameJacobian(model, ws, q, model.frameIndex(locks[k]), Expressed::Local, J); !t)
+      throw CliError(kExitError, std::string("energy: dual arm: ") + t.message);
+    tau += J.row(5).transpose() * nu[12 + k];
+  }
+  return tau;
+}
+
+PostureResult run(const Model& model, const Posture& posture) {
+  PostureResult r;
+  r.q = solvePosture(model, posture, r);
+  const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
+
+  Task task(model);  // gravity (0, 0, −9.81)
+  const int loop_row =
+      task.addRelativeConstraint("left_tool0", "right_tool0", ConstraintMatrix::Identity(6, 6), Expressed::Reference);
+  task.addConstraint("right_tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  ConstraintMatrix lock = ConstraintMatrix::Zero(6, 1);
+  lock(5, 0) = 1.0;  // angular z, the body's own axes
+  for (const char* body : {"torso_link", "left_panda_link1", "right_panda_link1"})
+    task.addConstraint(body, lock, Expressed::Local);
+  const Vec6 half_weight = (Vec6() << 0.0, 0.0, -0.5 * kBoxMass * 9.81, 0.0, 0.0, 0.0).finished();
+  task.wrench(task.addWrench("left_tool0", Expressed::World)) = half_weight;
+  task.wrench(task.addWrench("right_tool0", Expressed::World)) = half_weight;
+  Workspace ws(model, task);
+  Workspace check_ws(model);
+
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kDof);
+  // G'(q): RNEA with the task's gravity and wrenches (constraints ignored).
+  if (const Status s = inverseDynamics(model, task, r.q, zero, zero, ws); !s)
+    throw CliError(kExitError, where + "RNEA: " + s.message);
+  r.gravity = ws.tau;
+  Eigen::Isometry3d pose;
+  Status s = forwardKinematics(model, ws, r.q);
+  if (s) s = framePose(model, ws, model.frameIndex("left_tool0"), pose);
+  r.left = pose.translation();
+  if (s) s = framePose(model, ws, model.frameIndex("right_tool0"), pose);
+  r.right = pose.translation();
+  if (!s) throw CliError(kExitError, where + s.message);
+
+  for (int v = 0; v < kVariantCount; ++v) {
+    const Variant& variant = kVariants[v];
+    Status status;
+    if (variant.margin < 0) {
+      status = solveHybridDynamics(model, task, r.q, zero, zero, ws);
+    } else {
+      FrictionOptions options;
+      options.margin = variant.margin;
+      status = solveWithFriction(model, task, r.q, zero, zero, ws, options);
+    }
+    if (!status) throw CliError(kExitError, where + variant.name + ": " + status.message);
+    if (ws.solution.balance.rank != kDof || ws.solution.balance.singular)
+      throw CliError(kExitError, where + variant.name + ": the hold-still task has rank " +
+                                     std::to_string(ws.solution.balance.rank) + ", not " + std::to_string(kDof) +
+                                     " (q̈ is not fully determined)");
+    Effort& e = r.variant[v];
+    e.tau = ws.solution.tau_control;
+    e.mu = variant.margin < 0 ? zero : Eigen::VectorXd(ws.friction.mu);
+    e.loop = ws.solution.nu.segment<6>(loop_row);
+    e.sq = e.tau.squaredNorm();
+    e.norm = std::sqrt(e.sq);
+    e.abs_sum = e.tau.cwiseAbs().sum();
+    r.rank = ws.solution.balance.rank;
+    r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
+    // The closed form: τ_control = G' + μ with the effort-minimising μ.
+    for (int j = 0; j < kDof; ++j) {
+      const double f = variant.margin < 0 ? 0.0 : variant.margin * model.joint(j).breakaway_friction;
+      const double expected = std::copysign(std::max(0.0, std::abs(r.gravity[j]) - f), r.gravity[j]);
+      r.worst_closed_form = std::max(r.worst_closed_form, std::abs(e.tau[j] - expected));
+    }
+    // Closure: the joints feel τ_control − μ = G' (RNEA, with the wrenches);
+    // τ_c from ν and the Jacobians is the solver's, and τ_control = 0 + τ_c.
+    const Eigen::VectorXd tau_c = constraintTorques(model, check_ws, r.q, ws.solution.nu);
+    r.worst_closure =
+        std::max({r.worst_closure, (e.tau - e.mu - r.gravity).cwiseAbs().maxCoeff(),
+                  (tau_c - ws.solution.tau_constraint).cwiseAbs().maxCoeff(), (e.tau - tau_c).cwiseAbs().maxCoeff()});
+    // The loop's force is internal: it does nothing to the torso joint, which
+    // both arms hang from.
+    Eigen::VectorXd loop_only = Eigen::VectorXd::Zero(kDof);
+    loop_only.segment<6>(loop_row) = e.loop;
+    r.worst_torso_internal =
+        std::max(r.worst_torso_internal, std::abs(constraintTorques(model, check_ws, r.q, loop_only)[0]));
+  }
+  r.ok = r.rank == kDof && r.worst_qdd < kCheckTolerance && r.worst_closed_form < kCheckTolerance &&
+         r.worst_closure < kCheckTolerance && r.worst_torso_internal < kCheckTolerance;
+  return r;
+}
+
+std::string csvText(const std::vector<PostureResult>& results) {
+  std::ostringstream out;
+  out << "pose,variant";
+  for (const char* column : {"q", "tau", "mu"})
+    for (int j = 1; j <= kDof; ++j) out << "," << column << j;
+  out << ",tau_norm,tau_sq,tau_abs_sum,loop_fx,loop_fy,loop_fz,loop_nx,loop_ny,loop_nz\n";
+  char cell[40];
+  auto number = [&](double x) {
+    std::snprintf(cell, sizeof cell, ",%.17g", x);
+    out << cell;
+  };
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    const PostureResult& r = results[p];
+    for (int v = 0; v < kVariantCount; ++v) {
+      const Effort& e = r.variant[v];
+      out << kPostures[p].name << "," << kVariants[v].name;
+      for (int j = 0; j < kDof; ++j) number(r.q[j]);
+      for (int j = 0; j < kDof; ++j) number(e.tau[j]);
+      for (int j = 0; j < kDof; ++j) number(e.mu[j]);
+      number(e.norm);
+      number(e.sq);
+      number(e.abs_sum);
+      for (int k = 0; k < 6; ++k) number(e.loop[k]);
+      out << "\n";
+    }
+  }
+  return out.str();
+}
+
+// The joints' short names in the charts: t (torso), L1–L7, R1–R7.
+std::string jointLabel(int j) { return j == 0 ? "t" : (j <= 7 ? "L" : "R") + std::to_string(j <= 7 ? j : j - 7); }
+
+// The same two charts as the Panda's (energy.gp), in the same style.
+std::string plotScript(const Model& model, const std::vector<PostureResult>& results) {
+  std::ostringstream s;
+  char cell[40];
+  auto number = [&](double x) {
+    std::snprintf(cell, sizeof cell, " %.17g", std::abs(x) < 1e-12 ? 0.0 : x);
+    return std::string(cell);
+  };
+  s << "# Generated by `zwang energy`; run it in this directory: gnuplot dual_energy.gp\n"
+       "set encoding utf8\n"
+       "set datafile separator whitespace\n"
+       "# columns: posture, |tau_control| plain, margin 0.5, margin 1 [N·m]\n"
+       "$norms << EOD\n";
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    s << kPostures[p].name;
+    for (int v = 0; v < kVariantCount; ++v) s << number(results[p].variant[v].norm);
+    s << "\n";
+  }
+  s << "EOD\n";
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    s << "# columns: joint, |tau_control,j| plain, margin 0.5, margin 1, breakaway f_j [N·m]\n"
+      << "$joints_" << kPostures[p].name << " << EOD\n";
+    for (int j = 0; j < kDof; ++j) {
+      s << jointLabel(j);
+      for (int v = 0; v < kVariantCount; ++v) s << number(std::abs(results[p].variant[v].tau[j]));
+      s << number(model.joint(j).breakaway_friction) << "\n";
+    }
+    s << "EOD\n";
+  }
+  s << "set style data histograms\n"
+       "set style histogram clustered gap 1\n"
+       "set style fill solid 0.85 border -1\n"
+       "set boxwidth 0.9\n"
+       "set grid ytics\n"
+       "set key outside bottom center horizontal box maxrows 1 width -2\n"
+       "set yrange [0:*]\n"
+       "set xrange [-0.6:"
+    << results.size() - 0.4
+    << "]\n"
+       "\n"
+       "set terminal pngcairo size 900,520 font \"DejaVu Sans,11\"\n"
+       "set output \"dual_energy.png\"\n"
+       "set title \"Dual arm holding a 3 kg box still: motor effort ‖τ_{control}‖\"\n"
+       "set ylabel \"‖τ_{control}‖ [N·m]\"\n"
+       "set xtics noenhanced\n"
+       "plot $norms using 2:xtic(1) title \"plain (friction-unaware)\" linecolor rgb \"#a0a0a0\", \\\n"
+       "  '' using 3 title \"friction-aware, margin 0.5\" linecolor rgb \"#70a0e0\", \\\n"
+       "  '' using 4 title \"friction-aware, margin 1\" linecolor rgb \"#0050b0\"\n"
+       "\n"
+       "set terminal pngcairo size 1400,800 font \"DejaVu Sans,10\"\n"
+       "set output \"dual_energy_joints.png\"\n"
+       "set multiplot layout 2,3 title \"Dual arm holding a box: |τ_{control,j}| per joint (bars; t = torso, L/R = left/right "
+       "arm) and breakaway friction f_j (red)\"\n"
+       "set key inside top right vertical maxrows auto width 0 box opaque font \",8\"\n"
+       "set offsets 0, 0, graph 0.05, 0\n"
+       "set xrange [-0.6:"
+    << kDof - 0.4
+    << "]\n"
+       "set xlabel \"joint\"\n"
+       "set ylabel \"|τ| [N·m]\"\n"
+       "set yrange [0:*]\n";
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    const std::string data = std::string("$joints_") + kPostures[p].name;
+    s << "set title \"" << kPostures[p].name << "\" noenhanced\n"
+      << (p == 0 ? "" : "unset key\n") << "plot " << data
+      << " using 2:xtic(1) title \"plain\" linecolor rgb \"#a0a0a0\", \\\n  '' using 3 title \"margin 0.5\" "
+         "linecolor rgb \"#70a0e0\", \\\n  '' using 4 title \"margin 1\" linecolor rgb \"#0050b0\", \\\n  '' using "
+         "($0):5 with points pointtype 5 pointsize 1.1 linecolor rgb \"#c00000\" title \"f_j\"\n";
+  }
+  s << "unset multiplot\nunset output\n";
+  return s.str();
+}
+
+bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urdf, const Model& model,
+                   const std::vector<PostureResult>& results, bool all_ok, bool plot);
+
+}  // namespace
+
+std::function<bool(bool)> prepareDualArmEnergy(const ReportCommand& report) {
+  const std::string file = "dual_panda.urdf";
+  const std::filesystem::path urdf = std::filesystem::path(modelsDirectory(report.args, file)) / file;
+  Model model;
+  try {
+    model = loadUrdfFile(urdf.string());
+  } catch (const ModelError& e) {
+    throw CliError(kExitError, report.name + ": " + e.what() + " (use --models DIR)");
+  }
+  bool as_expected = model.dof() == kDof;
+  for (const char* frame : {"torso_link", "left_panda_link1", "right_panda_link1", "left_tool0", "right_tool0"})
+    as_expected = as_expected && model.hasFrame(frame);
+  if (as_expected)
+    as_expected = model.jointIndex("torso_joint") == 0 && model.jointIndex("left_panda_joint1") == 1 &&
+                  model.jointIndex("right_panda_joint1") == 8;
+  if (!as_expected)
+    throw CliError(kExitError, report.name + ": " + urdf.string() +
+                                   ": expected the 15-joint dual Panda (torso_joint, left_panda_joint1-7, "
+                                   "right_panda_joint1-7) with frames left_tool0 and right_tool0");
+
+  std::vector<PostureResult> results;
+  bool all_ok = true;
+  for (const Posture& posture : kPostures) {
+    results.push_back(run(model, posture));
+    all_ok = all_ok && results.back().ok;
+  }
+  return [&report, urdf, model = std::move(model), results = std::move(results), all_ok](bool plot) {
+    return printAndWrite(report, urdf, model, results, all_ok, plot);
+  };
+}
+
+namespace {
+
+bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urdf, const Model& model,
+                   const std::vector<PostureResult>& results, bool all_ok, bool plot) {
+  std::error_code ec;
+  const std::filesystem::path proximate = std::filesystem::proximate(urdf, ec);
+  const std::string shown = (ec ? urdf : proximate).string();
+  std::printf("\nzwang energy: %s (torso + two Pandas, 15 joints) holding a box still, at rest\n", shown.c_str());
+  std::printf(
+      "box: %g kg, 0.3 m wide (y, between the hands) x 0.2 m deep x 0.2 m high, centre midway between the hands;\n"
+      "its weight split evenly: (0, 0, -%g) N at each tool0 origin, world axes (no moment: the lever arms cancel)\n",
+      kBoxMass, 0.5 * kBoxMass * 9.81);
+  std::printf(
+      "task: left_tool0 relative to right_tool0 (6 rows, right_tool0's axes: the closed loop) + right_tool0 fixed\n"
+      "(6 rows, world axes) + torso_link, left_panda_link1, right_panda_link1 angular z (= qdd of torso, L1, R1)\n"
+      "fixed: 15 independent rows on 15 joints, qdd = 0 exactly\n");
+  std::printf("breakaway friction f [N·m]: torso %s, each arm", fmt(model.joint(0).breakaway_friction).c_str());
+  for (int j = 1; j <= 7; ++j) std::printf(" %s", fmt(model.joint(j).breakaway_friction).c_str());
+  std::printf(
+      "\npostures: the hands at the box's side faces (box centre +-0.15 m along the torso's y), tool0 z towards\n"
+      "the box, x down; solved by damped least squares from make_dual_panda.py --check's grasp\n\n");
+
+  std::printf(
+      "postures: torso angle [rad], box centre in the torso frame [m], hand error [m or rad], closest limit [rad]\n");
+  std::vector<std::vector<std::string>> postures{
+      {"posture", "what", "torso", "box x", "y", "z", "hand error", "closest limit"}};
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    const Posture& posture = kPostures[p];
+    postures.push_back({posture.name, posture.what, fmt(posture.torso), fmt(posture.box[0]), fmt(posture.box[1]),
+                        fmt(posture.box[2]), small(results[p].ik_error), fmt(results[p].limit_distance, "%.3f")});
+  }
+  printColumns(postures, 2);
+
+  std::printf("\nq [rad]: torso, left arm 1-7, right arm 1-7\n");
+  std::vector<std::vector<std::string>> qs{
+      {"posture", "t", "L1", "L2", "L3", "L4", "L5", "L6", "L7", "R1", "R2", "R3", "R4", "R5", "R6", "R7"}};
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    std::vector<std::string> row{kPostures[p].name};
+    for (int j = 0; j < kDof; ++j) row.push_back(fmt(results[p].q[j], "%.4f"));
+    qs.push_back(row);
+  }
+  printColumns(qs);
+
+  std::printf("\ntau_control per joint [N·m]\n");
+  std::vector<std::vector<std::string>> joints{{"posture", "variant"}};
+  for (int j = 0; j < kDof; ++j) joints[0].push_back(jointLabel(j));
+  for (std::size_t p = 0; p < results.size(); ++p)
+    for (int v = 0; v < kVariantCount; ++v) {
+      std::vector<std::string> row{v == 0 ? kPostures[p].name : "", kVariants[v].name};
+      for (int j = 0; j < kDof; ++j) row.push_back(fmt(results[p].variant[v].tau[j], "%.3g"));
+      joints.push_back(row);
+    }
+  printColumns(joints, 2);
+
+  std::printf(
+      "\nthe loop's force: nu of the relative rows, the wrench on the left hand (its opposite on the right arm) in\n"
+      "right_tool0's axes (z points from the right hand to the left: fz > 0 pulls the hands apart, fz < 0 squeezes;\n"
+      "x down); N and N·m; plain solver. It is the task rows' share of the motor torques, internal to the loop (it\n"
+      "puts no torque on the torso); the box's own load is in the wrenches, split evenly, so the box feels no squeeze.\n");
+  std::vector<std::vector<std::string>> loop{{"posture", "fx", "fy", "fz", "nx", "ny", "nz", "torso torque of it"}};
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    std::vector<std::string> row{kPostures[p].name};
+    for (int k = 0; k < 6; ++k) row.push_back(fmt(results[p].variant[0].loop[k]));
+    row.push_back(small(results[p].worst_torso_internal));
+    loop.push_back(row);
+  }
+  printColumns(loop);
+
+  std::printf(
+      "\nactuator effort: |tau| = 2-norm of tau_control [N·m], sum|tau| [N·m], |tau|^2 [N²m²];\n"
+      "m = margin of the friction-aware solve; saved = how much less |tau|^2 with m=1 than plain\n");
+  std::vector<std::vector<std::string>> table{{"posture", "|tau| plain", "|tau| m=0.5", "|tau| m=1", "sum|tau| plain",
+                                               "sum|tau| m=0.5", "sum|tau| m=1", "|tau|^2 plain", "|tau|^2 m=0.5",
+                                               "|tau|^2 m=1", "saved m=1", "check"}};
+  double total[kVariantCount] = {0, 0, 0};
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    const PostureResult& r = results[p];
+    std::vector<std::string> row{kPostures[p].name};
+    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].norm));
+    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].abs_sum));
+    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].sq));
+    for (int v = 0; v < kVariantCount; ++v) total[v] += r.variant[v].sq;
+    row.push_back(fmt(100.0 * (1.0 - r.variant[2].sq / r.variant[0].sq), "%.1f") + " %");
+    row.push_back(r.ok ? "ok" : "MISMATCH");
+    table.push_back(row);
+  }
+  printColumns(table);
+  std::printf("\nall postures: |tau|^2 summed %s (plain), %s (margin 0.5), %s (margin 1): %s %% and %s %% less\n",
+              fmt(total[0]).c_str(), fmt(total[1]).c_str(), fmt(total[2]).c_str(),
+              fmt(100.0 * (1.0 - total[1] / total[0]), "%.1f").c_str(),
+              fmt(100.0 * (1.0 - total[2] / total[0]), "%.1f").c_str());
+  double worst[4] = {0, 0, 0, 0};
+  for (const PostureResult& r : results) {
+    worst[0] = std::max(worst[0], r.worst_qdd);
+    worst[1] = std::max(worst[1], r.worst_closed_form);
+    worst[2] = std::max(worst[2], r.worst_closure);
+    worst[3] = std::max(worst[3], r.worst_torso_internal);
+  }
+  std::printf(
+      "check: rank 15 in every solve; within 1e-9: |qdd| (worst %s), tau_control = the closed form from G' = RNEA\n"
+      "with the box's wrenches (worst %s), closure tau_control - mu = G', tau_c = sum J^T A nu = tau_control\n"
+      "(worst %s), the loop's force puts no torque on the torso (worst %s)\n",
+      small(worst[0]).c_str(), small(worst[1]).c_str(), small(worst[2]).c_str(), small(worst[3]).c_str());
+
+  writeOutput((report.out / "dual_energy.csv").string(), csvText(results));
+  std::printf(
+      "wrote %s/dual_energy.csv (pose, variant, q1-15, tau1-15 = tau_control, mu1-15, tau_norm, tau_sq, tau_abs_sum,\n"
+      "loop_fx..loop_nz)\n",
+      report.out.string().c_str());
+  writePlots(report, "dual_energy.gp", plotScript(model, results), "dual_energy.png, dual_energy_joints.png", plot);
+  return all_ok;
+}
+
+}  // namespace
+
+}  // namespace zwang::cli

@@ -23,6 +23,7 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   FA.assign(bodies, Vec6::Zero());
   IAS.assign(bodies, Vec6::Zero());
   D.assign(bodies, 0.0);
+  inverse_D.assign(bodies, 0.0);
   u.assign(bodies, 0.0);
   const int columns = columnCapacity();
   SA.setZero(columns, static_cast<Eigen::Index>(bodies));

@@ -169,6 +169,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     const double u = tau[i - 1] - S.dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
     ws.u[at(i)] = u;
     const double inverse_D = 1.0 / D;  // one division per body; the rest multiply
+    ws.inverse_D[at(i)] = inverse_D;
     const double u_D = u * inverse_D;
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
 
@@ -297,19 +298,21 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   const int N = model.dof();
   const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(joints.size());
-  const auto firstAtOrAfter = [&joints](int body) {
-    return static_cast<Eigen::Index>(
-        std::lower_bound(joints.begin(), joints.end(), body, [](int j, int b) { return bodyOfJoint(j) < b; }) -
-        joints.begin());
-  };
   dU.setZero();
   dF.setZero();
   du.setZero();
+  Eigen::Index c_begin = k;  // the first column with its joint's body ≥ i: falls with i
   for (int i = N; i >= 1; --i) {
-    const Eigen::Index c_begin = firstAtOrAfter(i), c_end = firstAtOrAfter(model.subtreeEnd(i));
+    while (c_begin > 0 && bodyOfJoint(joints[static_cast<std::size_t>(c_begin - 1)]) >= i) --c_begin;
+    const int end = model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: k)
+    const Eigen::Index c_end = k == 0 || end > bodyOfJoint(joints.back())
+                                   ? k
+                                   : std::lower_bound(joints.begin(), joints.end(), end, [](int j, int b) {
+                                       return bodyOfJoint(j) < b;
+                                     }) - joints.begin();
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
-    const double inverse_D = 1.0 / ws.D[at(i)];
+    const double inverse_D = ws.inverse_D[at(i)];
     const int first = task.firstColumn(i), ki = task.activeColumns(i);
     for (Eigen::Index c = c_begin; c < c_end; ++c) {
       const double du_ic = (bodyOfJoint(joints[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
@@ -332,17 +335,17 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
     balanceApplyColumns(ws.balance_factorisation, dU.topRows(m), dnu.topRows(m), ws.balance_factorisation.work.head(m));
   }
   // Lines 28–29 for the differences: δẌ per body, one column at a time (the
-  // bodies' δẌ hang from their parents'; da holds one column's).
+  // bodies' δẌ hang from their parents'; da holds one column's, δẌ₀ = 0).
+  da.col(0).setZero();
   for (Eigen::Index c = 0; c < k; ++c) {
     for (int i = 1; i <= N; ++i) {
       const int first = task.firstColumn(i), ki = task.activeColumns(i);
       double constraint = 0.0;
       for (int r = first; r < ki; ++r) constraint += ws.SA(r, i) * dnu(r, c);
-      const int p = model.parent(i);
-      const double parent_dot = p > 0 ? ws.IAS[at(i)].dot(da.col(p)) : 0.0;
-      const double dq = (du(i, c) - parent_dot + constraint) / ws.D[at(i)];
+      const auto parent_da = da.col(model.parent(i));
+      const double dq = (du(i, c) - ws.IAS[at(i)].dot(parent_da) + constraint) * ws.inverse_D[at(i)];
       dqdd(i - 1, c) = dq;
-      da.col(i) = (p > 0 ? Vec6(da.col(p)) : Vec6::Zero()) + ws.S[at(i)] * dq;
+      da.col(i) = parent_da + ws.S[at(i)] * dq;
     }
   }
 }
@@ -364,9 +367,27 @@ void taskResidual(const Task& task, Workspace& ws) {
   // the error is within residual_tolerance of the size of what it is computed
   // from: the accelerations it reads, its set point, and the balance's
   // right-hand side (what the constraint force had to correct).
-  // A relative row sums its two columns' terms (the balance's rows).
   const int m = task.constraintRows();
   BalanceReport& report = ws.solution.balance;
+  if (!task.hasRelative()) {  // one column per row
+    double sum2 = 0.0;
+    bool met = true;
+    int col = 0;
+    for (const Task::ConstraintGroup& g : task.groups()) {
+      const Vec6& a = ws.a[at(g.body)];
+      for (int k = 0; k < g.rows; ++k, ++col) {
+        const auto A = ws.A_body.col(col);
+        const double error = A.dot(a) - ws.b_body[col];
+        const double size = A.cwiseAbs().dot(a.cwiseAbs()) + std::abs(ws.b_body[col]) + std::abs(ws.rhs[col]);
+        sum2 += error * error;
+        met = met && std::abs(error) <= task.balance.residual_tolerance * size;
+      }
+    }
+    report.residual = m > 0 ? std::sqrt(sum2) : 0.0;
+    report.consistent = met;
+    return;
+  }
+  // A relative row sums its two columns' terms (the balance's rows).
   auto error = ws.row_error.head(m);
   auto size = ws.row_size.head(m);
   error.setZero();
@@ -398,6 +419,15 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   const int N = model.dof();
   if (task.constraintRows() == 0) {
     tau_c.setZero();
+    return;
+  }
+  if (model.isChain()) {  // one running sum from the tip inward
+    Vec6 carried = Vec6::Zero();
+    for (int i = N; i >= 1; --i) {
+      const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
+      carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+      tau_c[i - 1] = ws.S[at(i)].dot(carried);
+    }
     return;
   }
   std::vector<Vec6>& carried = ws.constraint_wrench;

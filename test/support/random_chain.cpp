@@ -47,14 +47,19 @@ double gaussian(std::mt19937_64& rng) {
 
 Eigen::Vector3d randomUnitVector(std::mt19937_64& rng) {
   for (;;) {
-    const Eigen::Vector3d x(gaussian(rng), gaussian(rng), gaussian(rng));
+    // Named draws: the order of a call's arguments is unspecified in C++, so
+    // draws inside one call would differ between compilers (these are in the
+    // order g++ evaluated the former one-call form: last argument first).
+    const double z = gaussian(rng), y = gaussian(rng), x0 = gaussian(rng);
+    const Eigen::Vector3d x(x0, y, z);
     if (x.norm() > 1e-6) return x.normalized();
   }
 }
 
 Eigen::Matrix3d randomRotation(std::mt19937_64& rng) {
   for (;;) {
-    Eigen::Quaterniond quat(gaussian(rng), gaussian(rng), gaussian(rng), gaussian(rng));
+    const double z = gaussian(rng), y = gaussian(rng), x = gaussian(rng), w = gaussian(rng);  // named: see above
+    Eigen::Quaterniond quat(w, x, y, z);
     if (quat.norm() > 1e-6) return quat.normalized().toRotationMatrix();
   }
 }
@@ -68,8 +73,9 @@ Eigen::VectorXd randomVector(std::mt19937_64& rng, int n, double scale) {
 Eigen::Matrix3d randomInertia(std::mt19937_64& rng, double mass) {
   // s_k = ∫ x_k² dm of a body of size ~3–30 cm; I_x = s_y + s_z, … are then the
   // principal moments of a real mass distribution.
-  const Eigen::Vector3d s(mass * uniform(rng, 5e-4, 5e-2), mass * uniform(rng, 5e-4, 5e-2),
-                          mass * uniform(rng, 5e-4, 5e-2));
+  const double s_z = mass * uniform(rng, 5e-4, 5e-2), s_y = mass * uniform(rng, 5e-4, 5e-2),
+               s_x = mass * uniform(rng, 5e-4, 5e-2);  // named draws: see randomUnitVector
+  const Eigen::Vector3d s(s_x, s_y, s_z);
   const Eigen::Vector3d principal(s.y() + s.z(), s.x() + s.z(), s.x() + s.y());
   const Eigen::Matrix3d R = randomRotation(rng);
   const Eigen::Matrix3d I = R * principal.asDiagonal() * R.transpose();

@@ -1,0 +1,46 @@
+// Writes a ChainSpec (a serial chain or a kinematic tree, issue #14) as MJCF text
+// for MuJoCo, the oracle of test_mujoco.cpp (our own writer; it does not need
+// MuJoCo and no MuJoCo code is in it). The mapping, element by element:
+//  - each link is a <body> named as the link, nested in its parent link's body
+//    (ChainSpec::parentLink: links[k] for joints[k] unless JointSpec::parent
+//    names another), children in joint order; links[0] is a body
+//    welded to the world at the identity, so MuJoCo's world is the root link's
+//    frame, as zwang's (docs/conventions.md, "World");
+//  - the body's pos/quat is the joint origin (xyz, rpy → R = Rz(yaw)Ry(pitch)Rx(roll)
+//    as a unit quaternion "w x y z");
+//  - a moving joint is a <joint> of the body, named as the joint, at the body
+//    origin (pos="0 0 0"): type "hinge" (revolute, continuous) or "slide"
+//    (prismatic), its axis in the body (= joint) frame, armature = the reflected
+//    rotor inertia rotor_inertia·gear_ratio², no damping, stiffness, friction
+//    loss or limits (limited="false"); a fixed joint writes no <joint>: the body
+//    is welded to its parent;
+//  - a link with mass gets <inertial pos=com quat mass diaginertia>: the URDF
+//    inertia I (about the COM, axes R = R(inertial_rpy)) diagonalised here,
+//    I = V Λ Vᵀ, quat = R V, diaginertia = Λ (not fullinertia: MuJoCo 2.2.2's
+//    own diagonalisation is accurate to ~1e-6 only, see mjcf_writer.cpp). A
+//    massless link (mass 0, zero inertia) gets no <inertial>;
+//  - <compiler angle="radian" inertiafromgeom="false" balanceinertia="false"
+//    boundmass="0" boundinertia="0"/>: the inertias are taken as written;
+//    <option gravity=… integrator="Euler"> with contacts, the constraint solver,
+//    limits, friction loss, equality constraints and passive forces disabled.
+// Numbers are printed with %.17g (read back as the same doubles).
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "support/chain_spec.hpp"
+
+namespace zwang::testing {
+
+// The MJCF document for `spec` under `gravity` (world = root link axes, m/s²).
+// Throws std::invalid_argument when ChainSpec::check does (a parent after its
+// child among others) or, naming the link, when a moving joint's child link has
+// no mass (MuJoCo refuses a moving body without mass; the random trees and
+// chains give every link mass). Any tree, depth first or not: MuJoCo numbers
+// the dofs depth first, children in joint order, so a caller maps vectors by
+// joint name.
+std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity);
+
+}  // namespace zwang::testing

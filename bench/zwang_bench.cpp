@@ -2,8 +2,8 @@
 // the report's own way of finding the static friction torques (issue 5).
 //
 // Every benchmark is named  <family>/<model>,  <model> = "N=<dof>" for a random
-// revolute chain or "panda"; counters N (dof), m (constraint rows), k (stuck
-// joints). Families:
+// revolute chain, "panda", "N=<dof>,b=<branching>" for a tree or "dual_panda";
+// counters N (dof), m (constraint rows), k (stuck joints). Families:
 //   ours_hd_m{0,1,6}       zwang::solveHybridDynamics, m end-effector rows (world axes)
 //   ours_hd_m6x2           6 rows on 2 frames: 3 linear on the last link, 3 angular on the middle link
 //   ours_rnea, ours_crba   zwang::inverseDynamics, zwang::jointSpaceInertia
@@ -19,6 +19,18 @@
 //                          projected gradient on g with one full solve per gradient (∇g = q̈_Θ(μ)),
 //                          step 1/L (L estimated once from k unit-torque solves), stopped at the
 //                          tolerance solveWithFriction uses; no ∂q̈/∂μ reuse
+// Trees (issue 14):
+//   tree_hd_m{0,6}/N=<n>,b=<b>
+//                          zwang::solveHybridDynamics on the chain N=<n> with its joints re-hung as a
+//                          complete b-ary tree (b = 2, 4; b = 1 is the chain itself, timed again here so
+//                          that a filtered run compares within one run); m = 6: the 6 rows on the deepest
+//                          leaf (world axes); extra counters b, depth (joints from the base to that
+//                          leaf) and rank (of the balance: below 6 when the leaf has fewer than 6 joints)
+//   ours_hd_{hands12,rel6}/dual_panda, fric_as_{hands12,rel6}_kall/dual_panda
+//                          models/dual_panda.urdf (torso + 2 Panda arms, 15 joints) in a two-handed grasp
+//                          pose: 12 rows (each hand, tool0, held still in world axes) or 6 rows (the left
+//                          hand held to the right one: Task::addRelativeConstraint, the right hand's axes);
+//                          plain (solveHybridDynamics) and with friction, all 15 joints stuck (q̇ = 0)
 // Solvers, workspaces, tasks and KDL arrays are made outside the timed loops.
 // Before anything is timed, main() checks that ours and KDL solve the same
 // problems (q̈ and RNEA torques) and puts the largest differences into the
@@ -65,6 +77,9 @@ struct Problem {
   Eigen::VectorXd q, qd, qdd, tau;  // every joint moving: 0.1 ≤ |q̇_j| ≤ 2
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};
   std::string tip, middle;  // link names: the last one, and one half way
+  std::string tip2;         // dual arm: the other hand (the right one; tip is the left)
+  int branching = 0;        // trees: children per body (1: the chain); 0: not a tree benchmark
+  int depth = 0;            // trees: joints from the base to `tip`
 };
 
 constexpr std::uint64_t kSeed = 0x2a5eedULL;  // fixed: the same chains in every run
@@ -95,6 +110,45 @@ std::unique_ptr<Problem> randomProblemOfSize(int n) {
   p->tau = randomVector(rng, n, 10.0);
   p->tip = p->spec.links.back().name;
   p->middle = p->spec.links[static_cast<std::size_t>(std::max(1, n / 2))].name;
+  return p;
+}
+
+// The chain of randomProblemOfSize(n) (the same links, joints and state) with
+// its joints re-hung so that the bodies form a complete b-ary tree: in heap
+// order body v's parent is ⌊(v − 1)/b⌋ (0: the base, which has b children),
+// the branching-factor trees of Featherstone's benchmarks. The model needs
+// depth-first order, so the heap is renumbered depth first: link i of the
+// spec (and q_i) keeps its data, only its parent changes. `tip` is the last
+// body in heap order, a leaf as deep as any. b = 1 returns the chain itself.
+std::unique_ptr<Problem> treeProblemOfSize(int n, int branching) {
+  auto p = randomProblemOfSize(n);
+  p->label = "N=" + std::to_string(n) + ",b=" + std::to_string(branching);
+  p->branching = branching;
+  if (branching == 1) {
+    p->depth = n;
+    return p;
+  }
+  std::vector<int> order, stack{0};  // heap nodes (0 = the base) in depth-first order
+  while (!stack.empty()) {
+    const int v = stack.back();
+    stack.pop_back();
+    order.push_back(v);
+    for (int c = std::min(branching * v + branching, n); c > branching * v; --c) stack.push_back(c);
+  }
+  std::vector<int> position(static_cast<std::size_t>(n) + 1), depth(static_cast<std::size_t>(n) + 1, 0);
+  for (int i = 0; i <= n; ++i) position[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])] = i;
+  for (int v = 1; v <= n; ++v)
+    depth[static_cast<std::size_t>(v)] = depth[static_cast<std::size_t>((v - 1) / branching)] + 1;
+  for (int i = 1; i <= n; ++i)
+    p->spec.joints[static_cast<std::size_t>(i) - 1].parent =
+        position[static_cast<std::size_t>((order[static_cast<std::size_t>(i)] - 1) / branching)];
+  p->spec.name = "balanced_tree";
+  p->spec.check();
+  p->model = modelFromSpec(p->spec);
+  if (p->model.isChain()) throw std::runtime_error(p->label + ": the tree came out a chain");
+  p->tip = p->spec.links[static_cast<std::size_t>(position[static_cast<std::size_t>(n)])].name;
+  p->middle.clear();  // no split task on trees
+  p->depth = depth[static_cast<std::size_t>(n)];
   return p;
 }
 
@@ -177,10 +231,55 @@ std::unique_ptr<Problem> pandaProblem() {
   return p;
 }
 
+// The dual arm holding a box 0.5 m in front of the torso: the hands (tool0) at
+// (0.5, ±0.15, 0.35) m, pointing at each other — the grasp that
+// `python3 models/make_dual_panda.py --check` solves for (rounded to 4 digits).
+std::unique_ptr<Problem> dualPandaProblem() {
+  const std::string path = std::string(ZWANG_BENCH_MODELS_DIR) + "/dual_panda.urdf";
+  auto p = std::make_unique<Problem>();
+  p->label = "dual_panda";
+  p->model = loadUrdfFile(path);  // the whole tree (no tip)
+  p->n = p->model.dof();
+  if (p->n != 15 || p->model.isChain()) throw std::runtime_error("dual_panda: not a 15-joint tree");
+  p->q.resize(p->n);
+  p->q.setZero();
+  const double left[7] = {-0.0597, 0.9013, 0.2395, -2.0689, -0.7983, 2.8788, -0.6992};
+  const double right[7] = {-0.1724, 0.8639, -0.0690, -2.1175, 0.3159, 2.9720, 1.0418};
+  p->q[p->model.jointIndex("torso_joint")] = 0.0;
+  for (int j = 0; j < 7; ++j) {
+    p->q[p->model.jointIndex("left_panda_joint" + std::to_string(j + 1))] = left[j];
+    p->q[p->model.jointIndex("right_panda_joint" + std::to_string(j + 1))] = right[j];
+  }
+  p->qd.resize(p->n);
+  for (int j = 0; j < p->n; ++j) p->qd[j] = j % 2 ? -0.5 : 0.5;
+  p->qdd = Eigen::VectorXd::Constant(p->n, 0.3);
+  p->tau = Eigen::VectorXd::Zero(p->n);  // motors off: friction and the task carry the arms
+  p->tip = "left_tool0";
+  p->tip2 = "right_tool0";
+  return p;
+}
+
+// Where the dual arm's hands are in the benchmark's pose (world frame), for the context.
+std::string dualPandaHands(const Problem& p) {
+  Workspace ws(p.model, 0);
+  if (!forwardKinematics(p.model, ws, p.q)) return "forward kinematics failed";
+  std::string out;
+  for (const std::string& hand : {p.tip, p.tip2}) {
+    Eigen::Isometry3d pose;
+    if (!framePose(p.model, ws, p.model.frameIndex(hand), pose)) return "framePose failed";
+    char buffer[160];
+    std::snprintf(buffer, sizeof buffer, "%s%s at (%.4f, %.4f, %.4f) m, z axis (%.3f, %.3f, %.3f)",
+                  out.empty() ? "" : "; ", hand.c_str(), pose.translation().x(), pose.translation().y(),
+                  pose.translation().z(), pose.linear()(0, 2), pose.linear()(1, 2), pose.linear()(2, 2));
+    out += buffer;
+  }
+  return out;
+}
+
 // ---------------------------------------------------------------------------
 // Tasks (as DynamicsInput, so the same problem goes to ours and to KDL)
 
-enum class TaskKind { None, Ee1, Ee6, Split6 };
+enum class TaskKind { None, Ee1, Ee6, Split6, Hands12, Relative6 };
 
 DynamicsInput makeInput(const Problem& p, TaskKind kind, const Eigen::VectorXd& qd) {
   DynamicsInput in;
@@ -209,11 +308,24 @@ DynamicsInput makeInput(const Problem& p, TaskKind kind, const Eigen::VectorXd& 
       in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6).leftCols(3)));      // position
       in.constraints.push_back(constraint(p.middle, Matrix6Xd::Identity(6, 6).rightCols(3)));  // orientation
       break;
+    case TaskKind::Hands12:  // both hands held still
+      in.constraints.push_back(constraint(p.tip, Matrix6Xd::Identity(6, 6)));
+      in.constraints.push_back(constraint(p.tip2, Matrix6Xd::Identity(6, 6)));
+      break;
+    case TaskKind::Relative6: {  // the hands held together (a rigid box between them)
+      ConstraintInput c = constraint(p.tip, Matrix6Xd::Identity(6, 6));
+      c.relative_to = p.tip2;
+      c.axes = Axes::Reference;
+      in.constraints.push_back(std::move(c));
+      break;
+    }
   }
   return in;
 }
 
-int rowsOf(TaskKind kind) { return kind == TaskKind::None ? 0 : kind == TaskKind::Ee1 ? 1 : 6; }
+int rowsOf(TaskKind kind) {
+  return kind == TaskKind::None ? 0 : kind == TaskKind::Ee1 ? 1 : kind == TaskKind::Hands12 ? 12 : 6;
+}
 
 // k stuck joints spread evenly along the chain (k = N: all of them).
 std::vector<int> stuckSet(int n, int k) {
@@ -252,6 +364,27 @@ void benchOursHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
     benchmark::ClobberMemory();
   }
   setCounters(state, *p, task.constraintRows(), 0);
+}
+
+// The same on a tree (or its chain, b = 1), with the tree's counters.
+void benchTreeHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
+  const Task task = taskFromInput(p->model, makeInput(*p, kind, p->qd));
+  Workspace ws(p->model, task);
+  if (Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws); !s) {
+    state.SkipWithError(s.message);
+    return;
+  }
+  const int rank = ws.solution.balance.rank;
+  for (auto _ : state) {
+    const Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  setCounters(state, *p, task.constraintRows(), 0);
+  state.counters["b"] = p->branching;
+  state.counters["depth"] = p->depth;
+  state.counters["rank"] = rank;
 }
 
 void benchOursRnea(benchmark::State& state, const Problem* p) {
@@ -562,10 +695,14 @@ std::string fmt(double x) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::unique_ptr<Problem>> problems;
+  std::vector<std::unique_ptr<Problem>> problems, trees;
+  std::unique_ptr<Problem> dual;
   try {
     for (int n : {1, 2, 4, 7, 16, 32, 64, 128}) problems.push_back(randomProblemOfSize(n));
     problems.push_back(pandaProblem());
+    for (int n : {7, 16, 32, 64, 128})
+      for (int b : {1, 2, 4}) trees.push_back(treeProblemOfSize(n, b));
+    dual = dualPandaProblem();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "zwang_bench: %s\n", e.what());
     return 1;
@@ -584,6 +721,7 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("zwang_cxx_flags", ZWANG_BENCH_FLAGS);
   benchmark::AddCustomContext("zwang_build_type", ZWANG_BENCH_BUILD_TYPE);
   benchmark::AddCustomContext("zwang_chain_seed", std::to_string(kSeed));
+  benchmark::AddCustomContext("zwang_dual_panda_hands", dualPandaHands(*dual));
 
   auto reg = [](const std::string& family, const Problem& p, auto&& fn) {
     benchmark::RegisterBenchmark((family + "/" + p.label).c_str(), fn)->Unit(benchmark::kNanosecond);
@@ -637,6 +775,20 @@ int main(int argc, char** argv) {
         reg(std::string("naivepg_") + task_name + "_k" + std::to_string(k), *p,
             [q = p.get(), kind = kind, k](benchmark::State& s) { benchNaiveGradient(s, q, kind, k); });
       }
+
+  // Trees next to their chains; the dual arm.
+  for (const auto& [kind, name] : {std::pair{TaskKind::None, "m0"}, std::pair{TaskKind::Ee6, "m6"}})
+    for (const auto& p : trees)
+      reg(std::string("tree_hd_") + name, *p,
+          [q = p.get(), kind = kind](benchmark::State& s) { benchTreeHybrid(s, q, kind); });
+  const std::pair<TaskKind, const char*> dual_tasks[] = {{TaskKind::Hands12, "hands12"}, {TaskKind::Relative6, "rel6"}};
+  for (const auto& [kind, name] : dual_tasks)
+    reg(std::string("ours_hd_") + name, *dual,
+        [q = dual.get(), kind = kind](benchmark::State& s) { benchOursHybrid(s, q, kind); });
+  for (const auto& [kind, name] : dual_tasks)
+    reg(std::string("fric_as_") + name + "_kall", *dual, [q = dual.get(), kind = kind](benchmark::State& s) {
+      benchFriction(s, q, kind, q->n, FrictionMethod::ActiveSet);
+    });
 
   // Worst case over 10⁶ calls, Panda with every joint stuck (plain and 6 rows).
   for (const auto& p : problems)

@@ -423,6 +423,29 @@ TEST_CASE("mimic joints in a tree: refused naming the joint and its leader, or l
   CHECK(codes(c) == std::vector<WarningCode>{WarningCode::MimicLocked, WarningCode::MassBeyondTip});
 }
 
+TEST_CASE("mimic joints: nothing left to move, or no finite position to lock at", "[urdf][trees][errors]") {
+  // base -m1-> a and base -m2-> b, each mimicking the other: a tree of mimic joints only.
+  const std::string mimics = R"(<robot name="mimics"><link name="base"/>
+  <joint name="m1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="m2" multiplier="1e300"/></joint>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="m2" type="revolute"><parent link="base"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="m1"/></joint>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+</robot>)";
+  REQUIRE_THROWS_WITH(loadUrdfString(mimics, lockMimic()),
+                      Contains("the tree below root link 'base' has no moving joint (its mimic joints are locked)"));
+  UrdfOptions chain = lockMimic();
+  chain.tip = "b";
+  REQUIRE_THROWS_WITH(loadUrdfString(mimics, chain),
+                      Contains("the chain from root link 'base' to tip link 'b' has no moving joint (its mimic joints "
+                               "are locked)"));
+  UrdfOptions huge = lockMimic();
+  huge.locked_positions["m2"] = 1e300;
+  REQUIRE_THROWS_WITH(loadUrdfString(mimics, huge),
+                      Contains("joint 'm1' (q = 1e+300·q_m2 + 0): the position to lock it at is not finite"));
+}
+
 TEST_CASE("Baxter: the whole dual-arm tree with locked mimic fingers; refused without", "[urdf][trees]") {
   const std::string file = kModels + "/baxter.urdf";
   // The file's 19 moving joints, depth first from 'base' with children by joint

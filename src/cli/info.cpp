@@ -1,5 +1,5 @@
-// `zwang info MODEL.urdf [--root L] [--tip L] [--json]`: what the loader made
-// of a URDF chain.
+// `zwang info MODEL.urdf [--root L] [--tip L] [--lock-mimic] [--json]`: what the
+// loader made of a URDF tree or chain.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -67,10 +67,17 @@ struct Masses {
 
 std::string bodyLink(const Model& model, int body) { return model.frame(model.bodyFrame(body)).name; }
 
+// The joint that moves joint j's parent body (−1: it hangs from the base).
+int parentJoint(const Model& model, int j) { return model.parentBodyOfJoint(j) - 1; }
+
 Json infoJson(const Model& model, const std::string& path) {
   Json joints = Json::array();
-  for (const Joint& j : model.joints())
+  for (int k = 0; k < model.dof(); ++k) {
+    const Joint& j = model.joint(k);
+    const int parent = parentJoint(model, k);
     joints.push_back({{"name", j.name},
+                      {"parent", parent < 0 ? Json(nullptr) : Json(model.joint(parent).name)},
+                      {"parent_body", model.parentBodyOfJoint(k)},
                       {"type", toString(j.type)},
                       {"axis", {j.axis.x(), j.axis.y(), j.axis.z()}},
                       {"lower", finiteOrNull(j.lower)},
@@ -81,6 +88,7 @@ Json infoJson(const Model& model, const std::string& path) {
                       {"kinetic_friction", j.kinetic_friction},
                       {"viscous_friction", j.viscous_friction},
                       {"rotor_inertia", j.rotor_inertia}});
+  }
   Json frames = Json::array();
   for (const Frame& f : model.frames())
     frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyLink(model, f.body)}});
@@ -91,6 +99,7 @@ Json infoJson(const Model& model, const std::string& path) {
   return {{"file", path},
           {"model", model.name()},
           {"dof", model.dof()},
+          {"chain", model.isChain()},
           {"joints", std::move(joints)},
           {"frames", std::move(frames)},
           {"moving_mass", mass.moving},
@@ -100,17 +109,19 @@ Json infoJson(const Model& model, const std::string& path) {
 }
 
 void printInfoTable(const Model& model, const std::string& path) {
-  std::printf("%s: %d moving joint%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
-              model.dof() == 1 ? "" : "s", model.frames().size(), path.c_str());
-  std::vector<std::vector<std::string>> rows{{"#", "name", "type", "axis", "lower", "upper", "effort", "velocity",
-                                              "breakaway", "kinetic", "viscous", "rotor_inertia"}};
+  std::printf("%s: %d moving joint%s%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
+              model.dof() == 1 ? "" : "s", model.isChain() ? "" : " in a tree", model.frames().size(), path.c_str());
+  std::vector<std::vector<std::string>> rows{{"#", "name", "parent", "type", "axis", "lower", "upper", "effort",
+                                              "velocity", "breakaway", "kinetic", "viscous", "rotor_inertia"}};
   for (int k = 0; k < model.dof(); ++k) {
     const Joint& j = model.joint(k);
     char axis[64];
     std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
-    rows.push_back({std::to_string(k), j.name, toString(j.type), axis, cell(j.lower), cell(j.upper),
-                    cell(j.effort_limit), cell(j.velocity_limit), cell(j.breakaway_friction), cell(j.kinetic_friction),
-                    cell(j.viscous_friction), cell(j.rotor_inertia)});
+    const int parent = parentJoint(model, k);
+    rows.push_back({std::to_string(k), j.name, parent < 0 ? "(base)" : model.joint(parent).name, toString(j.type), axis,
+                    cell(j.lower), cell(j.upper), cell(j.effort_limit), cell(j.velocity_limit),
+                    cell(j.breakaway_friction), cell(j.kinetic_friction), cell(j.viscous_friction),
+                    cell(j.rotor_inertia)});
   }
   printTable(rows);
   std::printf("\nframes\n");
@@ -128,8 +139,8 @@ void printInfoTable(const Model& model, const std::string& path) {
 }  // namespace
 
 int commandInfo(int argc, char** argv) {
-  const Arguments args =
-      parseArguments("info", argc, argv, 2, {"--json", "--strict", "--attach-beyond-tip"}, {"--root", "--tip"});
+  const Arguments args = parseArguments(
+      "info", argc, argv, 2, {"--json", "--strict", "--attach-beyond-tip", "--lock-mimic"}, {"--root", "--tip"});
   if (args.help) {
     std::fputs(usageText("info"), stdout);
     return kExitOk;
@@ -142,7 +153,8 @@ int commandInfo(int argc, char** argv) {
   options.tip = args.value("--tip");
   options.strict = args.has("--strict");
   options.attach_beyond_tip = args.has("--attach-beyond-tip");
-  options.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip"};
+  options.mimic = args.has("--lock-mimic") ? MimicJoints::Lock : MimicJoints::Refuse;
+  options.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
   Model model;
   try {
     model = loadUrdfFile(path, options);

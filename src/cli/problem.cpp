@@ -10,13 +10,20 @@ namespace zwang::cli {
 
 namespace {
 
-Expressed parseExpressed(const JsonReader& in, const Json& value, const std::string& path, bool allow_aligned) {
+// "local", "world", "aligned" (constraints only), "reference" (relative constraints only).
+Expressed parseExpressed(const JsonReader& in, const Json& value, const std::string& path, bool allow_aligned,
+                         bool allow_reference = false) {
   const std::string text = in.string(value, path);
   if (text == "local") return Expressed::Local;
   if (text == "world") return Expressed::World;
   if (allow_aligned && text == "aligned") return Expressed::Aligned;
-  in.fail(path, "unknown value \"" + printable(text, 40) + "\" (expected " +
-                    (allow_aligned ? "\"local\", \"world\" or \"aligned\"" : "\"local\" or \"world\"") + ")");
+  if (allow_reference && text == "reference") return Expressed::Reference;
+  const std::string expected = !allow_aligned     ? "\"local\" or \"world\""
+                               : !allow_reference ? "\"local\", \"world\" or \"aligned\""
+                                                  : "\"local\", \"world\", \"aligned\" or \"reference\"";
+  std::string hint;
+  if (text == "reference" && allow_aligned) hint = "; \"reference\" is for a constraint with \"relative_to\"";
+  in.fail(path, "unknown value \"" + printable(text, 40) + "\" (expected " + expected + hint + ")");
 }
 
 WrenchSpec parseWrench(const JsonReader& in, const Json& value, const std::string& path) {
@@ -35,13 +42,23 @@ WrenchSpec parseWrench(const JsonReader& in, const Json& value, const std::strin
 }
 
 ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const std::string& path) {
-  in.object(value, path, {"frame", "expressed_in", "directions", "acceleration"});
+  in.object(value, path, {"frame", "relative_to", "expressed_in", "directions", "acceleration"});
   ConstraintSpec c;
   c.path = path;
   if (!value.contains("frame")) in.fail(path, "missing key \"frame\" (the link whose acceleration is constrained)");
   c.frame = in.string(value["frame"], childPath(path, "frame"));
+  if (value.contains("relative_to")) {
+    const std::string rpath = childPath(path, "relative_to");
+    c.relative_to = in.string(value["relative_to"], rpath);
+    if (c.relative_to.empty()) in.fail(rpath, "is empty (name the frame the constraint is relative to)");
+    if (c.relative_to == c.frame)
+      in.fail(rpath, "is the constrained frame itself (\"" + printable(c.frame, 60) +
+                         "\"): a relative constraint needs another frame to refer to");
+    c.expressed = Expressed::Reference;  // the default axes of a relative constraint
+  }
   if (value.contains("expressed_in"))
-    c.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), true);
+    c.expressed =
+        parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), true, !c.relative_to.empty());
   if (!value.contains("directions"))
     in.fail(path, "missing key \"directions\" (a list of 6-vectors, linear part first)");
   const std::string dpath = childPath(path, "directions");
@@ -130,8 +147,8 @@ Problem readProblem(const std::string& file) {
   const JsonReader in(file);
   if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
   in.object(doc, "",
-            {"model", "root", "tip", "strict", "attach_beyond_tip", "gravity", "q", "qd", "tau", "rotor_inertia",
-             "breakaway", "wrenches", "constraints", "friction", "balance"});
+            {"model", "root", "tip", "strict", "attach_beyond_tip", "lock_mimic", "gravity", "q", "qd", "tau",
+             "rotor_inertia", "breakaway", "wrenches", "constraints", "friction", "balance"});
 
   Problem p;
   p.file = file;
@@ -146,6 +163,7 @@ Problem readProblem(const std::string& file) {
   if (doc.contains("strict")) p.strict = in.boolean(doc["strict"], "strict");
   if (doc.contains("attach_beyond_tip"))
     p.attach_beyond_tip = in.boolean(doc["attach_beyond_tip"], "attach_beyond_tip");
+  if (doc.contains("lock_mimic")) p.lock_mimic = in.boolean(doc["lock_mimic"], "lock_mimic");
   if (doc.contains("gravity")) p.gravity = Vec3(in.numbers(doc["gravity"], "gravity", 3, "gx, gy, gz"));
   for (const char* key : {"q", "qd", "tau"})
     if (doc.contains(key)) {
@@ -178,7 +196,8 @@ BoundProblem bindProblem(const Problem& p) {
   urdf.tip = p.tip;
   urdf.strict = p.strict;
   urdf.attach_beyond_tip = p.attach_beyond_tip;
-  urdf.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\""};
+  urdf.mimic = p.lock_mimic ? MimicJoints::Lock : MimicJoints::Refuse;
+  urdf.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
   Model model;
   try {
     model = loadUrdfFile(p.model_path, urdf);
@@ -224,10 +243,10 @@ BoundProblem bindProblem(const Problem& p) {
   if (p.gravity) task.gravity = *p.gravity;
   task.balance = p.balance;
 
-  auto frameIndex = [&](const std::string& name, const std::string& path) {
+  auto frameIndex = [&](const std::string& name, const std::string& path, const char* key = "frame") {
     if (!m.hasFrame(name))
-      in.fail(childPath(path, "frame"),
-              "unknown frame \"" + printable(name, 60) + "\" (the chain's frames: " + frameList(m) + ")");
+      in.fail(childPath(path, key),
+              "unknown frame \"" + printable(name, 60) + "\" (the model's frames: " + frameList(m) + ")");
     const int f = m.frameIndex(name);
     bool seen = false;
     for (const int g : b.reported_frames) seen = seen || g == f;
@@ -237,7 +256,10 @@ BoundProblem bindProblem(const Problem& p) {
   try {
     for (const ConstraintSpec& c : p.constraints) {
       const int f = frameIndex(c.frame, c.path);
-      const int first = task.addConstraint(f, c.A, c.expressed);
+      const int first =
+          c.relative_to.empty()
+              ? task.addConstraint(f, c.A, c.expressed)
+              : task.addRelativeConstraint(f, frameIndex(c.relative_to, c.path, "relative_to"), c.A, c.expressed);
       task.targets().segment(first, c.acceleration.size()) = c.acceleration;
     }
     for (const WrenchSpec& w : p.wrenches) {

@@ -21,9 +21,10 @@ struct WrenchSpec {
 struct ConstraintSpec {
   std::string path;  // "constraints[k]"
   std::string frame;
-  Expressed expressed = Expressed::Local;
-  ConstraintMatrix A;            // 6 × directions
-  Eigen::VectorXd acceleration;  // one per direction (default 0)
+  std::string relative_to;  // "relative_to": the reference frame of a relative constraint (empty: the world)
+  Expressed expressed = Expressed::Local;  // default Reference for a relative constraint
+  ConstraintMatrix A;                      // 6 × directions
+  Eigen::VectorXd acceleration;            // one per direction (default 0)
 };
 
 struct FrictionSpec {
@@ -39,6 +40,7 @@ struct Problem {
   std::string root, tip;
   bool strict = false;             // "strict": refuse the model's warnings
   bool attach_beyond_tip = false;  // "attach_beyond_tip": weld the links beyond the tip as a payload
+  bool lock_mimic = false;         // "lock_mimic": weld the mimic joints (MimicJoints::Lock)
   std::optional<Vec3> gravity;
   std::optional<Eigen::VectorXd> q, qd, tau, rotor_inertia, breakaway;
   std::vector<WrenchSpec> wrenches;
@@ -57,7 +59,7 @@ struct BoundProblem {
   Eigen::VectorXd q, qd, tau;
   bool with_friction = false;  // run solveWithFriction (else solveHybridDynamics)
   FrictionOptions friction_options;
-  std::vector<int> reported_frames;  // constrained or loaded frames, first appearance order
+  std::vector<int> reported_frames;  // constrained, reference or loaded frames, first appearance order
 };
 
 // Load the model (rotor_inertia applied), check lengths and frames, build the

@@ -46,7 +46,8 @@ Vec3 vec3Arg(const char* name, py::handle value);
 Vec6 vec6Arg(const char* name, py::handle value);
 // A 6×m constraint matrix (a 6-vector is one column).
 ConstraintMatrix constraintMatrixArg(const char* name, py::handle value);
-Expressed expressedArg(const char* name, const std::string& text, bool allow_aligned);
+// "reference" only where allow_reference (a relative constraint).
+Expressed expressedArg(const char* name, const std::string& text, bool allow_aligned, bool allow_reference = false);
 const char* expressedName(Expressed e);
 
 // Read-only NumPy views of workspace memory that keep `base` alive.
@@ -60,6 +61,7 @@ py::array matrixCopy(const Eigen::Ref<const Eigen::MatrixXd>& m);
 struct Constraint {
   std::uint64_t serial;  // identity for the workspace's task cache (frame, A, expressed are immutable)
   std::string frame;
+  std::string relative_to;  // the reference frame of a relative constraint (empty: the world)
   Expressed expressed;
   ConstraintMatrix A;
   Eigen::VectorXd b;  // set points, mutable

@@ -114,15 +114,27 @@ ConstraintMatrix constraintMatrixArg(const char* name, py::handle value) {
   return A;
 }
 
-Expressed expressedArg(const char* name, const std::string& text, bool allow_aligned) {
+Expressed expressedArg(const char* name, const std::string& text, bool allow_aligned, bool allow_reference) {
   if (text == "local") return Expressed::Local;
   if (text == "world") return Expressed::World;
   if (allow_aligned && text == "aligned") return Expressed::Aligned;
-  raise(PyExc_ValueError, std::string(name) + ": unknown value '" + text + "' (expected " +
-                              (allow_aligned ? "'local', 'world' or 'aligned'" : "'local' or 'world'") + ")");
+  if (allow_reference && text == "reference") return Expressed::Reference;
+  const std::string expected = !allow_aligned     ? "'local' or 'world'"
+                               : !allow_reference ? "'local', 'world' or 'aligned'"
+                                                  : "'local', 'world', 'aligned' or 'reference'";
+  const std::string hint =
+      text == "reference" && allow_aligned ? "; 'reference' is for a constraint with relative_to=" : "";
+  raise(PyExc_ValueError, std::string(name) + ": unknown value '" + text + "' (expected " + expected + hint + ")");
 }
 
-const char* expressedName(Expressed e) { return e == Expressed::Local ? "local" : "world"; }
+const char* expressedName(Expressed e) {
+  switch (e) {
+    case Expressed::Local: return "local";
+    case Expressed::World: return "world";
+    case Expressed::Reference: return "reference";
+  }
+  return "world";
+}
 
 py::array vectorView(const double* data, Eigen::Index size, py::handle base, bool writeable) {
   if (size == 0) return py::array_t<double>(0);

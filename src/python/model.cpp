@@ -16,13 +16,14 @@ std::string pathArg(py::handle path) {
 }
 
 UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia, bool strict,
-                        bool attach_beyond_tip) {
+                        bool attach_beyond_tip, bool lock_mimic) {
   UrdfOptions options;
   options.root = root;
   options.tip = tip;
   options.strict = strict;
   options.attach_beyond_tip = attach_beyond_tip;
-  options.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True"};
+  options.mimic = lock_mimic ? MimicJoints::Lock : MimicJoints::Refuse;
+  options.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
   if (!rotor_inertia.is_none()) {
     if (!py::isinstance<py::dict>(rotor_inertia))
       raise(PyExc_TypeError, "rotor_inertia: expected a dict {joint name: inertia}");
@@ -66,6 +67,14 @@ py::array transformMatrix(const Eigen::Matrix3d& R, const Vec3& p) {
   return matrixCopy(T);
 }
 
+// A body index in [0, bodyCount()) (IndexError otherwise: the C++ accessors do not check).
+int bodyArg(const Model& model, const char* name, int b) {
+  if (b < 0 || b >= model.bodyCount())
+    raise(PyExc_IndexError, std::string(name) + ": body " + std::to_string(b) + " out of range [0, " +
+                                std::to_string(model.bodyCount()) + ")");
+  return b;
+}
+
 std::string jointRepr(const Joint& j) { return "<zwang.Joint '" + j.name + "' " + toString(j.type) + ">"; }
 
 // Each of the model's warnings through Python's warnings machinery (so filters
@@ -79,7 +88,7 @@ std::shared_ptr<Model> issueWarnings(std::shared_ptr<Model> model) {
 }  // namespace
 
 void bindModel(py::module_& m) {
-  py::class_<Joint>(m, "Joint", "A moving joint of the chain (read-only; SI units, radians).")
+  py::class_<Joint>(m, "Joint", "A moving joint of the model (read-only; SI units, radians).")
       .def_property_readonly("name", [](const Joint& j) { return j.name; })
       .def_property_readonly(
           "type", [](const Joint& j) { return std::string(toString(j.type)); },
@@ -113,8 +122,8 @@ void bindModel(py::module_& m) {
       .def("__repr__",
            [](const Frame& f) { return "<zwang.Frame '" + f.name + "' on body " + std::to_string(f.body) + ">"; });
 
-  py::class_<Model, std::shared_ptr<Model>>(m, "Model",
-                                            "An immutable serial chain (zwang::Model). Make one with load_urdf().")
+  py::class_<Model, std::shared_ptr<Model>>(
+      m, "Model", "An immutable kinematic tree or chain (zwang::Model). Make one with load_urdf().")
       .def_property_readonly("name", &Model::name)
       .def_property_readonly("dof", &Model::dof, "number of moving joints")
       .def_property_readonly(
@@ -141,6 +150,30 @@ void bindModel(py::module_& m) {
       .def("joint_index", &Model::jointIndex, py::arg("name"), "index of a moving joint; ModelError if unknown")
       .def("frame_index", &Model::frameIndex, py::arg("name"), "index of a frame; ModelError if unknown")
       .def("has_frame", &Model::hasFrame, py::arg("name"))
+      .def_property_readonly("body_count", &Model::bodyCount, "dof + 1: the fixed base (body 0) and one body per joint")
+      .def_property_readonly("is_chain", &Model::isChain, "True when every body's parent is the body before it")
+      .def_property_readonly(
+          "parents",
+          [](const Model& model) {
+    py::array_t<long> out(model.dof());
+    auto v = out.mutable_unchecked<1>();
+    for (int j = 0; j < model.dof(); ++j) v(j) = model.parentBodyOfJoint(j) - 1;
+    return out;
+          },
+          "per joint, the index of the joint that moves its parent body (-1: it hangs from the base)")
+      .def(
+          "parent", [](const Model& model, int b) { return model.parent(bodyArg(model, "parent", b)); },
+          py::arg("body"), "the parent body of a body (-1 for the base, body 0); joint j moves body j+1")
+      .def(
+          "subtree_end", [](const Model& model, int b) { return model.subtreeEnd(bodyArg(model, "subtree_end", b)); },
+          py::arg("body"),
+          "one past the last body of the body's subtree: the subtree is range(body, subtree_end(body))")
+      .def(
+          "supports",
+          [](const Model& model, int a, int b) {
+    return model.supports(bodyArg(model, "supports", a), bodyArg(model, "supports", b));
+          },
+          py::arg("a"), py::arg("b"), "True when body a is body b or one of its ancestors")
       .def_property_readonly("lower",
                              [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.lower; }); })
       .def_property_readonly("upper",
@@ -214,26 +247,30 @@ void bindModel(py::module_& m) {
   m.def(
       "load_urdf",
       [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
-         bool attach_beyond_tip) {
-    return issueWarnings(
-        std::make_shared<Model>(loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip))));
+         bool attach_beyond_tip, bool lock_mimic) {
+    return issueWarnings(std::make_shared<Model>(
+        loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic))));
       },
       py::arg("path"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
-      py::arg("strict") = false, py::arg("attach_beyond_tip") = false,
-      "Load the chain from link `root` (default: the URDF's root) to link `tip` (default: the unique leaf).\n"
+      py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,
+      "Load the whole tree below link `root` (default: the URDF's root link; joints depth first, each link's\n"
+      "children by joint name), or with `tip` the chain from `root` to `tip`.\n"
       "rotor_inertia: optional {joint name: reflected inertia} overriding the URDF.\n"
       "Doubtful data loads with a zwang.ModelWarning per warning (also in Model.warnings);\n"
       "strict=True raises ModelError instead. attach_beyond_tip=True welds links behind moving joints\n"
-      "below the tip to the tip body (joints locked at 0). Raises ModelError.");
+      "below the tip to the tip body (joints locked at 0). A <mimic> joint raises ModelError (mimic joints\n"
+      "are not modelled yet); lock_mimic=True welds it at its position when its leader is at 0.\n"
+      "Raises ModelError.");
   m.def(
       "load_urdf_string",
       [](const std::string& xml, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
-         bool attach_beyond_tip) {
-    return issueWarnings(
-        std::make_shared<Model>(loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip))));
+         bool attach_beyond_tip, bool lock_mimic) {
+    return issueWarnings(std::make_shared<Model>(
+        loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic))));
       },
       py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
-      py::arg("strict") = false, py::arg("attach_beyond_tip") = false, "load_urdf from a string holding the URDF XML.");
+      py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,
+      "load_urdf from a string holding the URDF XML.");
 }
 
 }  // namespace zwang::python

@@ -133,8 +133,12 @@ Task& solveTask(PyWorkspace& pw, py::handle constraints, py::handle wrenches, py
     for (std::size_t k = 0; k < g_constraints.size(); ++k) {
       const Constraint& c = *g_constraints[k];
       checkFrame(*pw.model, "constraints[" + std::to_string(k) + "]", c.frame);
+      if (!c.relative_to.empty())
+        checkFrame(*pw.model, "constraints[" + std::to_string(k) + "].relative_to", c.relative_to);
       try {
-        first_rows.push_back(task->addConstraint(c.frame, c.A, c.expressed));
+        first_rows.push_back(c.relative_to.empty()
+                                 ? task->addConstraint(c.frame, c.A, c.expressed)
+                                 : task->addRelativeConstraint(c.frame, c.relative_to, c.A, c.expressed));
       } catch (const ModelError& e) {
         raiseModelError("constraints[" + std::to_string(k) + "]", e);
       }
@@ -310,25 +314,54 @@ void bindSolve(py::module_& m) {
   py::class_<Constraint>(m, "Constraint",
                          "Acceleration constraint A^T Xdd = b on a frame (classical, true accelerations of the frame\n"
                          "origin; gravity not included). A is 6×m, its columns unit constraint forces, linear part\n"
-                         "first; a 6-vector is one column. frame, A and expressed are fixed; b may be changed\n"
-                         "between solves (c.b[:] = ... or c.b = ...) without rebuilding the task.")
-      .def(
-          py::init(
-              [](const std::string& frame, py::handle A, py::handle b, const std::string& expressed) {
-    Constraint c{g_next_serial++, frame, expressedArg("expressed", expressed, true), constraintMatrixArg("A", A), {}};
-    c.b.setZero(c.A.cols());
-    if (!b.is_none()) {
-      Eigen::VectorXd buffer;
-      const auto v = vectorArg("b", b, buffer);
-      if (v.size() != c.A.cols())
-        raise(PyExc_ValueError,
-              "b: has " + std::to_string(v.size()) + " entries, A has " + std::to_string(c.A.cols()) + " columns");
-      c.b = v;
-    }
-    return c;
-          }),
-          py::arg("frame"), py::arg("A"), py::arg("b") = py::none(), py::arg("expressed") = "local")
+                         "first; a 6-vector is one column. relative_to: another frame; then the acceleration is the\n"
+                         "one an observer riding on that frame sees (Task::addRelativeConstraint), and expressed\n"
+                         "defaults to 'reference' (that frame's axes). frame, relative_to, A and expressed are\n"
+                         "fixed; b may be changed between solves (c.b[:] = ... or c.b = ...) without rebuilding\n"
+                         "the task.")
+      .def(py::init([](const std::string& frame, py::handle A, py::handle b, py::handle expressed,
+                       py::handle relative_to) {
+             std::string reference;
+             if (!relative_to.is_none()) {
+               if (!py::isinstance<py::str>(relative_to))
+                 raise(PyExc_TypeError, "relative_to: expected a frame name (str) or None, got " +
+                                            std::string(py::str(py::type::handle_of(relative_to).attr("__name__"))));
+               reference = relative_to.cast<std::string>();
+               if (reference == frame)
+                 raise(exceptions().model_error, "relative_to: is the constrained frame itself ('" + frame +
+                                                     "'): a relative constraint needs another frame to refer to");
+             }
+             std::string axes = reference.empty() ? "local" : "reference";
+             if (!expressed.is_none()) {
+               if (!py::isinstance<py::str>(expressed))
+                 raise(PyExc_TypeError, "expressed: expected a str, got " +
+                                            std::string(py::str(py::type::handle_of(expressed).attr("__name__"))));
+               axes = expressed.cast<std::string>();
+             }
+             Constraint c{g_next_serial++,
+                          frame,
+                          reference,
+                          expressedArg("expressed", axes, true, !reference.empty()),
+                          constraintMatrixArg("A", A),
+                          {}};
+             c.b.setZero(c.A.cols());
+             if (!b.is_none()) {
+               Eigen::VectorXd buffer;
+               const auto v = vectorArg("b", b, buffer);
+               if (v.size() != c.A.cols())
+                 raise(PyExc_ValueError, "b: has " + std::to_string(v.size()) + " entries, A has " +
+                                             std::to_string(c.A.cols()) + " columns");
+               c.b = v;
+             }
+             return c;
+           }),
+           py::arg("frame"), py::arg("A"), py::arg("b") = py::none(), py::arg("expressed") = py::none(),
+           py::arg("relative_to") = py::none())
       .def_property_readonly("frame", [](const Constraint& c) { return c.frame; })
+      .def_property_readonly(
+          "relative_to",
+          [](const Constraint& c) { return c.relative_to.empty() ? py::object(py::none()) : py::str(c.relative_to); },
+          "the frame a relative constraint refers to (None: the world)")
       .def_property_readonly("expressed", [](const Constraint& c) { return std::string(expressedName(c.expressed)); })
       .def_property_readonly(
           "A", [](const Constraint& c) { return matrixCopy(c.A); }, "6×m (a copy)")
@@ -345,8 +378,9 @@ void bindSolve(py::module_& m) {
           },
           "set points, one per column of A (a writable view)")
       .def("__repr__", [](const Constraint& c) {
-        return "<zwang.Constraint on '" + c.frame + "', " + std::to_string(c.A.cols()) + " rows, " +
-               expressedName(c.expressed) + ">";
+        return "<zwang.Constraint on '" + c.frame + "'" +
+               (c.relative_to.empty() ? std::string() : " relative to '" + c.relative_to + "'") + ", " +
+               std::to_string(c.A.cols()) + " rows, " + expressedName(c.expressed) + ">";
       });
 
   // ---- Wrench --------------------------------------------------------------

@@ -229,6 +229,96 @@ TEST_CASE("Feed-forward torque, velocities, gravity, local wrench, world constra
           Approx(a[k]).margin(1e-12));
 }
 
+namespace {
+
+// A constraint of a problem file as the C++ API takes it: A (6 × directions).
+zwang::ConstraintMatrix directionsOf(const Json& c) {
+  zwang::ConstraintMatrix A(6, static_cast<Eigen::Index>(c["directions"].size()));
+  for (std::size_t k = 0; k < c["directions"].size(); ++k)
+    A.col(static_cast<Eigen::Index>(k)) =
+        Eigen::Map<const Eigen::Matrix<double, 6, 1>>(numbers(c["directions"][k]).data());
+  return A;
+}
+
+Eigen::VectorXd vectorOf(const Json& j) {
+  const std::vector<double> v = numbers(j);
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+// A problem file (with its // comments) as JSON.
+Json problemFile(const std::string& name) {
+  return Json::parse(cli_test::readText(problem(name)), nullptr, true, true);
+}
+
+int occurrences(const std::string& text, const std::string& part) {
+  int n = 0;
+  for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+  return n;
+}
+
+void sameAs(const Json& j, const Eigen::VectorXd& v) {
+  REQUIRE(j.size() == static_cast<std::size_t>(v.size()));
+  for (Eigen::Index k = 0; k < v.size(); ++k) CHECK(j[static_cast<std::size_t>(k)].get<double>() == v[k]);
+}
+
+}  // namespace
+
+TEST_CASE("A tree: per-joint arrays in the model's order; the tool and the library agree", "[golden]") {
+  const Json s = solve(problem("tree_two_arms.json"));
+  CHECK(s["joints"] == Json::array({"waist", "left_shoulder", "left_elbow", "right_shoulder", "right_elbow"}));
+  CHECK(s["friction"]["state"][2] == "moving");  // left_elbow, qd = 0.2
+  CHECK(s["status"]["consistent"] == true);
+  CHECK(std::abs(s["frames"]["right_hand"]["acceleration_world"][2].get<double>()) < 1e-12);
+
+  const Json p = problemFile("tree_two_arms.json");
+  const zwang::Model model = zwang::loadUrdfFile(problem("two_arms.urdf"));
+  zwang::Task task(model);
+  task.addConstraint("right_hand", directionsOf(p["constraints"][0]), zwang::Expressed::World);
+  task.wrench(task.addWrench("left_hand", zwang::Expressed::World)) << 0, 0, -20, 0, 0, 0;
+  zwang::Workspace ws(model, task);
+  REQUIRE(zwang::solveWithFriction(model, task, vectorOf(p["q"]), vectorOf(p["qd"]), Eigen::VectorXd::Zero(5), ws));
+  sameAs(s["qdd"], ws.solution.qdd);  // the tool prints every double exactly: equal, bit for bit
+  sameAs(s["tau_control"], ws.solution.tau_control);
+  sameAs(s["nu"], ws.solution.nu);
+  sameAs(s["friction"]["mu"], ws.friction.mu);
+}
+
+TEST_CASE("A relative constraint (\"relative_to\"): the tool and Task::addRelativeConstraint agree", "[golden]") {
+  const Json s = solve(problem("relative_hands.json"));
+  CHECK(s["status"]["rank"] == 3);
+  CHECK(s["status"]["consistent"] == true);
+  std::vector<std::string> frames;  // the constrained frame, then the one it is relative to
+  for (const auto& item : s["frames"].items()) frames.push_back(item.key());
+  CHECK(frames == std::vector<std::string>{"left_hand", "right_hand"});
+
+  const Json p = problemFile("relative_hands.json");
+  const zwang::Model model = zwang::loadUrdfFile(problem("two_arms.urdf"));
+  zwang::Task task(model);
+  task.addRelativeConstraint("left_hand", "right_hand", directionsOf(p["constraints"][0]));  // Expressed::Reference
+  zwang::Workspace ws(model, task);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(5);
+  REQUIRE(zwang::solveHybridDynamics(model, task, vectorOf(p["q"]), zero, zero, ws));
+  sameAs(s["qdd"], ws.solution.qdd);
+  sameAs(s["tau_constraint"], ws.solution.tau_constraint);
+  sameAs(s["nu"], ws.solution.nu);
+  CHECK(ws.solution.balance.residual < 1e-12);
+
+  // Baxter holding a box between its grippers: the whole tree, the mimic
+  // fingers locked ("lock_mimic"); at rest the grippers turn together.
+  const Run r = run({"solve", problem("baxter_hold_box.json")});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(occurrences(r.err, "zwang: warning: ") == 6);  // 4 placeholder/point-mass, 2 mimic_locked
+  CHECK(occurrences(r.err, "locked at q = 0 (\"lock_mimic\": true;") == 2);
+  const Json b = parse(r.out);
+  CHECK(b["joints"].size() == 17);
+  CHECK(b["status"]["rank"] == 6);
+  CHECK(b["status"]["consistent"] == true);
+  const std::vector<double> left = numbers(b["frames"]["left_gripper"]["acceleration_world"]),
+                            right = numbers(b["frames"]["right_gripper"]["acceleration_world"]);
+  for (std::size_t k = 3; k < 6; ++k) CHECK(left[k] == Approx(right[k]).margin(1e-12));
+}
+
 TEST_CASE("--pretty and -o give the same numbers", "[golden]") {
   const Json compact = solve(problem("panda_hold.json"));
   const Json pretty = solve(problem("panda_hold.json"), {"--pretty"});
@@ -310,6 +400,13 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_balance_threshold.json", {": balance.singular_threshold: must be between 0 and 1"}},
       {"err_balance_rank.json", {": balance.rank_tolerance: must be >= 0 and below singular_threshold (0.0001)"}},
       {"err_balance_key.json", {": balance.max_damping: unknown key"}},
+      {"err_relative_unknown.json",
+       {": constraints[0].relative_to: unknown frame \"box\" (the model's frames: world, torso, chest,"}},
+      {"err_relative_self.json",
+       {": constraints[0].relative_to: is the constrained frame itself (\"left_hand\")", "another frame"}},
+      {"err_reference_absolute.json",
+       {": constraints[0].expressed_in: unknown value \"reference\"", "for a constraint with \"relative_to\""}},
+      {"err_unknown_root.json", {": model: ", "root link 'shoulders' not found (links: 'chest',", "'world'"}},
   };
   for (const Case& c : cases) {
     SECTION(c.file) {
@@ -589,6 +686,28 @@ TEST_CASE("info: table and JSON", "[info]") {
     for (const Json& f : j["frames"]) frames.push_back(f["name"]);
     CHECK(frames == std::vector<std::string>{"base", "link1", "tip"});
     CHECK(j["frames"][2]["body"] == 1);
+    CHECK(j["chain"] == true);
+    CHECK(j["joints"][0]["parent"].is_null());
+  }
+  SECTION("a tree: the parent of each joint, in the table and in JSON") {
+    const std::string tree = problem("two_arms.urdf");
+    const Run table = run({"info", tree});
+    REQUIRE(table.exit_code == 0);
+    for (const char* part : {"two_arms: 5 moving joints in a tree, 11 frames", "parent", "waist           (base)",
+                             "right_shoulder  waist", "left_elbow      left_shoulder"})
+      CHECK(contains(table.out, part));
+    const Run r = run({"info", tree, "--json"});
+    REQUIRE(r.exit_code == 0);
+    const Json j = parse(r.out);
+    CHECK(j["chain"] == false);
+    CHECK(j["joints"][0]["parent"].is_null());
+    CHECK(j["joints"][0]["parent_body"] == 0);
+    CHECK(j["joints"][3]["name"] == "right_shoulder");
+    CHECK(j["joints"][3]["parent"] == "waist");
+    CHECK(j["joints"][3]["parent_body"] == 1);
+    const Json sub = parse(run({"info", tree, "--root", "chest", "--json"}).out);
+    CHECK(sub["dof"] == 4);
+    CHECK(sub["joints"][2]["parent"].is_null());  // right_shoulder hangs from the base (chest)
   }
   SECTION("--root/--tip") {
     const Run r = run({"info", std::string(ZWANG_MODELS_DIR) + "/panda.urdf", "--tip", "panda_link4", "--json"});
@@ -967,7 +1086,7 @@ const char* kDoubtfulArm = R"(<robot name="doubtful"><link name="base"/>
   <link name="l1"><inertial><origin xyz="0.5 0 0"/><mass value="2"/>
     <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link></robot>)";
 
-// base -j0-> hub, then 15 revolute branches hub -jk-> leaf_k: no unique tip.
+// base -j0-> hub, then 15 revolute branches hub -jk-> leaf_k (each with a little mass): a tree.
 std::string fifteenBranches() {
   std::string xml = R"(<robot name="star"><link name="base"/>
     <joint name="j0" type="continuous"><parent link="base"/><child link="hub"/></joint>
@@ -975,10 +1094,27 @@ std::string fifteenBranches() {
   for (int k = 0; k < 15; ++k) {
     const std::string n = std::to_string(k);
     xml += "<joint name=\"j" + n + "_\" type=\"continuous\"><parent link=\"hub\"/><child link=\"leaf_" + n +
-           "\"/></joint><link name=\"leaf_" + n + "\"/>";
+           "\"/></joint><link name=\"leaf_" + n +
+           "\"><inertial><mass value=\"0.1\"/><inertia ixx=\"1e-3\" ixy=\"0\" ixz=\"0\" iyy=\"1e-3\" iyz=\"0\" "
+           "izz=\"1e-3\"/></inertial></link>";
   }
   return xml + "</robot>";
 }
+
+// base -j1-> l1 -fixed-> palm; palm -f1-> finger1, palm -f2 (mimics f1)-> finger2.
+const char* kMimicGripper = R"(<robot name="gripper"><link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2" effort="10" velocity="3"/></joint>
+  <link name="l1"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="palm_joint" type="fixed"><parent link="l1"/><child link="palm"/><origin xyz="0.3 0 0"/></joint>
+  <link name="palm"/>
+  <joint name="f1" type="prismatic"><parent link="palm"/><child link="finger1"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.04" effort="10" velocity="1"/></joint>
+  <link name="finger1"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+  <joint name="f2" type="prismatic"><parent link="palm"/><child link="finger2"/><axis xyz="0 -1 0"/>
+    <limit lower="0" upper="0.04" effort="10" velocity="1"/><mimic joint="f1" multiplier="1" offset="0"/></joint>
+  <link name="finger2"><inertial><mass value="0.2"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+</robot>)";
 
 int countOf(const std::string& text, const std::string& part) {
   int n = 0;
@@ -1028,21 +1164,51 @@ TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8"
     CHECK(contains(strict.err, "model: "));
     CHECK(contains(strict.err, "refused in strict mode"));
   }
-  SECTION("no unique tip: the hint names --tip or \"tip\", the list is cut between names, … is UTF-8") {
+  SECTION("a tree: no tip needed; an unknown root lists the links, cut between names, … is UTF-8") {
     const std::string star = dir + "/star.urdf";
     cli_test::writeText(star, fifteenBranches());
-    const Run info = run({"info", star});
+    const Run whole = run({"info", star, "--json"});
+    INFO("stderr: " << whole.err);
+    REQUIRE(whole.exit_code == 0);
+    CHECK(parse(whole.out)["dof"] == 16);  // the hub and its 15 leaves
+    const Run info = run({"info", star, "--root", "nowhere"});
     checkOneLineError(info, 1);
-    CHECK(contains(info.err, "(set --tip)"));
-    CHECK_FALSE(contains(info.err, "UrdfOptions"));
-    CHECK(contains(info.err, ", \xE2\x80\xA6 (3 more)"));  // "…" as UTF-8, after 12 whole names
-    CHECK(countOf(info.err, "'leaf_") == 12);
+    CHECK(contains(info.err, "root link 'nowhere' not found (links: "));
+    CHECK(contains(info.err, ", \xE2\x80\xA6 (5 more)"));  // "…" as UTF-8, after 12 whole names
+    CHECK(countOf(info.err, "'leaf_") == 10);              // 'base', 'hub' and 10 leaves
     CHECK_FALSE(contains(info.err, "\\x"));
     const std::string file = dir + "/star.json";
-    cli_test::writeText(file, R"({"model": "star.urdf"})");
+    cli_test::writeText(file, R"({"model": "star.urdf", "root": "nowhere"})");
     const Run solve = run({"solve", file});
     checkOneLineError(solve, 1);
-    CHECK(contains(solve.err, "(set \"tip\")"));
+    CHECK(contains(solve.err, ": model: "));
+    CHECK(contains(solve.err, "root link 'nowhere' not found"));
+  }
+  SECTION("a mimic joint: the hint names --lock-mimic or \"lock_mimic\"; with it the model loads") {
+    const std::string gripper = dir + "/gripper.urdf";
+    cli_test::writeText(gripper, kMimicGripper);
+    const Run info = run({"info", gripper});
+    checkOneLineError(info, 1);
+    CHECK(contains(info.err, "joint 'f2' mimics joint 'f1' (q = 1·q_f1 + 0): mimic joints are not modelled yet"));
+    CHECK(contains(info.err, "set --lock-mimic to weld it at q = 0"));
+    CHECK_FALSE(contains(info.err, "UrdfOptions"));
+    const Run locked = run({"info", gripper, "--lock-mimic", "--json"});
+    REQUIRE(locked.exit_code == 0);
+    const Json j = parse(locked.out);
+    CHECK(j["dof"] == 2);
+    REQUIRE(j["warnings"].size() == 1);
+    CHECK(j["warnings"][0]["code"] == "mimic_locked");
+    CHECK(countOf(locked.err, "zwang: warning: ") == 1);
+    const std::string file = dir + "/gripper.json";
+    cli_test::writeText(file, R"({"model": "gripper.urdf"})");
+    const Run refused = run({"solve", file});
+    checkOneLineError(refused, 1);
+    CHECK(contains(refused.err, "set \"lock_mimic\": true to weld it"));
+    cli_test::writeText(file, R"({"model": "gripper.urdf", "lock_mimic": true, "strict": true})");
+    const Run solved = run({"solve", file});
+    INFO("stderr: " << solved.err);
+    CHECK(solved.exit_code == 0);  // the lock's note passes strict mode
+    CHECK(parse(solved.out)["joints"] == Json::array({"j1", "f1"}));
   }
   SECTION("valid UTF-8 passes through, other bytes are escaped") {
     const Run r = run({"info", "--\xC3\xA9t\xC3\xA9\xFF"});

@@ -1,6 +1,8 @@
-// libFuzzer target: URDF text → loadUrdfString. The only exception allowed out
-// of the loader is ModelError; a model that loads must then solve (zero state,
-// gravity) with finite outputs or a documented error status.
+// libFuzzer target: URDF text → loadUrdfString (whole trees, since no tip is
+// given; again with MimicJoints::Lock when the text has a <mimic>). The only
+// exception allowed out of the loader is ModelError; a model that loads must
+// then solve (zero state, gravity) with finite outputs or a documented error
+// status.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -8,18 +10,19 @@
 #include "fuzz_common.hpp"
 #include "zwang/zwang.hpp"
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+namespace {
+
+// Load and solve once; `options` as given.
+void loadAndSolve(const std::string& xml, const zwang::UrdfOptions& options) {
   using namespace zwang;
-  if (size > 1 << 16) return -1;  // the loader is not meant for megabytes; keeps the fuzzer fast
-  const std::string xml(reinterpret_cast<const char*>(data), size);
   Model model;
   try {
-    model = loadUrdfString(xml);
+    model = loadUrdfString(xml, options);
   } catch (const ModelError& e) {
     if (e.what()[0] == '\0') fuzz::failure("ModelError without a message", "loadUrdfString");
-    return 0;
+    return;
   }
-  if (model.dof() < 1 || model.dof() > 64) return 0;
+  if (model.dof() < 1 || model.dof() > 64) return;
   Task task(model);
   Workspace ws(model, task);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.dof());
@@ -29,6 +32,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fuzz::requireFinite(ws.solution.tau_control, "tau_control", "solveHybridDynamics on a loaded URDF");
   } else if (status.code != StatusCode::Degenerate) {
     fuzz::failure("unexpected status on a loaded model", status.message);
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size > 1 << 16) return -1;  // the loader is not meant for megabytes; keeps the fuzzer fast
+  const std::string xml(reinterpret_cast<const char*>(data), size);
+  loadAndSolve(xml, {});
+  if (xml.find("<mimic") != std::string::npos) {  // the same with the mimic joints locked
+    zwang::UrdfOptions lock;
+    lock.mimic = zwang::MimicJoints::Lock;
+    loadAndSolve(xml, lock);
   }
   return 0;
 }

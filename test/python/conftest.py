@@ -10,6 +10,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 MODELS = pathlib.Path(os.environ.get("ZWANG_MODELS_DIR", ROOT / "models"))
 PANDA = MODELS / "panda.urdf"
 ARM = MODELS / "one_dof_arm.urdf"
+BAXTER = MODELS / "baxter.urdf"  # a dual-arm tree with mimic fingers (load with lock_mimic=True)
+TWO_ARMS = ROOT / "test" / "cli" / "problems" / "two_arms.urdf"  # a small tree: waist, two 2-joint arms
 READY = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]  # the Panda ready pose of test/cli/problems/panda_hold.json
 
 

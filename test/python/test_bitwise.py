@@ -9,12 +9,13 @@ import json
 import os
 import pathlib
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
 
 import zwang
-from conftest import ARM, PANDA
+from conftest import ARM, BAXTER, PANDA
 
 CLI = os.environ.get("ZWANG_CLI")
 pytestmark = pytest.mark.skipif(not CLI or not pathlib.Path(CLI).exists(),
@@ -60,6 +61,41 @@ def random_problem(rng, seed, panda=True):
     return p
 
 
+N_TREE = 20
+BAXTER_FRAMES = ["left_gripper", "right_gripper", "left_lower_elbow", "right_wrist", "head", "torso",
+                 "l_gripper_l_finger", "r_gripper_r_finger_tip"]
+
+
+def random_tree_problem(rng):
+    """A random problem on the Baxter tree (mimic fingers locked), constraints relative to another frame or not."""
+    n = 17
+    p = {"model": str(BAXTER), "lock_mimic": True, "gravity": [0.0, 0.0, -9.81]}
+    p["q"] = rng.uniform(-1.0, 1.0, n).tolist()
+    qd = rng.uniform(-1, 1, n)
+    qd[rng.random(n) < 0.6] = 0.0
+    p["qd"] = qd.tolist()
+    p["tau"] = rng.uniform(-10, 10, n).tolist()
+    constraints = []
+    for _ in range(rng.integers(1, 4)):
+        m = int(rng.integers(1, 4))
+        frame, reference = (str(f) for f in rng.choice(BAXTER_FRAMES, 2, replace=False))
+        c = {"frame": frame, "directions": rng.normal(size=(m, 6)).tolist(), "acceleration": rng.normal(size=m).tolist()}
+        if rng.random() < 0.6:
+            c["relative_to"] = reference
+            c["expressed_in"] = str(rng.choice(["local", "world", "reference"]))
+        else:
+            c["expressed_in"] = str(rng.choice(["local", "world", "aligned"]))
+        constraints.append(c)
+    p["constraints"] = constraints
+    p["wrenches"] = [{"frame": str(rng.choice(BAXTER_FRAMES)), "expressed_in": str(rng.choice(["local", "world"])),
+                      "force": rng.normal(0, 5, 3).tolist(), "torque": rng.normal(0, 1, 3).tolist()}
+                     for _ in range(rng.integers(0, 3))]
+    if rng.random() < 0.5:
+        p["friction"] = {"velocity_tolerance": 1e-6, "margin": 1.0, "limits": False}
+        p["breakaway"] = rng.uniform(0, 3, n).tolist()
+    return p
+
+
 def cli_solve(problem, path):
     path.write_text(json.dumps(problem))
     out = subprocess.run([CLI, "solve", str(path)], capture_output=True, text=True)
@@ -70,11 +106,13 @@ def cli_solve(problem, path):
 def python_solve(problem, model=None, ws=None):
     """The same problem through the Python API; returns (result copy, infeasible, frame accelerations)."""
     if model is None:
-        model = zwang.load_urdf(problem["model"], root=problem.get("root", ""), tip=problem.get("tip", ""))
+        model = zwang.load_urdf(problem["model"], root=problem.get("root", ""), tip=problem.get("tip", ""),
+                                lock_mimic=problem.get("lock_mimic", False))
     if "rotor_inertia" in problem:
         model = model.with_rotor_inertia(problem["rotor_inertia"])
     constraints = [zwang.Constraint(c["frame"], np.array(c["directions"]).T, b=c["acceleration"],
-                                    expressed=c["expressed_in"]) for c in problem["constraints"]]
+                                    expressed=c["expressed_in"], relative_to=c.get("relative_to"))
+                   for c in problem["constraints"]]
     wrenches = [zwang.Wrench(w["frame"], force=w["force"], torque=w["torque"], expressed=w["expressed_in"])
                 for w in problem["wrenches"]]
     friction = None
@@ -92,10 +130,11 @@ def python_solve(problem, model=None, ws=None):
         infeasible = False
     except zwang.InfeasibleError as e:
         res, infeasible = e.result, True
-    frames = []
+    frames = []  # as the CLI reports them: constrained (and reference) frames, then loaded ones
     for item in problem["constraints"] + problem["wrenches"]:
-        if item["frame"] not in frames:
-            frames.append(item["frame"])
+        for name in [item["frame"], item.get("relative_to")]:
+            if name is not None and name not in frames:
+                frames.append(name)
     accelerations = {f: res.frame_acceleration(f, "world").tolist() for f in frames}
     return res.copy(), infeasible, accelerations
 
@@ -144,11 +183,21 @@ def test_arm_random_bit_for_bit(seed, scratch):
     compare(problem, cli, *python_solve(problem))
 
 
+@pytest.mark.parametrize("seed", range(N_TREE))
+def test_tree_random_bit_for_bit(seed, scratch):
+    rng = np.random.default_rng(9000 + seed)
+    problem = random_tree_problem(rng)
+    cli = cli_solve(problem, scratch / "problem.json")
+    with pytest.warns(zwang.ModelWarning):  # Baxter's placeholder inertias and the locked mimic joints
+        compare(problem, cli, *python_solve(problem))
+
+
 def test_reference_problem_files_bit_for_bit():
     """The CLI's golden problems (the report's scenarios, Fig. 5.5, Panda) through both paths."""
     problems = pathlib.Path(__file__).resolve().parents[1] / "cli" / "problems"
     checked = 0
-    for name in ["arm_stick.json", "arm_slip.json", "arm_fig55.json", "panda_hold.json", "panda_everything.json"]:
+    for name in ["arm_stick.json", "arm_slip.json", "arm_fig55.json", "panda_hold.json", "panda_everything.json",
+                 "tree_two_arms.json", "relative_hands.json", "baxter_hold_box.json"]:
         file = problems / name
         if not file.exists():
             continue
@@ -158,14 +207,19 @@ def test_reference_problem_files_bit_for_bit():
         cli = json.loads(out.stdout)
         problem = {"model": str((file.parent / raw["model"]).resolve()), "root": raw.get("root", ""),
                    "tip": raw.get("tip", ""), "gravity": raw.get("gravity", [0.0, 0.0, -9.81])}
-        model = zwang.load_urdf(problem["model"], root=problem["root"], tip=problem["tip"])
+        problem["lock_mimic"] = raw.get("lock_mimic", False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", zwang.ModelWarning)
+            model = zwang.load_urdf(problem["model"], root=problem["root"], tip=problem["tip"],
+                                    lock_mimic=problem["lock_mimic"])
         n = model.dof
         problem.update(q=raw.get("q", [0.0] * n), qd=raw.get("qd", [0.0] * n), tau=raw.get("tau", [0.0] * n))
         if "rotor_inertia" in raw:
             problem["rotor_inertia"] = raw["rotor_inertia"]
         if "breakaway" in raw:
             problem["breakaway"] = raw["breakaway"]
-        problem["constraints"] = [{"expressed_in": "local", "acceleration": [0.0] * len(c["directions"]), **c}
+        problem["constraints"] = [{"expressed_in": "reference" if "relative_to" in c else "local",
+                                   "acceleration": [0.0] * len(c["directions"]), **c}
                                   for c in raw.get("constraints", [])]
         problem["wrenches"] = [{"expressed_in": "local", "force": [0, 0, 0], "torque": [0, 0, 0], **w}
                                for w in raw.get("wrenches", [])]
@@ -173,9 +227,11 @@ def test_reference_problem_files_bit_for_bit():
             f = raw["friction"]
             problem["friction"] = {"margin": f.get("margin", 1.0), "velocity_tolerance": f.get("velocity_tolerance", 1e-6),
                                    "limits": f.get("limits", True)}
-        compare(problem, cli, *python_solve(problem))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", zwang.ModelWarning)
+            compare(problem, cli, *python_solve(problem))
         checked += 1
-    assert checked >= 3
+    assert checked >= 6
 
 
 def test_reused_workspace(scratch):

@@ -189,11 +189,15 @@ import random, numpy as np, zwang, sys
 m = zwang.load_urdf(sys.argv[1], tip="tool0"); ws = m.workspace()
 junk = [None, 1, -1, 1e308, float("nan"), "tool0", "", b"x", [], [1.0] * 7, np.zeros(7), np.zeros((7, 7)),
         np.zeros(0), np.array([np.nan] * 7), np.zeros(7, dtype=complex), object(), {}, (1, 2), np.zeros(6),
-        [zwang.Wrench("tool0")], [zwang.Constraint("tool0", np.eye(6))], zwang.Friction(), True, ws, m]
+        [zwang.Wrench("tool0")], [zwang.Constraint("tool0", np.eye(6))], zwang.Friction(), True, ws, m,
+        [zwang.Constraint("tool0", np.eye(6), relative_to="panda_link3")], 7, 8, "reference"]
 calls = [lambda a, b, c: zwang.solve(m, ws, a, b, c),
          lambda a, b, c: zwang.solve(m, ws, np.zeros(7), constraints=a, wrenches=b, friction=c),
          lambda a, b, c: zwang.solve(m, ws, a, gravity=b, friction=c),
          lambda a, b, c: zwang.Constraint(a, b, c),
+         lambda a, b, c: zwang.Constraint(a, np.eye(6), expressed=b, relative_to=c),
+         lambda a, b, c: (m.parent(a), m.subtree_end(b), m.supports(a, c)),
+         lambda a, b, c: zwang.load_urdf_string(a, b, c, lock_mimic=True),
          lambda a, b, c: zwang.Wrench(a, b),
          lambda a, b, c: zwang.frame_jacobian(m, ws, a, b, c),
          lambda a, b, c: zwang.inverse_dynamics(m, ws, a, b, c),
@@ -205,7 +209,7 @@ for _ in range(4000):
     f = rng.choice(calls)
     try:
         f(rng.choice(junk), rng.choice(junk), rng.choice(junk))
-    except (zwang.Error, TypeError, ValueError, RuntimeError, OverflowError):
+    except (zwang.Error, TypeError, ValueError, RuntimeError, OverflowError, IndexError):
         count += 1
 print("ok", count)
 '''

@@ -4,8 +4,9 @@
 // Infeasible, whose outputs docs/friction.md promises finite).
 //
 // The "model" key names a file; the harness never lets the fuzzer open one: it
-// binds every problem to models/one_dof_arm.urdf, or to models/panda.urdf when
-// the model string mentions "panda".
+// binds every problem to models/one_dof_arm.urdf, to models/dual_panda.urdf (a
+// tree) when the model string mentions "dual", or to models/panda.urdf when it
+// mentions "panda".
 #include <unistd.h>
 
 #include <cstddef>
@@ -46,8 +47,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (e.what()[0] == '\0' || e.exitCode() != kExitError) fuzz::failure("bad CliError from readProblem", e.what());
     return 0;
   }
-  problem.model_path = std::string(ZWANG_MODELS_DIR) +
-                       (problem.model_path.find("panda") != std::string::npos ? "/panda.urdf" : "/one_dof_arm.urdf");
+  const bool dual = problem.model_path.find("dual") != std::string::npos;
+  const bool panda = problem.model_path.find("panda") != std::string::npos;
+  problem.model_path = std::string(ZWANG_MODELS_DIR) + (dual    ? "/dual_panda.urdf"
+                                                        : panda ? "/panda.urdf"
+                                                                : "/one_dof_arm.urdf");
   BoundProblem bound;
   try {
     bound = bindProblem(problem);

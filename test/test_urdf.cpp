@@ -561,3 +561,14 @@ TEST_CASE("error: bad Drake rotor inertia or gear ratio", "[urdf][errors]") {
   REQUIRE_THROWS_WITH(with(transmission("t1", "j7", R"(<drake:rotor_inertia value="1"/>)")),
                       Contains("transmission 't1'") && Contains("'j7'") && Contains("not a joint"));
 }
+
+TEST_CASE("a text ending inside a multi-byte UTF-8 name is refused, never read past its end", "[urdf]") {
+  // TinyXML steps over the final NUL when the last byte is a UTF-8 lead byte
+  // (found by fuzz_urdf); the ASan build of this test reads out of bounds if
+  // the loader passes the text without room after it.
+  const std::string text = "<?xml version=\"1.0\"?>\n<robot name=\"r\">\n  <joint name=\"j\xdd\xd7";
+  for (std::size_t cut = text.size() - 3; cut <= text.size(); ++cut) {
+    const std::string truncated = text.substr(0, cut);
+    CHECK_THROWS_AS(zwang::loadUrdfString(truncated), zwang::ModelError);
+  }
+}

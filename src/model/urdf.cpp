@@ -937,7 +937,13 @@ void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, co
   checkLockedPositions(report, options, {}, placement.locked_mimic, false);
 }
 
-Model load(const Reporter& report, const std::string& xml, const UrdfOptions& options) {
+Model load(const Reporter& report, const std::string& text, const UrdfOptions& options) {
+  // TinyXML 2.6 (what urdfdom parses with) trusts a UTF-8 lead byte's length:
+  // a text that ends inside a multi-byte name makes it step over the final
+  // NUL and read on into whatever memory follows (found by fuzz_urdf). Both
+  // parsers stop at the first NUL, so eight more of them (the longest step is
+  // four bytes) give the same parse and keep every read inside this string.
+  const std::string xml = text + std::string(8, '\0');
   TiXmlDocument doc;
   const TiXmlElement* robot = parseXml(report, xml, doc);
   checkAllNumbers(report, robot);  // every number finite, anywhere

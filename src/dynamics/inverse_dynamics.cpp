@@ -19,15 +19,31 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
   // In base coordinates (src/dynamics/sweeps.hpp): no transforms between bodies.
   internal::outwardKinematics(model, q, qd, ws, true);
   ws.a[0] = internal::gravityAcceleration(task.gravity);  // gravity as base acceleration
+  // A body whose parent is the body before it (every body of a chain, most of
+  // a tree's) takes the parent's value from a register, not from the store
+  // just made: a load that waits on that store costs more than the sum.
+  Vec6 a_previous = ws.a[0];
   for (int i = 1; i <= N; ++i) {
-    ws.a[at(i)] = ws.a[at(model.parent(i))] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
+    const int p = model.parent(i);
+    const Vec6 a = (p == i - 1 ? a_previous : ws.a[at(p)]) + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
+    ws.a[at(i)] = a;
+    a_previous = a;
     ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);
   }
   internal::applyExternalWrenches(model, task, ws);
   for (int i = 1; i <= N; ++i) ws.f[at(i)] = ws.I[at(i)] * ws.a[at(i)] + ws.Fbias[at(i)];
+  // Inward: the child just done passes its force to body i − 1 in a register
+  // when that is its parent; other parents collect in ws.f.
+  Vec6 to_previous = Vec6::Zero();
   for (int i = N; i >= 1; --i) {
-    ws.tau[i - 1] = ws.S[at(i)].dot(ws.f[at(i)]) + model.joint(i - 1).rotor_inertia * qdd[i - 1];
-    if (model.parent(i) > 0) ws.f[at(model.parent(i))] += ws.f[at(i)];
+    const Vec6 f = ws.f[at(i)] + to_previous;
+    ws.tau[i - 1] = ws.S[at(i)].dot(f) + model.joint(i - 1).rotor_inertia * qdd[i - 1];
+    const int p = model.parent(i);
+    to_previous.setZero();
+    if (p == i - 1)
+      to_previous = f;
+    else if (p > 0)
+      ws.f[at(p)] += f;
   }
   return {};
 }

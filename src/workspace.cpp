@@ -5,9 +5,11 @@
 namespace zwang {
 
 Workspace::Workspace(const Model& model, int max_constraint_rows)
-    : dof_(model.dof()), capacity_(max_constraint_rows < 0 ? 0 : max_constraint_rows) {
+    : dof_(model.dof()),
+      capacity_(max_constraint_rows < 0 ? 0 : max_constraint_rows),
+      mimic_rows_(static_cast<int>(model.mimicJoints().size())) {
   const auto bodies = static_cast<std::size_t>(model.bodyCount());
-  const int n = dof_, m = capacity_;
+  const int n = dof_, m = balanceCapacity();
   solution.qdd.setZero(n);
   solution.nu.setZero(0);
   solution.tau_constraint.setZero(n);

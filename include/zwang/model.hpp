@@ -39,6 +39,18 @@ enum class JointType { Revolute, Continuous, Prismatic };
 /// The URDF name of a joint type: "revolute", "continuous" or "prismatic".
 const char* toString(JointType type);
 
+/// A joint that follows another (URDF `<mimic>`): q = multiplier·q_leader +
+/// offset, so q̇ = multiplier·q̇_leader and q̈ = multiplier·q̈_leader. The
+/// mechanism that couples them (gears, a linkage, a tendon) supplies the
+/// coupling torque; the leader's motor carries the rest (docs/solver.md, "Mimic joints").
+struct Mimic {
+  int leader = -1;          ///< the joint followed (never itself a mimic joint once built); −1: independent
+  double multiplier = 1.0;  ///< a in q = a·q_leader + b
+  double offset = 0.0;      ///< b [rad or m]
+  /// True when the joint follows a leader.
+  bool active() const { return leader >= 0; }
+};
+
 /// One moving joint of the tree: its axis and placement, drive (rotor inertia), friction and limits.
 struct Joint {
   std::string name;                      ///< unique among the model's joints
@@ -55,6 +67,9 @@ struct Joint {
   double effort_limit = std::numeric_limits<double>::infinity();
   /// Largest speed [rad/s or m/s] (URDF `<limit velocity>`).
   double velocity_limit = std::numeric_limits<double>::infinity();
+  /// The leader this joint follows, if it is a mimic joint (chains of mimic
+  /// joints are resolved to the first leader when the model is built).
+  Mimic mimic;
 
   /// True for revolute and continuous joints.
   bool isRevolute() const { return type != JointType::Prismatic; }
@@ -147,12 +162,20 @@ class Model {
 
   /// Index lookups; throw ModelError naming the unknown name and the known ones.
   int jointIndex(const std::string& name) const;
+  /// True when a moving joint of that name exists.
+  bool hasJoint(const std::string& name) const;
   /// Index of the frame called `name`; throws ModelError naming the known frames.
   int frameIndex(const std::string& name) const;
   /// True when a frame of that name exists.
   bool hasFrame(const std::string& name) const;
   /// The frame of body b (the link the moving joint b−1 ends in; b = 0: the base link).
   int bodyFrame(int b) const { return body_frames_.at(static_cast<std::size_t>(b)); }
+  /// The mimic joints (Joint::mimic active), in model order. Every solve adds
+  /// one internal balance row per mimic joint, q̈_m − a·q̈_leader = 0.
+  const std::vector<int>& mimicJoints() const { return mimic_joints_; }
+  /// Set each mimic joint's q and q̇ from its leader's (q = a·q_leader + b, q̇ =
+  /// a·q̇_leader); the other entries are left as they are. Either may be empty.
+  void followLeaders(Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qd) const;
   /// What was doubtful in the data the model was built from (each once, in the
   /// order found); empty for clean data.
   const std::vector<ModelWarning>& warnings() const { return warnings_; }
@@ -167,6 +190,7 @@ class Model {
   std::vector<int> parents_{-1};     // bodyCount() entries, parents_[0] = −1
   std::vector<int> subtree_end_{1};  // bodyCount() entries
   bool is_chain_ = true;
+  std::vector<int> mimic_joints_;
   std::vector<ModelWarning> warnings_;
 };
 
@@ -200,6 +224,12 @@ class ModelBuilder {
   ModelBuilder& prefixWarnings(const std::string& prefix);
   /// Set a joint's breakaway friction f_j, kinetic (Coulomb) friction f_c,j and viscous friction b_j (finite, ≥ 0).
   ModelBuilder& setFriction(const std::string& joint, double breakaway, double kinetic, double viscous);
+
+  /// Make `joint` follow `leader`: q = multiplier·q_leader + offset (a URDF
+  /// `<mimic>`). The leader may itself be a mimic joint: build() resolves the
+  /// chain to its first leader, and refuses a cycle. ModelError for an unknown
+  /// joint, a joint that mimics itself, or a multiplier or offset that is not finite.
+  ModelBuilder& setMimic(const std::string& joint, const std::string& leader, double multiplier, double offset);
 
   /// Checks the whole tree (every moving joint must carry some inertia, every
   /// moving body's merged inertia is positive semi-definite to rounding) and

@@ -17,6 +17,7 @@ enum class StatusCode {
   Degenerate,         ///< a joint has no inertia to move (D_j ≤ 0) in this configuration
   BadOption,          ///< an option or per-solve override is out of range
   Infeasible,         ///< the task drives a joint into its position limit (outputs finite, not physical)
+  MimicMismatch,      ///< a mimic joint's q or q̇ does not follow its leader's (Model::followLeaders)
 };
 
 /// The result of a hot-path call: a code and, on error, a message naming the input at fault.

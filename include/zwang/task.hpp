@@ -101,6 +101,11 @@ class Task {
 
   /// Number of constraint rows m (the length of b and ν).
   int constraintRows() const { return static_cast<int>(b_.size()); }
+  /// Internal rows the model's mimic joints add, q̈_m − a·q̈_leader = 0, one per
+  /// mimic joint (Model::mimicJoints), after the user's rows in the balance.
+  int mimicRows() const { return mimic_rows_; }
+  /// Rows of the balance: the user's constraint rows, then the mimic rows.
+  int balanceRows() const { return constraintRows() + mimic_rows_; }
   /// Number of wrenches added.
   int wrenchCount() const { return static_cast<int>(wrenches_.size()); }
 
@@ -116,7 +121,12 @@ class Task {
     int rows;                     ///< number of rows (columns of A)
     ConstraintMatrix A;           ///< 6 × rows
     int reference = -1;           ///< the frame a relative constraint refers to (−1: the world)
-    bool reference_side = false;  ///< this entry is the reference frame's side of a relative constraint
+    bool reference_side = false;  ///< this entry is the reference (or parent body's) side
+    /// A piece of a mimic row (rows = 1, A unused): coefficient·q̈_joint, read
+    /// as a unit force along joint's axis on the joint's body and its opposite
+    /// on the parent body (reference_side). −1: a frame constraint.
+    int joint = -1;
+    double coefficient = 0.0;  ///< 1 for the mimic joint, −multiplier for its leader
   };
   /// One wrench, as the solver reads it.
   struct AppliedWrench {
@@ -132,15 +142,16 @@ class Task {
   /// Number of solver columns: one per row, two for a row of a relative
   /// constraint (one on each side).
   int solverColumns() const { return static_cast<int>(solver_row_.size()); }
-  /// The user row of each solver column.
+  /// The row of each solver column: a user row (< constraintRows()) or a mimic row.
   const std::vector<int>& solverRowToUserRow() const { return solver_row_; }
   /// Number of solver columns acting on bodies b, b+1, … (a leading block).
   int activeColumns(int body) const { return active_[static_cast<std::size_t>(body)]; }
   /// First solver column acting on body b's subtree; the block is
   /// [firstColumn(b), activeColumns(b)).
   int firstColumn(int body) const { return first_column_[static_cast<std::size_t>(body)]; }
-  /// True when some constraint is relative: then the balance works on rows,
-  /// each the sum of its solver columns (balanceRowOfColumn).
+  /// True when some balance row has several solver columns (a relative
+  /// constraint or a mimic joint): then the balance works on rows, each the
+  /// sum of its solver columns (balanceRowOfColumn).
   bool hasRelative() const { return has_relative_; }
   /// The balance row of each solver column (the identity without relative constraints).
   const std::vector<int>& balanceRowOfColumn() const { return balance_row_; }
@@ -163,8 +174,10 @@ class Task {
   std::vector<int> active_;
   std::vector<int> first_column_;
   bool has_relative_ = false;
+  int mimic_rows_ = 0;
   std::vector<AppliedWrench> wrenches_;
   Eigen::VectorXd b_;
+  void addMimicRows(const Model& model);
   void reorder();
 };
 

@@ -98,8 +98,11 @@ class Workspace {
   int dof() const { return dof_; }
   /// The most constraint rows a task solved here may have.
   int constraintCapacity() const { return capacity_; }
-  /// The most solver columns: two per row, since a relative row has one on each side.
-  int columnCapacity() const { return 2 * capacity_; }
+  /// The most balance rows: the constraint rows and one per mimic joint.
+  int balanceCapacity() const { return capacity_ + mimic_rows_; }
+  /// The most solver columns: two per row, since a relative row has one on
+  /// each side, and four per mimic row (each joint's body and its parent).
+  int columnCapacity() const { return 2 * capacity_ + 4 * mimic_rows_; }
 
   Solution solution;        ///< the results of the last solve
   FrictionResult friction;  ///< filled by solveWithFriction
@@ -166,6 +169,7 @@ class Workspace {
  private:
   int dof_;
   int capacity_;
+  int mimic_rows_;
   std::unique_ptr<internal::FrictionScratch> friction_scratch_;
 };
 

@@ -20,7 +20,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   taskResidual(task, ws);                                          // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(task.solverColumns()), out.tau_constraint);
-  out.tau_control = tau + out.tau_constraint;
+  controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   out.gauss = gaussFunction(model, task, out.qdd, tau, ws);
   return {};
 }

@@ -18,7 +18,12 @@
 //    only at their common ancestors;
 //  * relative constraints (two frames on any bodies): each row is two solver
 //    columns, +A on the frame's body and −A on the reference's, swept
-//    independently; the balance adds the columns of each row (condensedBalance).
+//    independently; the balance adds the columns of each row (condensedBalance);
+//  * mimic joints (q_m = a·q_l + b): one internal row q̈_m − a·q̈_l = 0 each,
+//    after the user's rows, as four columns: a unit effort along each joint on
+//    its body and the opposite on its parent (mimicPieceInBodyForm). Its ν is
+//    the coupling torque the mechanism carries; the motor torques the leader
+//    carries are folded onto it at the end (carryMimicTorques).
 #include "dynamics/popov_vereshchagin.hpp"
 
 #include <algorithm>
@@ -33,6 +38,33 @@ namespace zwang::internal {
 
 namespace {
 inline std::size_t at(int i) { return static_cast<std::size_t>(i); }
+}  // namespace
+
+namespace {
+// A mimic joint's q and q̇ must follow its leader's: the mechanism cannot be
+// anywhere else, and solving such a state would be a silent wrong answer.
+// Allowed: the rounding of a·q + b and what an integrator's steps add to it
+// (1e-9 of the terms' size; Model::followLeaders sets the entries exactly).
+Status checkMimicState(const Model& model, const VectorRef& q, const VectorRef& qd) {
+  for (const int m : model.mimicJoints()) {
+    const Joint& joint = model.joint(m);
+    const Mimic& law = joint.mimic;
+    const char* leader = model.joint(law.leader).name.c_str();
+    const double q_law = law.multiplier * q[law.leader] + law.offset;
+    if (std::abs(q[m] - q_law) > 1e-9 * (1.0 + std::abs(q[m]) + std::abs(q_law) + std::abs(law.offset)))
+      return Status::error(StatusCode::MimicMismatch,
+                           "joint '%s' mimics '%s' (q = %g·q_leader + %g): q is %.17g, its leader puts it at %.17g "
+                           "(Model::followLeaders sets it)",
+                           joint.name.c_str(), leader, law.multiplier, law.offset, q[m], q_law);
+    const double qd_law = law.multiplier * qd[law.leader];
+    if (std::abs(qd[m] - qd_law) > 1e-9 * (1.0 + std::abs(qd[m]) + std::abs(qd_law)))
+      return Status::error(StatusCode::MimicMismatch,
+                           "joint '%s' mimics '%s' (multiplier %g): qd is %.17g, its leader gives %.17g "
+                           "(Model::followLeaders sets it)",
+                           joint.name.c_str(), leader, law.multiplier, qd[m], qd_law);
+  }
+  return {};
+}
 }  // namespace
 
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
@@ -51,6 +83,10 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
   if (Status s = checkVector("q", q, model.dof()); !s) return s;
   if (Status s = checkVector("qd", qd, model.dof()); !s) return s;
   if (Status s = checkVector("tau", tau, model.dof()); !s) return s;
+  if (task.mimicRows() != static_cast<int>(model.mimicJoints().size()))
+    return Status::error(StatusCode::ModelMismatch, "task was made for a model with %d mimic joints, this one has %d",
+                         task.mimicRows(), static_cast<int>(model.mimicJoints().size()));
+  if (Status s = checkMimicState(model, q, qd); !s) return s;
   if (Status s = checkFinite("gravity", task.gravity); !s) return s;
   if (Status s = checkFinite("constraint targets b", task.targets()); !s) return s;
   for (int w = 0; w < task.wrenchCount(); ++w)
@@ -96,6 +132,25 @@ void relativeConstraintInBodyForm(const Model& model, const Task& task, const Ta
   }
 }
 
+// One piece of a mimic row (Task::addMimicRows): coefficient·q̈_j, read with
+// a unit effort F along joint j (F·S_j = 1): a couple about a revolute axis,
+// a force along a prismatic axis through the body origin. Since
+// Ẍ_body − Ẍ_parent = S q̈ + Ẍ_bias (line 29), F·(Ẍ_body − Ẍ_parent) = q̈ + F·Ẍ_bias:
+// the column is +F on the joint's body and −F on its parent, and F·Ẍ_bias
+// goes to the set point (on the body's side; the row's b is 0). A different F
+// with F·S = 1 would differ by a force the joint itself transmits: same motion, same ν.
+void mimicPieceInBodyForm(const Model& model, const Task::ConstraintGroup& g, int col, Workspace& ws) {
+  const int body = g.joint + 1;
+  const Vec6& S = ws.S[at(body)];
+  Vec6 F;
+  if (model.joint(g.joint).isRevolute())
+    F << Vec3::Zero(), S.tail<3>();
+  else
+    F << S.head<3>(), ws.Xworld[at(body)].r.cross(S.head<3>());
+  ws.A_body.col(col) = ((g.reference_side ? -1.0 : 1.0) * g.coefficient) * F;
+  ws.b_body[col] = g.reference_side ? 0.0 : g.coefficient * F.dot(ws.c[at(body)]);
+}
+
 // The task's constraints as unit forces on their bodies in base coordinates,
 // and the set points b as the sweep sees them (b is the true classical
 // acceleration of the frame origin p: docs/conventions.md, "What a frame's
@@ -105,6 +160,10 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
   const std::vector<int>& user_row = task.solverRowToUserRow();
   int col = 0;
   for (const Task::ConstraintGroup& g : task.groups()) {
+    if (g.joint >= 0) {
+      mimicPieceInBodyForm(model, g, col++, ws);
+      continue;
+    }
     if (g.reference >= 0) {
       relativeConstraintInBodyForm(model, task, g, col, ws);
       col += g.rows;
@@ -216,7 +275,7 @@ namespace {
 // A₀ᵀẌ₀, with M the 0/1 map of columns to rows. Into ws.L_rows (lower
 // triangle), ws.L_scale_rows and ws.rhs.
 void condensedBalance(const Task& task, Workspace& ws) {
-  const int columns = task.solverColumns(), m = task.constraintRows();
+  const int columns = task.solverColumns(), m = task.balanceRows();
   const std::vector<int>& row = task.balanceRowOfColumn();
   ws.L_rows.topLeftCorner(m, m).setZero();
   ws.L_scale_rows.head(m).setZero();
@@ -244,7 +303,7 @@ void expandToColumns(const Task& task, const Eigen::Ref<const Eigen::MatrixXd>& 
 }  // namespace
 
 void balance(const Task& task, Workspace& ws) {
-  const int m = task.constraintRows();
+  const int m = task.balanceRows();
   const bool condensed = task.hasRelative();
   if (condensed) condensedBalance(task, ws);
   Eigen::MatrixXd& L = condensed ? ws.L_rows : ws.L;
@@ -324,7 +383,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
   dU.topRows(m) *= -1.0;     // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
-    const int rows = task.constraintRows();
+    const int rows = task.balanceRows();
     auto dU_rows = ws.dU_rows.topLeftCorner(rows, k);
     dU_rows.setZero();
     for (int col = 0; col < m; ++col) dU_rows.row(task.balanceRowOfColumn()[at(col)]) += dU.row(col);
@@ -367,7 +426,7 @@ void taskResidual(const Task& task, Workspace& ws) {
   // the error is within residual_tolerance of the size of what it is computed
   // from: the accelerations it reads, its set point, and the balance's
   // right-hand side (what the constraint force had to correct).
-  const int m = task.constraintRows();
+  const int m = task.balanceRows();
   BalanceReport& report = ws.solution.balance;
   if (!task.hasRelative()) {  // one column per row
     double sum2 = 0.0;
@@ -417,7 +476,7 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   // On a tree each body carries its own wrenches and its children's: the
   // body's slot of `carried` collects them, then passes them to the parent.
   const int N = model.dof();
-  if (task.constraintRows() == 0) {
+  if (task.solverColumns() == 0) {
     tau_c.setZero();
     return;
   }
@@ -470,7 +529,29 @@ void publishNu(const Task& task, Workspace& ws) {
   const int m = task.constraintRows();
   if (ws.solution.nu.size() != m) ws.solution.nu.resize(m);  // only when the task's size changed
   // Both columns of a relative row carry the row's ν: either may write it.
-  for (int col = 0; col < task.solverColumns(); ++col) ws.solution.nu[task.solverRowToUserRow()[at(col)]] = ws.nu[col];
+  // Mimic rows (after the user's) are the mechanism's, not the task's.
+  for (int col = 0; col < task.solverColumns(); ++col) {
+    const int row = task.solverRowToUserRow()[at(col)];
+    if (row < m) ws.solution.nu[row] = ws.nu[col];
+  }
+}
+
+void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control) {
+  // Power-equivalent: a torque τ_m at the mimic joint moves the robot as
+  // a·τ_m at its leader does (q̇_m = a·q̇_l), the difference being a coupling
+  // torque the mechanism supplies. So the leader's motor carries it.
+  for (const int m : model.mimicJoints()) {
+    const Mimic& law = model.joint(m).mimic;
+    tau_control[law.leader] += law.multiplier * tau_control[m];
+    tau_control[m] = 0.0;
+  }
+}
+
+void controlTorques(const Model& model, const VectorRef& tau, Solution& out) {
+  out.tau_control = tau + out.tau_constraint;
+  if (model.mimicJoints().empty()) return;
+  carryMimicTorques(model, out.tau_control);
+  out.tau_constraint = out.tau_control - tau;  // so that τ_control = τ + τ_c still holds
 }
 
 }  // namespace zwang::internal

@@ -64,6 +64,13 @@ void taskResidual(const Task& task, Workspace& ws);
 void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c);
 
+// Mimic joints' torques onto their leaders' motors: τ_l += a·τ_m, τ_m = 0.
+void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control);
+
+// τ_control = τ + τ_c with the mimic joints' torques carried by their leaders
+// (τ_c adjusted to keep the sum), from out.tau_constraint.
+void controlTorques(const Model& model, const VectorRef& tau, Solution& out);
+
 // Gauss function of the true accelerations ws.a − [−g; 0], with joint torques `tau`.
 double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
                      const Workspace& ws);

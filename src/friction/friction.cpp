@@ -85,6 +85,18 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
     fs.kinetic[j] = options.kinetic.size() ? options.kinetic[j] : joint.kinetic_friction;
     fs.viscous[j] = options.viscous.size() ? options.viscous[j] : joint.viscous_friction;
   }
+  // A mimic joint moves with its leader (q̇_m = a·q̇_l, sticks when it sticks),
+  // and its friction torque acts on the motion as a times it at the leader:
+  // the two boxes add, f_l + |a|·f_m (likewise kinetic), and viscous b_l + a²·b_m.
+  // The leader carries it all; the mimic joint is not in the stuck set.
+  for (const int m : model.mimicJoints()) {
+    const Mimic& law = model.joint(m).mimic;
+    const double a = law.multiplier;
+    fs.breakaway[law.leader] += std::abs(a) * fs.breakaway[m];
+    fs.kinetic[law.leader] += std::abs(a) * fs.kinetic[m];
+    fs.viscous[law.leader] += a * a * fs.viscous[m];
+    fs.breakaway[m] = fs.kinetic[m] = fs.viscous[m] = 0.0;
+  }
   fr.stuck.clear();
   fr.limit_impact = false;
   fr.impact_joint = -1;
@@ -92,6 +104,10 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
   fr.tau_friction.setZero();
   for (int j = 0; j < n; ++j) {
     const Joint& joint = model.joint(j);
+    if (joint.mimic.active()) {  // friction and limits are its leader's (above)
+      fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
+      continue;
+    }
     const bool at_lower = options.joint_limits && q[j] <= joint.lower + options.limit_tolerance;
     const bool at_upper = options.joint_limits && q[j] >= joint.upper - options.limit_tolerance;
     if (std::abs(qd[j]) <= options.velocity_tolerance) {
@@ -180,9 +196,11 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
   fs.nu_first.head(m) = fs.nu0.head(m);  // ν(μ*) by superposition
   fs.nu_first.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * fs.mu.head(k);
   constraintTorques(model, task, ws, fs.nu_first.head(m), fs.tau_constraint_first);
+  fs.tau_control_first = tau + fs.tau_constraint_first;
+  carryMimicTorques(model, fs.tau_control_first);
   for (Eigen::Index a = 0; a < k; ++a) {
     const int j = stuck[static_cast<std::size_t>(a)];
-    fs.effort_offset[a] = tau[j] + fs.tau_constraint_first[j] - fs.mu[a];
+    fs.effort_offset[a] = fs.tau_control_first[j] - fs.mu[a];
     fs.margin_limit[a] = options.margin * fs.breakaway[j];
   }
 }
@@ -288,8 +306,10 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   taskResidual(task, ws);
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(m), out.tau_constraint);
-  out.tau_control = tau + out.tau_constraint;
+  controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   const double mu_dot_qdd = frictionStates(out.qdd, acc_tolerance, fs, fr);
+  for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader
+    fr.state[static_cast<std::size_t>(j)] = fr.state[static_cast<std::size_t>(model.joint(j).mimic.leader)];
   // g(μ*) = Z₀(q̈*) + μ*ᵀ W q̈* = Z with the joint torques τ − kinetic − Wᵀμ (eq. 5.7).
   fr.gauss_dual = gaussFunction(model, task, out.qdd, fs.tau_joint, ws);
   out.gauss = fr.gauss_dual - mu_dot_qdd;

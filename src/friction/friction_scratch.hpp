@@ -33,6 +33,7 @@ struct FrictionScratch {
         effort_offset(dof),
         nu_first(capacity),
         tau_constraint_first(dof),
+        tau_control_first(dof),
         choice(dof),
         tau_joint(dof) {}
 
@@ -62,6 +63,7 @@ struct FrictionScratch {
   Eigen::VectorXd effort_offset;         // h = τ + τ_c(μ*) − μ* on Θ₀: the motor torque without friction
   Eigen::VectorXd nu_first;              // ν at the maximiser returned by the QP (per solver column)
   Eigen::VectorXd tau_constraint_first;  // τ_c at that maximiser
+  Eigen::VectorXd tau_control_first;     // τ + τ_c there, mimic joints' carried by their leaders
   MaximiserChoiceScratch choice;
 
   // Outputs

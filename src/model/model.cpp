@@ -38,6 +38,12 @@ int Model::jointIndex(const std::string& name) const {
   throw ModelError("model '" + name_ + "' has no moving joint '" + name + "' (joints: " + knownNames(names) + ")");
 }
 
+bool Model::hasJoint(const std::string& name) const {
+  for (const Joint& j : joints_)
+    if (j.name == name) return true;
+  return false;
+}
+
 bool Model::hasFrame(const std::string& name) const {
   for (const Frame& f : frames_)
     if (f.name == name) return true;
@@ -274,6 +280,55 @@ ModelBuilder& ModelBuilder::setFriction(const std::string& joint, double breakaw
   return *this;
 }
 
+ModelBuilder& ModelBuilder::setMimic(const std::string& joint, const std::string& leader, double multiplier,
+                                     double offset) {
+  const std::string where = "joint '" + joint + "' (mimic of '" + leader + "')";
+  if (!model_.hasJoint(joint)) throw ModelError(where + ": the model has no joint '" + joint + "'");
+  if (!model_.hasJoint(leader))
+    throw ModelError(where + ": it mimics joint '" + leader + "', which is not a moving joint of the model");
+  if (joint == leader) throw ModelError(where + ": a joint cannot mimic itself");
+  if (!std::isfinite(multiplier) || !std::isfinite(offset))
+    throw ModelError(where + ": multiplier and offset must be finite");
+  Mimic& mimic = jointNamed(joint).mimic;
+  mimic.leader = model_.jointIndex(leader);
+  mimic.multiplier = multiplier;
+  mimic.offset = offset;
+  return *this;
+}
+
+namespace {
+// Follow each mimic joint's leaders to the first independent joint,
+// composing the laws: q_m = a·(a'·q_l + b') + b. A cycle is refused, naming it.
+void resolveMimicChains(std::vector<Joint>& joints, std::vector<int>& mimic_joints) {
+  const std::vector<Joint> direct = joints;
+  mimic_joints.clear();
+  for (std::size_t m = 0; m < joints.size(); ++m) {
+    if (!direct[m].mimic.active()) continue;
+    Mimic law = direct[m].mimic;
+    std::string path = "'" + direct[m].name + "'";
+    for (std::size_t steps = 0; direct[static_cast<std::size_t>(law.leader)].mimic.active(); ++steps) {
+      const Joint& next = direct[static_cast<std::size_t>(law.leader)];
+      path += " → '" + next.name + "'";
+      if (steps == joints.size() || law.leader == static_cast<int>(m))
+        throw ModelError("mimic joints " + path + " form a cycle: no joint in it has an independent leader");
+      law.offset += law.multiplier * next.mimic.offset;
+      law.multiplier *= next.mimic.multiplier;
+      law.leader = next.mimic.leader;
+    }
+    joints[m].mimic = law;
+    mimic_joints.push_back(static_cast<int>(m));
+  }
+}
+}  // namespace
+
+void Model::followLeaders(Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qd) const {
+  for (const int m : mimic_joints_) {
+    const Mimic& law = joints_[static_cast<std::size_t>(m)].mimic;
+    if (q.size() == dof()) q[m] = law.multiplier * q[law.leader] + law.offset;
+    if (qd.size() == dof()) qd[m] = law.multiplier * qd[law.leader];
+  }
+}
+
 Model ModelBuilder::build() const {
   // Each link passed on its own; their sum is checked too, to rounding of the
   // merged figures, so no moving body reaches a solve with a negative moment.
@@ -300,7 +355,9 @@ Model ModelBuilder::build() const {
                        "' would have no inertia to move)");
     }
   }
-  return model_;
+  Model model = model_;
+  resolveMimicChains(model.joints_, model.mimic_joints_);
+  return model;
 }
 
 }  // namespace zwang

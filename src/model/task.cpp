@@ -12,7 +12,32 @@ Task::Task(const Model& model) : dof_(model.dof()), frames_(static_cast<int>(mod
     frame_bodies_.push_back(f.body);
   }
   for (int b = 0; b < model.bodyCount(); ++b) subtree_end_.push_back(model.subtreeEnd(b));
+  addMimicRows(model);
   reorder();
+}
+
+void Task::addMimicRows(const Model& model) {
+  // Row r: q̈_m − a·q̈_l = 0, four pieces: each joint's body and the body it
+  // hangs from (where the coupling torque reacts), scaled 1 and −a.
+  for (const int m : model.mimicJoints()) {
+    const Mimic& law = model.joint(m).mimic;
+    const struct {
+      int joint;
+      double coefficient;
+    } pieces[] = {{m, 1.0}, {law.leader, -law.multiplier}};
+    for (const auto& piece : pieces) {
+      if (piece.coefficient == 0.0) continue;  // a = 0: the mimic joint is held at its offset
+      for (const bool parent_side : {false, true}) {
+        const int body = parent_side ? model.parentBodyOfJoint(piece.joint) : piece.joint + 1;
+        ConstraintGroup g{model.bodyFrame(body), body, Expressed::World, mimic_rows_, 1, ConstraintMatrix()};
+        g.reference_side = parent_side;
+        g.joint = piece.joint;
+        g.coefficient = piece.coefficient;
+        groups_.push_back(g);
+      }
+    }
+    ++mimic_rows_;
+  }
 }
 
 namespace {
@@ -49,10 +74,10 @@ int Task::addRelativeConstraint(int frame, int reference, const ConstraintMatrix
     throw ModelError("task: a relative constraint on frame '" + frame_names_[static_cast<std::size_t>(frame)] +
                      "' needs another frame to refer to, not itself");
   const int first = addConstraint(frame, A, expressed);  // checks frame and A, sorts
+  const auto user_group = [first](const ConstraintGroup& g) { return g.joint < 0 && g.first_row == first; };
   for (ConstraintGroup& g : groups_)
-    if (g.first_row == first) g.reference = reference;
-  ConstraintGroup side =
-      *std::find_if(groups_.begin(), groups_.end(), [first](const ConstraintGroup& g) { return g.first_row == first; });
+    if (user_group(g)) g.reference = reference;
+  ConstraintGroup side = *std::find_if(groups_.begin(), groups_.end(), user_group);
   side.body = frame_bodies_[static_cast<std::size_t>(reference)];
   side.reference_side = true;
   groups_.push_back(side);
@@ -87,10 +112,12 @@ void Task::reorder() {
   balance_row_.clear();
   for (const ConstraintGroup& g : groups_)
     for (int k = 0; k < g.rows; ++k) {
-      // With relative constraints the balance works on the user's rows (each
-      // the sum of its sides); otherwise on the solver columns themselves.
-      balance_row_.push_back(has_relative_ ? g.first_row + k : static_cast<int>(solver_row_.size()));
-      solver_row_.push_back(g.first_row + k);
+      // A mimic piece's row follows the user's rows, however many there are.
+      const int row = g.joint >= 0 ? constraintRows() + g.first_row : g.first_row + k;
+      // With relative constraints the balance works on the rows (each the sum
+      // of its sides); otherwise on the solver columns themselves.
+      balance_row_.push_back(has_relative_ ? row : static_cast<int>(solver_row_.size()));
+      solver_row_.push_back(row);
     }
   const auto bodies = static_cast<std::size_t>(dof_ + 1);
   active_.assign(bodies + 1, 0);  // active_[N + 1] = 0: no body beyond the last

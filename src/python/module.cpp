@@ -32,6 +32,7 @@ const char* codeName(StatusCode code) {
     case StatusCode::Degenerate: return "Degenerate";
     case StatusCode::BadOption: return "BadOption";
     case StatusCode::Infeasible: return "Infeasible";
+    case StatusCode::MimicMismatch: return "MimicMismatch";
   }
   return "Unknown";
 }

@@ -369,7 +369,7 @@ TEST_CASE("random trees through the URDF writer and loader match the ModelBuilde
   CHECK(e_tau < 1e-10);
 }
 
-TEST_CASE("mimic joints in a tree: refused naming the joint and its leader, or locked", "[urdf][trees][errors]") {
+TEST_CASE("mimic joints in a tree: modelled (the default), locked or refused", "[urdf][trees][errors]") {
   // base -j1-> l1 -fixed-> palm; palm -f1-> finger1, palm -f2 (mimics f1)-> finger2: a tree.
   const std::string gripper = R"(<robot name="gripper"><link name="base"/>
   <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
@@ -384,9 +384,51 @@ TEST_CASE("mimic joints in a tree: refused naming the joint and its leader, or l
     <limit lower="0" upper="0.04" effort="10" velocity="1"/><mimic joint="f1" multiplier="0.5" offset="0.01"/></joint>
   <link name="finger2"><inertial><mass value="0.2"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
 </robot>)";
+  const Model modelled = loadUrdfString(gripper);
+  CHECK(jointNames(modelled) == std::vector<std::string>{"j1", "f1", "f2"});
+  CHECK(modelled.mimicJoints() == std::vector<int>{2});
+  CHECK(modelled.joint(2).mimic.leader == 1);
+  CHECK(modelled.joint(2).mimic.multiplier == 0.5);
+  CHECK(modelled.joint(2).mimic.offset == 0.01);
+  CHECK(!modelled.joint(1).mimic.active());
+  CHECK(modelled.warnings().empty());
+  {  // the same gripper built by hand, mimic law and all: the same motion
+    ModelBuilder b("gripper", "base");
+    for (int j = 0; j < modelled.dof(); ++j) {
+      const Joint& joint = modelled.joint(j);
+      const int parent = modelled.parentBodyOfJoint(j);
+      b.addJoint(joint, modelled.frame(modelled.bodyFrame(j + 1)).name, modelled.inertia(j + 1),
+                 modelled.frame(modelled.bodyFrame(parent)).name);
+    }
+    b.setMimic("f2", "f1", 0.5, 0.01);
+    const Model built = b.build();
+    Task task_l(modelled), task_b(built);
+    Workspace ws_l(modelled, task_l), ws_b(built, task_b);
+    Eigen::VectorXd q(3), qd(3), tau(3);
+    q << 0.4, 0.02, 0.0;
+    qd << -0.3, 0.1, 0.0;
+    tau << 0.5, 2.0, -1.0;
+    modelled.followLeaders(q, qd);
+    CHECK(q[2] == 0.5 * 0.02 + 0.01);
+    CHECK(qd[2] == 0.5 * 0.1);
+    REQUIRE(solveHybridDynamics(modelled, task_l, q, qd, tau, ws_l));
+    REQUIRE(solveHybridDynamics(built, task_b, q, qd, tau, ws_b));
+    CHECK(relativeError(ws_l.solution.qdd, ws_b.solution.qdd) < 1e-14);
+    CHECK(std::abs(ws_l.solution.qdd[2] - 0.5 * ws_l.solution.qdd[1]) < 1e-12 * (1 + std::abs(ws_l.solution.qdd[1])));
+    CHECK(ws_l.solution.tau_control[2] == 0.0);  // the leader's motor carries it
+    Eigen::VectorXd q_off = q;
+    q_off[2] = 0.0;  // not where f1 puts it
+    const Status s = solveHybridDynamics(modelled, task_l, q_off, qd, tau, ws_l);
+    CHECK(s.code == StatusCode::MimicMismatch);
+    CHECK_THAT(std::string(s.message), Contains("joint 'f2' mimics 'f1'"));
+  }
+
+  UrdfOptions refuse;
+  refuse.mimic = MimicJoints::Refuse;
   REQUIRE_THROWS_WITH(
-      loadUrdfString(gripper),
-      Contains("<string>: joint 'f2' mimics joint 'f1' (q = 0.5·q_f1 + 0.01): mimic joints are not modelled yet") &&
+      loadUrdfString(gripper, refuse),
+      Contains("<string>: joint 'f2' mimics joint 'f1' (q = 0.5·q_f1 + 0.01): refused (UrdfOptions::mimic = "
+               "MimicJoints::Refuse)") &&
           Contains("set UrdfOptions::mimic = MimicJoints::Lock to weld it at q = 0.01 (its position when 'f1' is at "
                    "rest)"));
 
@@ -411,10 +453,23 @@ TEST_CASE("mimic joints in a tree: refused naming the joint and its leader, or l
                       Contains("locked position for joint 'f1' (0.02): not a finite position of a locked mimic joint "
                                "(those joints: 'f2')"));
 
-  // On an explicit chain through the mimic joint: refused as before, or locked.
+  // On an explicit chain through the mimic joint: its leader is off the chain,
+  // so the coupling cannot be kept: refused, or locked.
   REQUIRE_THROWS_WITH(loadUrdfString(gripper, rootTip("", "finger2")),
+                      Contains("joint 'f2' (q = 0.5·q_f1 + 0.01) mimics joint 'f1', which is not in the chain from "
+                               "'base' to 'finger2': load a tree or chain that holds both, or set UrdfOptions::mimic "
+                               "= MimicJoints::Lock"));
+  UrdfOptions refuse_chain = rootTip("", "finger2");
+  refuse_chain.mimic = MimicJoints::Refuse;
+  REQUIRE_THROWS_WITH(loadUrdfString(gripper, refuse_chain),
                       Contains("joint 'f2' on the chain mimics joint 'f1'") &&
                           Contains("choose a UrdfOptions::tip before it (e.g. 'palm')"));
+  // The subtree below the palm holds both fingers: modelled.
+  UrdfOptions palm;
+  palm.root = "palm";
+  const Model hand = loadUrdfString(gripper, palm);
+  CHECK(jointNames(hand) == std::vector<std::string>{"f1", "f2"});
+  CHECK(hand.joint(1).mimic.leader == 0);
   UrdfOptions chain = rootTip("", "finger2");
   chain.mimic = MimicJoints::Lock;
   const Model c = loadUrdfString(gripper, chain);
@@ -433,8 +488,15 @@ TEST_CASE("mimic joints: nothing left to move, or no finite position to lock at"
     <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="m1"/></joint>
   <link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
 </robot>)";
+  REQUIRE_THROWS_WITH(loadUrdfString(mimics), Contains("<string>: mimic joints 'm1' → 'm2' → 'm1' form a cycle"));
   REQUIRE_THROWS_WITH(loadUrdfString(mimics, lockMimic()),
                       Contains("the tree below root link 'base' has no moving joint (its mimic joints are locked)"));
+  std::string missing = mimics;
+  missing.replace(missing.find("<mimic joint=\"m1\"/>"), std::string("<mimic joint=\"m1\"/>").size(),
+                  "<mimic joint=\"nope\"/>");
+  REQUIRE_THROWS_WITH(loadUrdfString(missing),
+                      Contains("<string>: joint 'm2' (q = 1·q_nope + 0) mimics joint 'nope', which the URDF does not "
+                               "have"));
   UrdfOptions chain = lockMimic();
   chain.tip = "b";
   REQUIRE_THROWS_WITH(loadUrdfString(mimics, chain),
@@ -446,14 +508,42 @@ TEST_CASE("mimic joints: nothing left to move, or no finite position to lock at"
                       Contains("joint 'm1' (q = 1e+300·q_m2 + 0): the position to lock it at is not finite"));
 }
 
-TEST_CASE("Baxter: the whole dual-arm tree with locked mimic fingers; refused without", "[urdf][trees]") {
+TEST_CASE("Baxter: the whole dual-arm tree with its mimic fingers modelled, or locked", "[urdf][trees]") {
   const std::string file = kModels + "/baxter.urdf";
   // The file's 19 moving joints, depth first from 'base' with children by joint
   // name: head_pan, the left arm, its gripper's two fingers, the right arm and
   // its fingers. The two r_finger joints mimic the l_finger joints.
-  REQUIRE_THROWS_WITH(loadUrdfFile(file), Contains("baxter.urdf: joint 'l_gripper_r_finger_joint' mimics joint "
-                                                   "'l_gripper_l_finger_joint' (q = -1·q_l_gripper_l_finger_joint "
-                                                   "+ 0): mimic joints are not modelled yet"));
+  const Model full = loadUrdfFile(file);
+  REQUIRE(full.dof() == 19);
+  REQUIRE(full.mimicJoints().size() == 2);
+  for (const int j : full.mimicJoints()) {
+    const Joint& joint = full.joint(j);
+    CHECK(joint.name.find("_gripper_r_finger_joint") != std::string::npos);
+    CHECK(full.joint(joint.mimic.leader).name == joint.name.substr(0, 2) + "gripper_l_finger_joint");
+    CHECK(joint.mimic.multiplier == -1.0);
+  }
+  {  // both grippers close while the arms hold still against gravity: the
+     // fingers move as one, and only the leaders' motors work.
+    Task task(full);
+    Workspace ws(full, task);
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(19), qd = q, tau = q;
+    for (const int j : full.mimicJoints()) {
+      const int l = full.joint(j).mimic.leader;
+      q[l] = 0.01;
+      qd[l] = -0.02;
+      tau[l] = 5.0;
+      tau[j] = 1.0;
+    }
+    full.followLeaders(q, qd);
+    REQUIRE(solveHybridDynamics(full, task, q, qd, tau, ws));
+    for (const int j : full.mimicJoints()) {
+      const int l = full.joint(j).mimic.leader;
+      CHECK(std::abs(ws.solution.qdd[j] + ws.solution.qdd[l]) < 1e-10 * (1 + std::abs(ws.solution.qdd[l])));
+      CHECK(ws.solution.tau_control[j] == 0.0);
+      CHECK(std::abs(ws.solution.tau_control[l] - (5.0 - 1.0)) < 1e-12);  // τ_l + a·τ_m, a = −1
+    }
+    CHECK(ws.solution.balance.residual < 1e-9);
+  }
   const Model m = loadUrdfFile(file, lockMimic());
   const std::vector<std::string> expected{"head_pan",
                                           "left_s0",

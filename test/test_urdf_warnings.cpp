@@ -374,6 +374,10 @@ TEST_CASE("a mimic joint on the chain is refused; mass on a moving side branch i
   UrdfOptions to_finger2;
   to_finger2.tip = "finger2";
   REQUIRE_THROWS_WITH(loadUrdfString(gripper, to_finger2),
+                      Contains("joint 'f2' (q = 1·q_f1 + 0) mimics joint 'f1', which is not in the chain from 'base' "
+                               "to 'finger2'"));
+  to_finger2.mimic = MimicJoints::Refuse;
+  REQUIRE_THROWS_WITH(loadUrdfString(gripper, to_finger2),
                       Contains("joint 'f2' on the chain mimics joint 'f1' (q = 1·q_f1 + 0)") &&
                           Contains("choose a UrdfOptions::tip before it (e.g. 'palm')"));
   UrdfOptions to_finger1;
@@ -433,5 +437,7 @@ TEST_CASE("Baxter: each arm loads with the warnings its data calls for and solve
   UrdfOptions through_mimic;
   through_mimic.tip = "r_gripper_r_finger_tip";
   CHECK_THROWS_WITH(loadUrdfFile(file, through_mimic),
-                    Contains("joint 'r_gripper_r_finger_joint' on the chain mimics joint 'r_gripper_l_finger_joint'"));
+                    Contains("joint 'r_gripper_r_finger_joint' (q = -1·q_r_gripper_l_finger_joint + 0) mimics joint "
+                             "'r_gripper_l_finger_joint', which is not in the chain from 'base' to "
+                             "'r_gripper_r_finger_tip'"));
 }

@@ -10,19 +10,22 @@
 namespace zwang {
 
 /// What the loader does with a URDF `<mimic>` joint (q = multiplier · q_leader +
-/// offset) among the joints it loads. zwang does not model the coupling yet;
-/// loading such a joint as an independent one would be a silent wrong answer,
-/// so the default refuses it. A later `Model` choice (the joint follows its
-/// leader) is meant to become the default.
+/// offset) among the joints it loads.
 enum class MimicJoints {
-  /// ModelError naming the joint and its leader (the default).
-  Refuse,
+  /// The joint follows its leader (Joint::mimic; the default): its q, q̇, q̈
+  /// obey the law, its torque is carried by the leader's motor and its
+  /// friction joins the leader's (docs/solver.md, "Mimic joints"). The leader
+  /// must be loaded too (ModelError otherwise, naming both joints).
+  Model,
   /// Weld each mimic joint (and the links behind it) to its parent link at
   /// UrdfOptions::locked_positions[joint], by default at the position its leader
   /// at rest implies: multiplier · q_leader + offset with q_leader =
   /// locked_positions[leader] if that is given, else 0 (so `offset`). Each
   /// locked joint is noted with a MimicLocked warning (strict mode lets it pass).
   Lock,
+  /// ModelError naming the joint and its leader: for callers that want no
+  /// coupled joints at all.
+  Refuse,
 };
 
 /// What to load from the URDF, and rotor inertias it does not state.
@@ -59,8 +62,8 @@ struct UrdfOptions {
   /// joints locked at locked_positions[joint] (default 0; a mimic joint's default
   /// is as for MimicJoints::Lock), and become frames.
   bool attach_beyond_tip = false;
-  /// Mimic joints among the loaded ones: refused (default) or locked; see MimicJoints.
-  MimicJoints mimic = MimicJoints::Refuse;
+  /// Mimic joints among the loaded ones: modelled (default), locked or refused; see MimicJoints.
+  MimicJoints mimic = MimicJoints::Model;
   /// Position of each locked joint, by name: the joints beyond the tip
   /// (attach_beyond_tip) and the mimic joints (MimicJoints::Lock). Any other
   /// name is a ModelError.
@@ -72,6 +75,7 @@ struct UrdfOptions {
     std::string rotor_inertia = "UrdfOptions::rotor_inertia";           ///< the name of the rotor_inertia option
     std::string attach_beyond_tip = "UrdfOptions::attach_beyond_tip";   ///< the name of the attach_beyond_tip option
     std::string lock_mimic = "UrdfOptions::mimic = MimicJoints::Lock";  ///< how to ask for MimicJoints::Lock
+    std::string refuse_mimic = "UrdfOptions::mimic = MimicJoints::Refuse";  ///< how MimicJoints::Refuse was asked for
   } names;                                                              ///< see Names
 };
 

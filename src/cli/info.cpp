@@ -87,7 +87,11 @@ Json infoJson(const Model& model, const std::string& path) {
                       {"breakaway_friction", j.breakaway_friction},
                       {"kinetic_friction", j.kinetic_friction},
                       {"viscous_friction", j.viscous_friction},
-                      {"rotor_inertia", j.rotor_inertia}});
+                      {"rotor_inertia", j.rotor_inertia},
+                      {"mimic", j.mimic.active() ? Json({{"leader", model.joint(j.mimic.leader).name},
+                                                        {"multiplier", j.mimic.multiplier},
+                                                        {"offset", j.mimic.offset}})
+                                                 : Json(nullptr)}});
   }
   Json frames = Json::array();
   for (const Frame& f : model.frames())
@@ -124,6 +128,15 @@ void printInfoTable(const Model& model, const std::string& path) {
                     cell(j.rotor_inertia)});
   }
   printTable(rows);
+  if (!model.mimicJoints().empty()) {
+    std::printf("\nmimic joints (their torque is carried by the leader's motor)\n");
+    for (const int k : model.mimicJoints()) {
+      const Joint& j = model.joint(k);
+      const std::string& leader = model.joint(j.mimic.leader).name;
+      std::printf("  %s follows %s: q = %s·q_%s + %s\n", j.name.c_str(), leader.c_str(),
+                  cell(j.mimic.multiplier).c_str(), leader.c_str(), cell(j.mimic.offset).c_str());
+    }
+  }
   std::printf("\nframes\n");
   rows = {{"name", "body", "body link"}};
   for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyLink(model, f.body)});
@@ -153,7 +166,7 @@ int commandInfo(int argc, char** argv) {
   options.tip = args.value("--tip");
   options.strict = args.has("--strict");
   options.attach_beyond_tip = args.has("--attach-beyond-tip");
-  options.mimic = args.has("--lock-mimic") ? MimicJoints::Lock : MimicJoints::Refuse;
+  options.mimic = args.has("--lock-mimic") ? MimicJoints::Lock : MimicJoints::Model;
   options.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
   Model model;
   try {

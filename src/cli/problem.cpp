@@ -196,7 +196,7 @@ BoundProblem bindProblem(const Problem& p) {
   urdf.tip = p.tip;
   urdf.strict = p.strict;
   urdf.attach_beyond_tip = p.attach_beyond_tip;
-  urdf.mimic = p.lock_mimic ? MimicJoints::Lock : MimicJoints::Refuse;
+  urdf.mimic = p.lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
   urdf.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
   Model model;
   try {

@@ -26,9 +26,10 @@
 // For a chain, links connected through a moving joint that is not on it are
 // NOT part of the model: their mass is ignored, as KDL's tree→chain
 // conversion does, with a warning when they ride on a moving body (beyond the
-// tip, or a side branch). A <mimic> joint among the loaded ones is refused (a
-// model of independent joints cannot follow a leader), or welded at the
-// position its leader at rest implies with MimicJoints::Lock.
+// tip, or a side branch). A <mimic> joint among the loaded ones follows its
+// leader (Joint::mimic; the leader must be loaded too), or is welded at the
+// position its leader at rest implies (MimicJoints::Lock), or refused
+// (MimicJoints::Refuse): never loaded as an independent joint.
 #include "zwang/urdf.hpp"
 
 #include <console_bridge/console.h>
@@ -470,9 +471,8 @@ double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const Ur
   return q;
 }
 
-// A <mimic> joint follows its leader (q = a·q_leader + b). zwang does not model
-// that coupling yet, and an independent joint in its place would be a silent
-// wrong answer: refused (MimicJoints::Refuse), with the ways around it.
+// A <mimic> joint follows its leader (q = a·q_leader + b); the caller asked
+// for none (MimicJoints::Refuse): refused, with the ways around it.
 // `chain_before` is the link before it on a chain (empty in a tree).
 [[noreturn]] void refuseMimic(const Reporter& report, const urdf::Joint& uj, const UrdfOptions& options,
                               const std::string& chain_before) {
@@ -481,20 +481,18 @@ double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const Ur
                            " (its position when '" + uj.mimic->joint_name + "' is at rest)";
   if (!chain_before.empty())
     report.fail("joint '" + uj.name + "' on the chain mimics joint '" + uj.mimic->joint_name + "' (" + mimicLaw(uj) +
-                "): mimic joints are not modelled yet and a chain of independent joints cannot keep that coupling; "
-                "choose a " +
+                "): refused (" + options.names.refuse_mimic + "); choose a " +
                 options.names.tip + " before it (e.g. '" + chain_before + "') or set " + lock);
   report.fail("joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" + mimicLaw(uj) +
-              "): mimic joints are not modelled yet, and loading it as an independent joint would be a silent "
-              "wrong answer; set " +
-              lock + ", or choose a " + options.names.tip + " for a chain without it");
+              "): refused (" + options.names.refuse_mimic + "); model it (the default), set " + lock +
+              ", or choose a " + options.names.tip + " for a chain without it");
 }
 
 // A note on a locked mimic joint (MimicLocked, which strict mode lets pass).
 ModelWarning mimicLockedNote(const urdf::Joint& uj, double q, const UrdfOptions& options) {
   return {WarningCode::MimicLocked, "joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" +
                                         mimicLaw(uj) + "): locked at q = " + fmt(q) + " (" + options.names.lock_mimic +
-                                        "; mimic joints are not modelled yet), link '" + uj.child_link_name +
+                                        "), link '" + uj.child_link_name +
                                         "' welded to link '" + uj.parent_link_name + "'"};
 }
 
@@ -632,6 +630,27 @@ void checkRotorNames(const Reporter& report, const urdf::ModelInterface& urdf_mo
         options.names.rotor_inertia + " names joint '" + entry.first + "', which is not a moving joint of " + what +
         " (its joints: " + nameList(moving) + ")" +
         (urdf_model.getJoint(entry.first) ? std::string() : std::string("; the URDF has no joint of that name")));
+  }
+}
+
+// Each loaded mimic joint follows its leader (MimicJoints::Model), which must
+// be a loaded moving joint too: a coupling to a joint outside the model
+// cannot be kept, and dropping it would be a silent wrong answer.
+void addMimicLaws(const Reporter& report, const urdf::ModelInterface& urdf_model, const UrdfOptions& options,
+                  const std::vector<std::string>& moving, const std::string& what, ModelBuilder& builder) {
+  if (options.mimic != MimicJoints::Model) return;
+  for (const std::string& name : moving) {
+    const urdf::Joint& uj = *urdf_model.getJoint(name);
+    if (!uj.mimic) continue;
+    const std::string& leader = uj.mimic->joint_name;
+    const std::string who = "joint '" + name + "' (" + mimicLaw(uj) + ") mimics joint '" + leader + "'";
+    const urdf::JointConstSharedPtr leader_joint = urdf_model.getJoint(leader);
+    if (!leader_joint) report.fail(who + ", which the URDF does not have");
+    if (!isMoving(*leader_joint)) report.fail(who + ", which is not a moving joint (a fixed, floating or planar joint)");
+    if (std::find(moving.begin(), moving.end(), leader) == moving.end())
+      report.fail(who + ", which is not in " + what + ": load a tree or chain that holds both, or set " +
+                  options.names.lock_mimic);
+    report.builder([&] { builder.setMimic(name, leader, uj.mimic->multiplier, uj.mimic->offset); });
   }
 }
 
@@ -921,6 +940,8 @@ void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, c
                 (locked ? " (its mimic joints are locked)" : ""));
   checkRotorNames(report, urdf_model, options, moving, "the chain from '" + root->name + "' to '" + tip_name + "'");
   addChain(report, builder, placement, chain, rotor, options);
+  addMimicLaws(report, urdf_model, options, moving,
+               "the chain from '" + root->name + "' to '" + tip_name + "'", builder);
   handleBeyondTip(report, builder, placement, tip_name, options);
   warnMassOffChain(placement, urdf_model, root->name, options);
 }
@@ -934,6 +955,7 @@ void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, co
   if (moving.empty())
     report.fail("the tree below root link '" + root->name + "' has no moving joint (its mimic joints are locked)");
   checkRotorNames(report, urdf_model, options, moving, "the tree below '" + root->name + "'");
+  addMimicLaws(report, urdf_model, options, moving, "the tree below '" + root->name + "'", builder);
   checkLockedPositions(report, options, {}, placement.locked_mimic, false);
 }
 

@@ -22,7 +22,7 @@ UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const p
   options.tip = tip;
   options.strict = strict;
   options.attach_beyond_tip = attach_beyond_tip;
-  options.mimic = lock_mimic ? MimicJoints::Lock : MimicJoints::Refuse;
+  options.mimic = lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
   options.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
   if (!rotor_inertia.is_none()) {
     if (!py::isinstance<py::dict>(rotor_inertia))
@@ -109,6 +109,13 @@ void bindModel(py::module_& m) {
           "placement",
           [](const Joint& j) { return transformMatrix(j.placement.rotationOfTarget(), j.placement.originOfTarget()); },
           "4×4 pose of the joint frame in the parent body frame at q = 0")
+      .def_property_readonly(
+          "mimic",
+          [](const Joint& j) -> py::object {
+    if (!j.mimic.active()) return py::none();
+    return py::make_tuple(j.mimic.leader, j.mimic.multiplier, j.mimic.offset);
+          },
+          "None, or (leader joint index, multiplier, offset) when the joint follows q = multiplier*q_leader + offset")
       .def("__repr__", &jointRepr);
 
   py::class_<Frame>(m, "Frame", "A named frame (every URDF link), rigidly attached to a body.")
@@ -150,6 +157,22 @@ void bindModel(py::module_& m) {
       .def("joint_index", &Model::jointIndex, py::arg("name"), "index of a moving joint; ModelError if unknown")
       .def("frame_index", &Model::frameIndex, py::arg("name"), "index of a frame; ModelError if unknown")
       .def("has_frame", &Model::hasFrame, py::arg("name"))
+      .def_property_readonly(
+          "mimic_joints", [](const Model& model) { return model.mimicJoints(); },
+          "indices of the joints that follow a leader (Joint.mimic)")
+      .def(
+          "follow_leaders",
+          [](const Model& model, const py::object& q, const py::object& qd) {
+    Eigen::VectorXd q_buf, qd_buf;
+    Eigen::VectorXd q_out = vectorArg("q", q, q_buf), qd_out = vectorArg("qd", qd, qd_buf);
+    if (q_out.size() != model.dof() || qd_out.size() != model.dof())
+      throw py::value_error("follow_leaders: q and qd need " + std::to_string(model.dof()) + " entries each");
+    model.followLeaders(q_out, qd_out);
+    return py::make_tuple(vectorCopy(q_out), vectorCopy(qd_out));
+          },
+          py::arg("q"), py::arg("qd"),
+          "copies of q and qd with each mimic joint's entries set from its leader's (q = a*q_leader + b, "
+          "qd = a*qd_leader)")
       .def_property_readonly("body_count", &Model::bodyCount, "dof + 1: the fixed base (body 0) and one body per joint")
       .def_property_readonly("is_chain", &Model::isChain, "True when every body's parent is the body before it")
       .def_property_readonly(
@@ -258,8 +281,9 @@ void bindModel(py::module_& m) {
       "rotor_inertia: optional {joint name: reflected inertia} overriding the URDF.\n"
       "Doubtful data loads with a zwang.ModelWarning per warning (also in Model.warnings);\n"
       "strict=True raises ModelError instead. attach_beyond_tip=True welds links behind moving joints\n"
-      "below the tip to the tip body (joints locked at 0). A <mimic> joint raises ModelError (mimic joints\n"
-      "are not modelled yet); lock_mimic=True welds it at its position when its leader is at 0.\n"
+      "below the tip to the tip body (joints locked at 0). A <mimic> joint follows its leader (its q, qd\n"
+      "must obey the law: Model.follow_leaders; its torque is carried by the leader); lock_mimic=True\n"
+      "welds it instead, at its position when its leader is at 0.\n"
       "Raises ModelError.");
   m.def(
       "load_urdf_string",

@@ -309,7 +309,7 @@ TEST_CASE("A relative constraint (\"relative_to\"): the tool and Task::addRelati
   INFO("stderr: " << r.err);
   REQUIRE(r.exit_code == 0);
   CHECK(occurrences(r.err, "zwang: warning: ") == 6);  // 4 placeholder/point-mass, 2 mimic_locked
-  CHECK(occurrences(r.err, "locked at q = 0 (\"lock_mimic\": true;") == 2);
+  CHECK(occurrences(r.err, "locked at q = 0 (\"lock_mimic\": true)") == 2);
   const Json b = parse(r.out);
   CHECK(b["joints"].size() == 17);
   CHECK(b["status"]["rank"] == 6);
@@ -1184,14 +1184,18 @@ TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8"
     CHECK(contains(solve.err, ": model: "));
     CHECK(contains(solve.err, "root link 'nowhere' not found"));
   }
-  SECTION("a mimic joint: the hint names --lock-mimic or \"lock_mimic\"; with it the model loads") {
+  SECTION("a mimic joint: modelled by default (info shows its law), locked with --lock-mimic or \"lock_mimic\"") {
     const std::string gripper = dir + "/gripper.urdf";
     cli_test::writeText(gripper, kMimicGripper);
-    const Run info = run({"info", gripper});
-    checkOneLineError(info, 1);
-    CHECK(contains(info.err, "joint 'f2' mimics joint 'f1' (q = 1·q_f1 + 0): mimic joints are not modelled yet"));
-    CHECK(contains(info.err, "set --lock-mimic to weld it at q = 0"));
-    CHECK_FALSE(contains(info.err, "UrdfOptions"));
+    const Run info = run({"info", gripper, "--json"});
+    REQUIRE(info.exit_code == 0);
+    const Json modelled = parse(info.out);
+    CHECK(modelled["dof"] == 3);
+    CHECK(modelled["warnings"].empty());
+    CHECK(modelled["joints"][2]["mimic"] == Json({{"leader", "f1"}, {"multiplier", 1.0}, {"offset", 0.0}}));
+    CHECK(modelled["joints"][1]["mimic"].is_null());
+    const Run table = run({"info", gripper});
+    CHECK(contains(table.out, "f2 follows f1: q = 1·q_f1 + 0"));
     const Run locked = run({"info", gripper, "--lock-mimic", "--json"});
     REQUIRE(locked.exit_code == 0);
     const Json j = parse(locked.out);
@@ -1200,10 +1204,20 @@ TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8"
     CHECK(j["warnings"][0]["code"] == "mimic_locked");
     CHECK(countOf(locked.err, "zwang: warning: ") == 1);
     const std::string file = dir + "/gripper.json";
-    cli_test::writeText(file, R"({"model": "gripper.urdf"})");
-    const Run refused = run({"solve", file});
-    checkOneLineError(refused, 1);
-    CHECK(contains(refused.err, "set \"lock_mimic\": true to weld it"));
+    // q of the mimic joint off its law: a one-line error naming both joints.
+    cli_test::writeText(file, R"({"model": "gripper.urdf", "q": [0.1, 0.02, 0.0]})");
+    const Run off = run({"solve", file});
+    checkOneLineError(off, 1);
+    CHECK(contains(off.err, "joint 'f2' mimics 'f1'"));
+    cli_test::writeText(file, R"({"model": "gripper.urdf", "q": [0.1, 0.02, 0.02], "tau": [0, 1, 0.5]})");
+    const Run solved_mimic = run({"solve", file});
+    INFO("stderr: " << solved_mimic.err);
+    REQUIRE(solved_mimic.exit_code == 0);
+    const Json s = parse(solved_mimic.out);
+    CHECK(s["joints"] == Json::array({"j1", "f1", "f2"}));
+    CHECK(s["tau_control"][2] == 0.0);
+    CHECK(std::abs(s["tau_control"][1].get<double>() - 1.5) < 1e-12);  // τ_f1 + 1·τ_f2
+    CHECK(std::abs(s["qdd"][2].get<double>() - s["qdd"][1].get<double>()) < 1e-12);
     cli_test::writeText(file, R"({"model": "gripper.urdf", "lock_mimic": true, "strict": true})");
     const Run solved = run({"solve", file});
     INFO("stderr: " << solved.err);

@@ -1,5 +1,5 @@
 """Kinematic trees (issue #14) from Python: the whole tree, a subtree, a chain; the tree's
-structure (parents, subtree_end, supports); mimic joints refused or locked (lock_mimic=True);
+structure (parents, subtree_end, supports); mimic joints modelled (follow_leaders) or locked (lock_mimic=True);
 constraints relative to another frame (Constraint(..., relative_to=...))."""
 import warnings
 
@@ -55,15 +55,37 @@ def test_subtree_and_chain(two_arms):
         zwang.load_urdf(TWO_ARMS, root="shoulders")
 
 
-def test_mimic_joints_refused_or_locked(baxter):
-    with pytest.raises(zwang.ModelError, match=r"joint 'l_gripper_r_finger_joint' mimics joint "
-                       r"'l_gripper_l_finger_joint'.*not modelled yet.*set lock_mimic=True to weld it at q = 0"):
-        zwang.load_urdf(BAXTER)
+def test_mimic_joints_modelled_or_locked(baxter):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", zwang.ModelWarning)
+        full = zwang.load_urdf(BAXTER)  # the default: the mimic fingers follow their leaders
+    assert full.dof == 19 and len(full.mimic_joints) == 2
+    for j in full.mimic_joints:
+        leader, multiplier, offset = full.joints[j].mimic
+        assert full.joint_names[j].endswith("_gripper_r_finger_joint")
+        assert full.joint_names[leader].endswith("_gripper_l_finger_joint")
+        assert (multiplier, offset) == (-1.0, 0.0)
+    assert full.joints[0].mimic is None
+    q, qd, tau = np.zeros(19), np.zeros(19), np.zeros(19)
+    leaders = [full.joints[j].mimic[0] for j in full.mimic_joints]
+    q[leaders], qd[leaders], tau[leaders] = 0.01, -0.02, 5.0
+    tau[full.mimic_joints] = 1.0
+    with pytest.raises(zwang.SolveError, match=r"joint 'l_gripper_r_finger_joint' mimics "
+                       r"'l_gripper_l_finger_joint'.*follow_leaders"):
+        zwang.solve(full, full.workspace(), q, qd, tau)
+    q, qd = full.follow_leaders(q, qd)
+    assert q[full.mimic_joints].tolist() == [-0.01, -0.01] and qd[full.mimic_joints].tolist() == [0.02, 0.02]
+    res = zwang.solve(full, full.workspace(), q, qd, tau)
+    qdd = np.array(res.qdd)
+    np.testing.assert_allclose(qdd[full.mimic_joints], -qdd[leaders], atol=1e-10 * (1 + np.abs(qdd).max()))
+    assert np.array(res.tau_control)[full.mimic_joints].tolist() == [0.0, 0.0]  # the leaders' motors carry them
+    np.testing.assert_allclose(np.array(res.tau_control)[leaders], 5.0 - 1.0, atol=1e-12)
+
     assert baxter.joint_names == BAXTER_JOINTS  # 19 moving joints in the file, 2 of them mimic: locked
     assert [code for code, _ in baxter.warnings].count("mimic_locked") == 2
     with pytest.warns(zwang.ModelWarning) as record:
         zwang.load_urdf(BAXTER, lock_mimic=True)
-    assert sum("locked at q = 0 (lock_mimic=True;" in str(w.message) for w in record) == 2
+    assert sum("locked at q = 0 (lock_mimic=True)" in str(w.message) for w in record) == 2
     # The lock's note passes strict mode; Baxter's placeholder inertias do not.
     with pytest.raises(zwang.ModelError, match=r"strict mode \(4 warnings\)"):
         zwang.load_urdf(BAXTER, lock_mimic=True, strict=True)

@@ -2,7 +2,8 @@
 // masses 1e-6–1e4 kg, offsets 1e-3–10 m, rotor inertias 0–1e3, friction
 // 0–1e4, limits), a state (speeds to 1e3, joints exactly stuck or on a limit),
 // wrenches, constraints on up to three frames (random, repeated or on the base:
-// singular tasks) and friction options. Calls solveHybridDynamics, both
+// singular tasks), mimic joints (laws to any other joint: chains, cycles the
+// builder refuses, states on or off the law) and friction options. Calls solveHybridDynamics, both
 // friction maximisers, RNEA, CRBA and a Jacobian.
 //
 // Fails (abort) when a call that returns Ok — or Infeasible, whose outputs
@@ -111,9 +112,16 @@ bool buildChain(FuzzedDataProvider& in, Chain& out) {
         out.frames.push_back(tool);
       }
     }
+    for (int j = 0; j < n && n > 1; ++j)
+      if (in.ConsumeProbability<double>() < 0.15) {
+        int leader = in.ConsumeIntegralInRange(0, n - 2);
+        leader += leader >= j ? 1 : 0;  // any other joint (a mimic joint too: a chain, or a cycle)
+        const double multiplier = in.ConsumeBool() ? (in.ConsumeBool() ? 1.0 : -1.0) : signedLog(in, 1e-3, 1e2);
+        builder.setMimic("j" + std::to_string(j), "j" + std::to_string(leader), multiplier, signedLog(in, 1e-3, 1.0));
+      }
     out.model = builder.build();
   } catch (const ModelError&) {
-    return false;  // e.g. a massless last link: the builder refuses it, by design
+    return false;  // e.g. a massless last link or a mimic cycle: the builder refuses it, by design
   }
   return true;
 }
@@ -166,7 +174,8 @@ bool documented(StatusCode code) {
     case StatusCode::ModelMismatch:
     case StatusCode::Degenerate:
     case StatusCode::BadOption:
-    case StatusCode::Infeasible: return true;
+    case StatusCode::Infeasible:
+    case StatusCode::MimicMismatch: return true;
   }
   return false;
 }
@@ -225,6 +234,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     qd[j] = in.ConsumeBool() ? 0.0 : signedLog(in, 1e-9, 1e3);
     tau[j] = signedLog(in, 1e-3, 1e4);
   }
+  if (in.ConsumeProbability<double>() < 0.9) model.followLeaders(q, qd);  // else most likely MimicMismatch
   // Occasionally a non-finite input: must come back as NonFinite, not as a crash.
   const int poison = in.ConsumeIntegralInRange(0, 40);
   if (poison < n) {

@@ -1,8 +1,9 @@
 // libFuzzer target: URDF text → loadUrdfString (whole trees, since no tip is
-// given; again with MimicJoints::Lock when the text has a <mimic>). The only
-// exception allowed out of the loader is ModelError; a model that loads must
-// then solve (zero state, gravity) with finite outputs or a documented error
-// status.
+// given; mimic joints modelled, and again with MimicJoints::Lock when the
+// text has a <mimic>). The only exception allowed out of the loader is
+// ModelError; a model that loads must then solve (the zero state with each
+// mimic joint where its leader puts it, gravity) with finite outputs or a
+// documented error status.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -26,7 +27,9 @@ void loadAndSolve(const std::string& xml, const zwang::UrdfOptions& options) {
   Task task(model);
   Workspace ws(model, task);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.dof());
-  const Status status = solveHybridDynamics(model, task, zero, zero, zero, ws);
+  Eigen::VectorXd q = zero, qd = zero;
+  model.followLeaders(q, qd);  // a mimic joint's offset
+  const Status status = solveHybridDynamics(model, task, q, qd, zero, ws);
   if (status.ok()) {
     fuzz::requireFinite(ws.solution.qdd, "qdd", "solveHybridDynamics on a loaded URDF");
     fuzz::requireFinite(ws.solution.tau_control, "tau_control", "solveHybridDynamics on a loaded URDF");

@@ -34,6 +34,20 @@ class ModelError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// How the base (body 0: the root link and the links welded to it) is attached
+/// to the world (docs/conventions.md, "Floating base").
+///   Fixed  : bolted down (no base coordinates);
+///   Free   : a free-flyer, unactuated: q_base = [x, y, z, q_w, q_x, q_y, q_z]
+///            (the base origin in the world, the unit quaternion of the base's
+///            orientation), v_base = [v; ω], the velocity of the base origin and
+///            the angular velocity, both in base axes (Pinocchio's convention);
+///   Planar : a mobile base moving in a plane, unactuated: q_base = [x, y, ψ],
+///            v_base = [ẋ, ẏ, ψ̇] in the plane's axes (the world's, unless the
+///            base placement turns the plane), ψ the yaw about the plane's normal.
+enum class BaseType { Fixed, Free, Planar };
+/// "fixed", "free" or "planar".
+const char* toString(BaseType type);
+
 /// The kinds of moving joint, as URDF names them.
 enum class JointType { Revolute, Continuous, Prismatic };
 /// The URDF name of a joint type: "revolute", "continuous" or "prismatic".
@@ -132,10 +146,29 @@ struct Frame {
 /// The robot: a tree of moving joints and rigid bodies, immutable once built (ModelBuilder, loadUrdfFile).
 class Model {
  public:
-  /// Number of moving joints n (the length of q, q̇, τ, q̈).
+  /// Number of moving (1-DOF) joints n. On a fixed base this is the length of
+  /// q, q̇, τ and q̈; a floating base puts its coordinates in front (nq(), nv()).
   int dof() const { return static_cast<int>(joints_.size()); }
-  /// Number of bodies, n + 1 with the fixed base.
+  /// Number of bodies, n + 1 with the base (body 0).
   int bodyCount() const { return dof() + 1; }
+  /// How the base is attached to the world.
+  BaseType baseType() const { return base_type_; }
+  /// True for a Free or Planar base: body 0 moves, unactuated.
+  bool hasFloatingBase() const { return base_type_ != BaseType::Fixed; }
+  /// Entries of q for the base: 0 (fixed), 7 (free), 3 (planar).
+  int baseConfigurationSize() const {
+    return base_type_ == BaseType::Free ? 7 : base_type_ == BaseType::Planar ? 3 : 0;
+  }
+  /// Entries of q̇, τ, q̈ for the base: 0 (fixed), 6 (free), 3 (planar).
+  int baseVelocitySize() const { return base_type_ == BaseType::Free ? 6 : base_type_ == BaseType::Planar ? 3 : 0; }
+  /// Length of q: the base's coordinates, then one per joint.
+  int nq() const { return baseConfigurationSize() + dof(); }
+  /// Length of q̇, τ and q̈: the base's velocity coordinates, then one per joint.
+  int nv() const { return baseVelocitySize() + dof(); }
+  /// Planar base: the plane's frame in the world, ᴾX_world (its x, y span the
+  /// plane, z is the yaw axis; identity: the world's XY plane at height 0).
+  /// Identity for the other bases.
+  const Transform& basePlacement() const { return base_placement_; }
   /// The robot's name (URDF `<robot name>`).
   const std::string& name() const { return name_; }
 
@@ -190,6 +223,8 @@ class Model {
   std::vector<int> parents_{-1};     // bodyCount() entries, parents_[0] = −1
   std::vector<int> subtree_end_{1};  // bodyCount() entries
   bool is_chain_ = true;
+  BaseType base_type_ = BaseType::Fixed;
+  Transform base_placement_;
   std::vector<int> mimic_joints_;
   std::vector<ModelWarning> warnings_;
 };
@@ -230,6 +265,12 @@ class ModelBuilder {
   /// chain to its first leader, and refuses a cycle. ModelError for an unknown
   /// joint, a joint that mimics itself, or a multiplier or offset that is not finite.
   ModelBuilder& setMimic(const std::string& joint, const std::string& leader, double multiplier, double offset);
+
+  /// Let the base float: a free-flyer or a planar joint between the world and
+  /// body 0 (unactuated). `placement` is the plane's frame for a Planar base
+  /// (ᴾX_world; must be identity for Free). ModelError when the base already
+  /// floats (the URDF had a floating root joint, say) or the placement is not finite.
+  ModelBuilder& setBase(BaseType type, const Transform& placement = Transform{});
 
   /// Checks the whole tree (every moving joint must carry some inertia, every
   /// moving body's merged inertia is positive semi-definite to rounding) and

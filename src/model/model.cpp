@@ -280,6 +280,28 @@ ModelBuilder& ModelBuilder::setFriction(const std::string& joint, double breakaw
   return *this;
 }
 
+const char* toString(BaseType type) {
+  switch (type) {
+    case BaseType::Fixed: return "fixed";
+    case BaseType::Free: return "free";
+    case BaseType::Planar: return "planar";
+  }
+  return "unknown";
+}
+
+ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement) {
+  if (model_.base_type_ != BaseType::Fixed)
+    throw ModelError(std::string("the base already floats (a ") + toString(model_.base_type_) +
+                     " joint under the root link '" + model_.frames_[0].name + "'): it cannot get a " +
+                     toString(type) + " base as well");
+  if (!finite(placement)) throw ModelError("base placement is not finite");
+  if (type == BaseType::Free && !(placement.E.isIdentity(0.0) && placement.r.isZero(0.0)))
+    throw ModelError("a free base takes no placement (its pose is its configuration)");
+  model_.base_type_ = type;
+  model_.base_placement_ = placement;
+  return *this;
+}
+
 ModelBuilder& ModelBuilder::setMimic(const std::string& joint, const std::string& leader, double multiplier,
                                      double offset) {
   const std::string where = "joint '" + joint + "' (mimic of '" + leader + "')";
@@ -355,7 +377,19 @@ Model ModelBuilder::build() const {
                        "' would have no inertia to move)");
     }
   }
+  if (model_.hasFloatingBase()) {
+    // Body 0 moves: its inertia (the root link and what is welded to it) now
+    // enters the dynamics, so it gets the checks the other bodies got.
+    const std::string link = model_.frames_[0].name;
+    if (mass_beyond[0] + model_.inertias_[0].mass + model_.inertias_[0].Ibar.trace() <= 0.0)
+      throw ModelError("link '" + link + "': a floating base with no mass anywhere in the robot");
+  }
   Model model = model_;
+  if (model.hasFloatingBase())
+    for (const ModelWarning& w :
+         validate::rigidInertia("base body of link '" + model.frames_[0].name + "' (with the links welded to it)",
+                                model.inertias_[0]))
+      model.warnings_.push_back(w);
   resolveMimicChains(model.joints_, model.mimic_joints_);
   return model;
 }

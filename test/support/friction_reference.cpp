@@ -86,17 +86,22 @@ FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd
     s.viscous(j) = joint.damping;   // URDF <dynamics damping>
     if (std::abs(qd(j)) <= velocity_tolerance && !joint.isMimic()) s.stuck.push_back(j);
   }
+  foldMimicFriction(spec, s);
+  return s;
+}
+
+void foldMimicFriction(const ChainSpec& spec, FrictionSetup& setup) {
   // A mimic joint moves with its leader (q̇_m = a·q̇_l): its friction torque
   // −f_m sign(q̇_m) − b_m q̇_m does the work of a times it at the leader, so it
   // folds into the leader's box: f_l + |a|·f_m (kinetic alike), b_l + a²·b_m.
   for (const MimicLaw& law : spec.mimicLaws()) {
     const double a = law.multiplier;
-    s.breakaway(law.leader) += std::abs(a) * s.breakaway(law.joint);
-    s.kinetic(law.leader) += std::abs(a) * s.kinetic(law.joint);
-    s.viscous(law.leader) += a * a * s.viscous(law.joint);
-    s.breakaway(law.joint) = s.kinetic(law.joint) = s.viscous(law.joint) = 0.0;
+    setup.breakaway(law.leader) += std::abs(a) * setup.breakaway(law.joint);
+    setup.kinetic(law.leader) += std::abs(a) * setup.kinetic(law.joint);
+    setup.viscous(law.leader) += a * a * setup.viscous(law.joint);
+    setup.breakaway(law.joint) = setup.kinetic(law.joint) = setup.viscous(law.joint) = 0.0;
+    setup.stuck.erase(std::remove(setup.stuck.begin(), setup.stuck.end(), law.joint), setup.stuck.end());
   }
-  return s;
 }
 
 Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd& qd) {

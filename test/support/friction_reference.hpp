@@ -69,6 +69,10 @@ struct FrictionSetup {
 // breakaway f_l + |a|·f_m, kinetic likewise, viscous b_l + a²·b_m, its own 0
 // (the same motion: its torque does a times its work at the leader).
 FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd& qd, double velocity_tolerance = 1e-6);
+// That folding on any setup (per-dof values as given, e.g. a solve's
+// overrides): each mimic joint's breakaway, kinetic and viscous friction onto
+// its resolved leader (|a|, |a|, a²), its own set to 0, and it leaves Θ₀.
+void foldMimicFriction(const ChainSpec& spec, FrictionSetup& setup);
 
 // −f_c,j sign(q̇_j) − b_j q̇_j on the moving joints, 0 on the stuck ones.
 Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd& qd);

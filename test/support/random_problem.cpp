@@ -70,9 +70,8 @@ DynamicsInput randomProblem(std::mt19937_64& rng, const ChainSpec& spec, const R
 }
 
 Model modelFromSpec(const ChainSpec& spec) {
-  // The URDF loader does not model <mimic> (it refuses or locks such joints):
-  // a spec with mimic joints goes through the builder.
-  return spec.isChain() && !spec.hasMimic() ? loadUrdfString(toUrdf(spec)) : modelFromSpecByBuilder(spec);
+  // A chain's <mimic> joints are loaded as mimic joints (UrdfOptions::mimic = MimicJoints::Model, the default).
+  return spec.isChain() ? loadUrdfString(toUrdf(spec)) : modelFromSpecByBuilder(spec);
 }
 
 Model modelFromSpecByBuilder(const ChainSpec& spec) {

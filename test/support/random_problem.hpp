@@ -24,8 +24,8 @@ struct RandomProblemOptions {
 // leaders (ChainSpec::followMimicLaws; no draws of their own beyond the rest).
 DynamicsInput randomProblem(std::mt19937_64& rng, const ChainSpec& spec, const RandomProblemOptions& options = {});
 
-// The chain through the URDF loader (writer → loader: both are exercised); a
-// tree, or a spec with mimic joints, through the ModelBuilder (modelFromSpecByBuilder).
+// The chain through the URDF loader (writer → loader: both are exercised,
+// <mimic> included); a tree through the ModelBuilder (modelFromSpecByBuilder).
 Model modelFromSpec(const ChainSpec& spec);
 // The spec built joint by joint with the ModelBuilder, as the URDF loader
 // would; then ModelBuilder::setMimic for each mimic joint, as written.

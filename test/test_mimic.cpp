@@ -113,12 +113,13 @@ struct FingerTerms {
 };
 FingerTerms fingerTerms(const Finger& f, double q, const Eigen::Vector3d& g) {
   const Eigen::Matrix3d R_joint = rpyToMatrix(kPalmRpy) * rpyToMatrix(f.rpy);  // joint frame in the world
-  const Eigen::Vector3d u = R_joint * f.axis;                                   // the axis in the world
+  const Eigen::Vector3d u = R_joint * f.axis;                                  // the axis in the world
   if (f.type == "prismatic") return {f.mass + f.rotor, f.mass * g.dot(u)};
   // About the axis through the joint origin: the COM's own moment plus the
   // parallel-axis term (a rotation about the axis leaves both unchanged).
   const Eigen::Matrix3d R_in = rpyToMatrix(f.inertial_rpy);
-  const double J = f.axis.dot(R_in * f.inertia * R_in.transpose() * f.axis) + f.mass * f.axis.cross(f.com).squaredNorm();
+  const double J =
+      f.axis.dot(R_in * f.inertia * R_in.transpose() * f.axis) + f.mass * f.axis.cross(f.com).squaredNorm();
   const Eigen::Vector3d r = R_joint * (Eigen::AngleAxisd(q, f.axis) * f.com);  // joint origin → COM, world
   return {J + f.rotor, u.dot(r.cross(f.mass * g))};
 }
@@ -434,7 +435,7 @@ TEST_CASE("gripper, closed form: a chain of mimics m → k → l resolves to the
 
 TEST_CASE("mimic trees: q̈, ν and τ_control match the dense KKT reference (300+ random trees)", "[mimic]") {
   std::mt19937_64 rng(20261125);
-  RandomTreeOptions tree;  // 2–30 moving joints, branching 1–4, fixed joints, rotors
+  RandomTreeOptions tree;            // 2–30 moving joints, branching 1–4, fixed joints, rotors
   RandomMimicOptions mimic_options;  // 1–3 mimic joints, a ∈ [−2, 2], b ∈ [−0.5, 0.5], chains 30 %
   int accepted = 0, attempts = 0, mimics = 0, chains = 0, negative = 0, rows_total = 0, relative_rows = 0,
       with_rows = 0, most_rows = 0, largest = 0, leader_below = 0, other_branch = 0, via_urdf = 0;
@@ -527,8 +528,8 @@ TEST_CASE("mimic trees: q̈, ν and τ_control match the dense KKT reference (30
       "  max rel. error qdd %.2e, nu %.2e, tau_control %.2e, tau_c %.2e, closure %.2e, Gauss %.2e, "
       "drive by tau_control %.2e\n"
       "  mimic law qdd_m - a qdd_l %.2e, balance residual %.2e, resolved laws vs by hand %.2e\n",
-      accepted, attempts, via_urdf, largest, mimics, chains, negative, leader_below, other_branch, with_rows, rows_total,
-      relative_rows, most_rows, e_qdd, e_nu, e_tau, e_tau_c, e_closure, e_gauss, e_drive, e_law, e_balance,
+      accepted, attempts, via_urdf, largest, mimics, chains, negative, leader_below, other_branch, with_rows,
+      rows_total, relative_rows, most_rows, e_qdd, e_nu, e_tau, e_tau_c, e_closure, e_gauss, e_drive, e_law, e_balance,
       e_model_law);
   CHECK(e_model_law < 1e-14);
   CHECK(via_urdf > 30);
@@ -542,8 +543,7 @@ TEST_CASE("mimic trees: q̈, ν and τ_control match the dense KKT reference (30
 // 3. Friction: brute force with the mimic friction folded into the leader
 // ===========================================================================
 
-TEST_CASE("mimic trees: friction matches the brute-force enumeration of stick/slip patterns (150+ trees)",
-          "[mimic]") {
+TEST_CASE("mimic trees: friction matches the brute-force enumeration of stick/slip patterns (150+ trees)", "[mimic]") {
   std::mt19937_64 rng(161803);
   RandomMimicOptions mimic_options;
   mimic_options.max_mimics = 2;
@@ -780,9 +780,9 @@ TEST_CASE("friction: a task that drives a stuck leader into its limit through tw
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
     const Status status = solveWithFriction(model, task, d.input.q, d.input.qd, d.input.tau, ws, draw.options);
-    INFO((with_mimic ? "with" : "without") << " the mimic joint: status " << static_cast<int>(status.code) << " '"
-                                           << status.message << "', mu at the leader " << ws.friction.mu(2)
-                                           << ", qdd " << ws.solution.qdd.transpose());
+    INFO((with_mimic ? "with" : "without")
+         << " the mimic joint: status " << static_cast<int>(status.code) << " '" << status.message
+         << "', mu at the leader " << ws.friction.mu(2) << ", qdd " << ws.solution.qdd.transpose());
     CHECK(status.code == StatusCode::Infeasible);
   }
 }
@@ -848,7 +848,7 @@ TEST_CASE("mimic errors: q or q̇ off the law is MimicMismatch, naming both join
       const Status s = friction ? solveWithFriction(model, task, q_off, qd_off, tau, ws)
                                 : solveHybridDynamics(model, task, q_off, qd_off, tau, ws);
       INFO((velocity ? "qd" : "q") << " off, " << (friction ? "solveWithFriction" : "solveHybridDynamics") << ": "
-                                    << s.message);
+                                   << s.message);
       CHECK(s.code == StatusCode::MimicMismatch);
       CHECK(contains(s.message, "'finger2'"));
       CHECK(contains(s.message, "'finger1'"));
@@ -982,8 +982,8 @@ TEST_CASE("mimic errors: a workspace made for the model without mimic joints has
     INFO("workspace: " << ws.constraintCapacity() << " rows, " << ws.balanceCapacity() << " balance rows, "
                        << ws.columnCapacity() << " columns; task: " << task.balanceRows() << " balance rows, "
                        << task.solverColumns() << " columns");
-    const Status s = friction ? solveWithFriction(mimic, task, q, qd, tau, ws)
-                              : solveHybridDynamics(mimic, task, q, qd, tau, ws);
+    const Status s =
+        friction ? solveWithFriction(mimic, task, q, qd, tau, ws) : solveHybridDynamics(mimic, task, q, qd, tau, ws);
     INFO((friction ? "solveWithFriction: " : "solveHybridDynamics: ") << s.message);
     CHECK((s.code == StatusCode::WorkspaceTooSmall || s.code == StatusCode::ModelMismatch));
   }
@@ -1030,8 +1030,7 @@ TEST_CASE("a solve on a model with mimic joints allocates nothing (with and with
       allocationsDuring([&] { status = solveHybridDynamics(model, task, q_off, in.qd, in.tau, ws); });
   CHECK(status.code == StatusCode::MimicMismatch);
   CHECK(error_count == 0);
-  std::printf("mimic allocations: %ld in 20 solves (10 with friction), %ld for a MimicMismatch\n", count,
-              error_count);
+  std::printf("mimic allocations: %ld in 20 solves (10 with friction), %ld for a MimicMismatch\n", count, error_count);
 }
 #endif
 

@@ -103,8 +103,8 @@ struct DenseResult {
   Eigen::VectorXd tau_control;
   int user_rows = 0;   // the input's constraint rows (the first rows of G and ν)
   int mimic_rows = 0;  // one per mimic joint (the last rows of G and ν)
-  double gauss = 0.0;     // Z(q̈) of docs/theory.md §1 at the solution
-  Eigen::MatrixXd G;      // m×n constraint rows: G q̈ = gamma
+  double gauss = 0.0;  // Z(q̈) of docs/theory.md §1 at the solution
+  Eigen::MatrixXd G;   // m×n constraint rows: G q̈ = gamma
   Eigen::VectorXd gamma;
   std::vector<Eigen::Isometry3d> poses;  // ⁰T_link for every link
   std::vector<Vector6d> acc_world;       // classical [p̈; ω̇] of every link origin, world axes

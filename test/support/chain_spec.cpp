@@ -44,6 +44,59 @@ void ChainSpec::check() const {
       throw std::invalid_argument(where + "joint " + joints[k].name + " has a parent after its child");
 }
 
+std::vector<int> ChainSpec::directLeaders() const {
+  const std::vector<int> moving = movingJoints();
+  std::vector<int> leaders(moving.size(), -1);
+  for (std::size_t j = 0; j < moving.size(); ++j) {
+    const JointSpec& joint = joints[static_cast<std::size_t>(moving[j])];
+    if (!joint.isMimic()) continue;
+    for (std::size_t l = 0; l < moving.size(); ++l)
+      if (joints[static_cast<std::size_t>(moving[l])].name == joint.mimic) leaders[j] = static_cast<int>(l);
+    if (leaders[j] < 0 || leaders[j] == static_cast<int>(j))
+      throw std::invalid_argument("ChainSpec '" + name + "': joint " + joint.name + " mimics '" + joint.mimic +
+                                  "', which is not another moving joint");
+  }
+  return leaders;
+}
+
+bool ChainSpec::hasMimic() const {
+  for (const JointSpec& joint : joints)
+    if (!joint.isFixed() && joint.isMimic()) return true;
+  return false;
+}
+
+std::vector<MimicLaw> ChainSpec::mimicLaws() const {
+  const std::vector<int> moving = movingJoints();
+  const std::vector<int> leaders = directLeaders();
+  std::vector<MimicLaw> laws;
+  for (std::size_t j = 0; j < moving.size(); ++j) {
+    if (leaders[j] < 0) continue;
+    // Substitute the leader's own law while it is a mimic joint: q_j = a·q_k + b
+    // with q_k = a'·q_l + b' is q_j = (a·a')·q_l + (a·b' + b).
+    MimicLaw law;
+    law.joint = static_cast<int>(j);
+    law.leader = static_cast<int>(j);
+    for (std::size_t steps = 0; leaders[static_cast<std::size_t>(law.leader)] >= 0; ++steps) {
+      if (steps > moving.size())
+        throw std::invalid_argument("ChainSpec '" + name + "': the mimic joints through " +
+                                    joints[static_cast<std::size_t>(moving[j])].name + " form a cycle");
+      const JointSpec& here = joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(law.leader)])];
+      law.offset += law.multiplier * here.mimic_offset;
+      law.multiplier *= here.mimic_multiplier;
+      law.leader = leaders[static_cast<std::size_t>(law.leader)];
+    }
+    laws.push_back(law);
+  }
+  return laws;
+}
+
+void ChainSpec::followMimicLaws(Eigen::VectorXd& q, Eigen::VectorXd& qd) const {
+  for (const MimicLaw& law : mimicLaws()) {
+    q(law.joint) = law.multiplier * q(law.leader) + law.offset;
+    if (qd.size() > 0) qd(law.joint) = law.multiplier * qd(law.leader);
+  }
+}
+
 bool ChainSpec::isChain() const {
   for (std::size_t k = 0; k < joints.size(); ++k)
     if (parentLink(k) != static_cast<int>(k)) return false;

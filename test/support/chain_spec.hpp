@@ -42,11 +42,27 @@ struct JointSpec {
   // Index into ChainSpec::links of the parent link; −1: links[k] for joints[k]
   // (a chain). The child of joints[k] is always links[k + 1].
   int parent = -1;
+  // URDF <mimic joint= multiplier= offset=>: this joint follows the moving joint
+  // named `mimic` (empty: independent), q = mimic_multiplier·q_mimic + mimic_offset.
+  // The leader may itself be a mimic joint (ChainSpec::mimicLaws resolves it).
+  std::string mimic;
+  double mimic_multiplier = 1.0, mimic_offset = 0.0;
 
   bool isFixed() const { return type == "fixed"; }
   bool isPrismatic() const { return type == "prismatic"; }
+  bool isMimic() const { return !mimic.empty(); }
   // rotor_inertia · gear_ratio² (docs/conventions.md, "Joints, links, frames"); 0 for fixed joints.
   double reflectedInertia() const { return isFixed() ? 0.0 : rotor_inertia * gear_ratio * gear_ratio; }
+};
+
+// A mimic joint's law resolved to its first independent leader, in dof
+// indices: q[joint] = multiplier·q[leader] + offset (so q̇ and q̈ scale by
+// multiplier). Composed along a chain of mimics: m → k → l with
+// q_m = a·q_k + b, q_k = a'·q_l + b' gives q_m = a·a'·q_l + a·b' + b.
+struct MimicLaw {
+  int joint = -1;   // the mimic joint (dof index)
+  int leader = -1;  // its first independent leader (dof index)
+  double multiplier = 1.0, offset = 0.0;
 };
 
 // A serial chain or a tree: joints[k] connects the parent link
@@ -72,8 +88,19 @@ struct ChainSpec {
   // naming the link when there is none.
   int linkIndex(const std::string& name) const;
   // Throws std::invalid_argument when the sizes or joint types are inconsistent,
-  // an axis is not unit, or a name repeats.
+  // an axis is not unit, or a name repeats. (A mimic naming a joint that is
+  // not a moving one, or itself, is left to the model builder to refuse, as
+  // is a cycle: the error tests need such specs.)
   void check() const;
+  // The dof index of each mimic joint's direct leader (−1: independent), per dof.
+  std::vector<int> directLeaders() const;
+  // Every mimic joint's law resolved to its first independent leader, in dof
+  // order; std::invalid_argument for a cycle or a leader that is not a moving joint.
+  std::vector<MimicLaw> mimicLaws() const;
+  // True when some moving joint is a mimic joint.
+  bool hasMimic() const;
+  // Set every mimic joint's q and q̇ from its resolved leader (q̇ may be empty).
+  void followMimicLaws(Eigen::VectorXd& q, Eigen::VectorXd& qd) const;
 };
 
 // R = Rz(yaw)·Ry(pitch)·Rx(roll) for rpy = (roll, pitch, yaw) (URDF).

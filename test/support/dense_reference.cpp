@@ -1,5 +1,6 @@
 #include "support/dense_reference.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -219,11 +220,16 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
   const DenseKinematics kin = denseKinematics(spec, input.q, input.qd);
   const int n = spec.dof();
   if (input.tau.size() != n) throw std::invalid_argument("dense reference: tau must have spec.dof() entries");
-  const int m = input.constraintRows();
+  const int m_user = input.constraintRows();
+  const std::vector<int> leaders = spec.directLeaders();  // per dof, −1: independent
+  const int m_mimic = static_cast<int>(std::count_if(leaders.begin(), leaders.end(), [](int l) { return l >= 0; }));
+  const int m = m_user + m_mimic;
   const std::vector<Vector6d> f_ext = externalWrenches(spec, kin, input.wrenches);
   const Vector6d g = stack(input.gravity, Eigen::Vector3d::Zero());
 
   DenseResult out;
+  out.user_rows = m_user;
+  out.mimic_rows = m_mimic;
   out.poses = kin.poses;
   out.H = kin.reflected.asDiagonal();
   out.C = Eigen::VectorXd::Zero(n);
@@ -261,6 +267,15 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
       out.gamma(row) = c.b(col) - A_world.dot(kin.bias[li]) - l.dot(omega.cross(pdot));
     }
   }
+  // Mimic rows q̈_m − a·q̈_k = 0 (k the direct leader), after the user's.
+  const std::vector<int> moving = spec.movingJoints();
+  for (int j = 0; j < n; ++j) {
+    if (leaders[static_cast<std::size_t>(j)] < 0) continue;
+    const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
+    out.G(row, j) += 1.0;
+    out.G(row, leaders[static_cast<std::size_t>(j)]) -= joint.mimic_multiplier;
+    ++row;
+  }
 
   // KKT: [H −Gᵀ; G 0][q̈; ν] = [τ − C; γ], full-pivot LU in long double and
   // one step of iterative refinement (residual also in long double).
@@ -276,6 +291,11 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
   out.qdd = x.head(n).cast<double>();
   out.nu = x.tail(m).cast<double>();
   out.tau_c = out.G.transpose() * out.nu;
+  out.tau_control = input.tau + out.tau_c;
+  for (const MimicLaw& law : spec.mimicLaws()) {  // resolved leaders are independent: any order
+    out.tau_control(law.leader) += law.multiplier * out.tau_control(law.joint);
+    out.tau_control(law.joint) = 0.0;
+  }
 
   // Accelerations of every link and the Gauss function at the solution.
   out.acc_world.resize(spec.links.size());

@@ -15,6 +15,11 @@
 //   C         = Σ_i J_iᵀ (I_i J̇_i q̇ + v_i ×* I_i v_i − f_ext,i − f_grav,i),
 //               f_grav,i = I_i [g; 0];
 //   KKT       [H −Gᵀ; G 0] [q̈; ν] = [τ − C; γ]  (H q̈ + C = τ + Σ Jᵀ A ν).
+// Mimic joints (JointSpec::mimic, q_m = a·q_k + b with k its DIRECT leader):
+// one row e_mᵀ − a·e_kᵀ each (γ = 0), after the user's rows, in dof order.
+// Chains of mimics are not resolved for the rows (the direct rows span the
+// same constraint as the resolved ones); only the folded control torque uses
+// the resolved laws (ChainSpec::mimicLaws).
 // A constraint column [l; r] (unit force l and moment r acting at the link
 // origin) constrains lᵀ p̈ + rᵀ ω̇ = b, p̈ the classical acceleration of the link
 // origin; the wrench A ν is applied to the link at its origin (docs/solver.md, "Sign of ν").
@@ -90,10 +95,16 @@ struct DenseResult {
   Eigen::MatrixXd H;      // n×n joint-space inertia
   Eigen::VectorXd C;      // bias (Coriolis, centrifugal, gravity, −external)
   Eigen::VectorXd qdd;    // q̈
-  Eigen::VectorXd nu;     // ν, rows in input order (constraint by constraint)
-  Eigen::VectorXd tau_c;  // Σ J_iᵀ A_i ν_i = Gᵀ ν (physical constraint torques)
-  double gauss = 0.0;     // Z(q̈) of docs/theory.md §1 at the solution
-  Eigen::MatrixXd G;      // m×n constraint rows: G q̈ = gamma
+  Eigen::VectorXd nu;     // ν, rows in input order (constraint by constraint), then one per mimic joint
+  Eigen::VectorXd tau_c;  // Σ J_iᵀ A_i ν_i = Gᵀ ν (physical constraint torques, mimic couplings included)
+  // τ + Gᵀν with every mimic joint's entry carried by its resolved leader:
+  // τ_ctrl[l] += a·τ_ctrl[m], τ_ctrl[m] = 0 (power equivalence, q̇_m = a·q̇_l);
+  // τ + tau_c without mimic joints.
+  Eigen::VectorXd tau_control;
+  int user_rows = 0;   // the input's constraint rows (the first rows of G and ν)
+  int mimic_rows = 0;  // one per mimic joint (the last rows of G and ν)
+  double gauss = 0.0;  // Z(q̈) of docs/theory.md §1 at the solution
+  Eigen::MatrixXd G;   // m×n constraint rows: G q̈ = gamma
   Eigen::VectorXd gamma;
   std::vector<Eigen::Isometry3d> poses;  // ⁰T_link for every link
   std::vector<Vector6d> acc_world;       // classical [p̈; ω̇] of every link origin, world axes

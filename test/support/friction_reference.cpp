@@ -84,9 +84,24 @@ FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd
     s.breakaway(j) = joint.friction;
     s.kinetic(j) = joint.friction;  // default f_c = f: docs/friction.md, "The model of friction"
     s.viscous(j) = joint.damping;   // URDF <dynamics damping>
-    if (std::abs(qd(j)) <= velocity_tolerance) s.stuck.push_back(j);
+    if (std::abs(qd(j)) <= velocity_tolerance && !joint.isMimic()) s.stuck.push_back(j);
   }
+  foldMimicFriction(spec, s);
   return s;
+}
+
+void foldMimicFriction(const ChainSpec& spec, FrictionSetup& setup) {
+  // A mimic joint moves with its leader (q̇_m = a·q̇_l): its friction torque
+  // −f_m sign(q̇_m) − b_m q̇_m does the work of a times it at the leader, so it
+  // folds into the leader's box: f_l + |a|·f_m (kinetic alike), b_l + a²·b_m.
+  for (const MimicLaw& law : spec.mimicLaws()) {
+    const double a = law.multiplier;
+    setup.breakaway(law.leader) += std::abs(a) * setup.breakaway(law.joint);
+    setup.kinetic(law.leader) += std::abs(a) * setup.kinetic(law.joint);
+    setup.viscous(law.leader) += a * a * setup.viscous(law.joint);
+    setup.breakaway(law.joint) = setup.kinetic(law.joint) = setup.viscous(law.joint) = 0.0;
+    setup.stuck.erase(std::remove(setup.stuck.begin(), setup.stuck.end(), law.joint), setup.stuck.end());
+  }
 }
 
 Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd& qd) {
@@ -323,15 +338,18 @@ FrictionDraw frictionDrawOn(std::mt19937_64& rng, ChainSpec spec, int min_stuck,
     }
     d.input.qd(j) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
   }
-  // Choose the stuck joints.
-  const int k = uniformInt(rng, std::min(min_stuck, n), std::min(max_stuck, n));
-  std::vector<int> all(static_cast<std::size_t>(n));
-  for (int j = 0; j < n; ++j) all[static_cast<std::size_t>(j)] = j;
+  // Choose the stuck joints among the independent ones (all of them without mimic joints).
+  std::vector<int> all;
+  for (int j = 0; j < n; ++j)
+    if (!d.spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])].isMimic()) all.push_back(j);
+  const int free = static_cast<int>(all.size());
+  const int k = uniformInt(rng, std::min(min_stuck, free), std::min(max_stuck, free));
   for (int s = 0; s < k; ++s)  // partial Fisher–Yates with the portable uniformInt
-    std::swap(all[static_cast<std::size_t>(s)], all[static_cast<std::size_t>(uniformInt(rng, s, n - 1))]);
+    std::swap(all[static_cast<std::size_t>(s)], all[static_cast<std::size_t>(uniformInt(rng, s, free - 1))]);
   std::vector<int> stuck(all.begin(), all.begin() + k);
   std::sort(stuck.begin(), stuck.end());
   for (int j : stuck) d.input.qd(j) = 0.0;
+  d.spec.followMimicLaws(d.input.q, d.input.qd);  // mimic joints where their leaders put them
   d.setup = frictionSetupFromSpec(d.spec, d.input.qd);
   return d;
 }
@@ -354,6 +372,17 @@ FrictionDraw randomTreeFrictionDraw(std::mt19937_64& rng, int min_dof, int max_d
   tree.max_moving_joints = max_dof;
   ChainSpec spec = randomTree(rng, tree);
   return frictionDrawOn(rng, std::move(spec), 1, max_stuck, max_rows, relative_probability);
+}
+
+FrictionDraw randomTreeMimicFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, int max_stuck, int max_rows,
+                                         double relative_probability, const RandomMimicOptions& mimics) {
+  RandomTreeOptions tree;
+  tree.min_moving_joints = min_dof;
+  tree.max_moving_joints = max_dof;
+  ChainSpec spec = randomTree(rng, tree);
+  const int k = addRandomMimics(rng, spec, mimics);
+  const int rows = std::min(max_rows, spec.dof() - k);  // more rows than independent joints can never be met
+  return frictionDrawOn(rng, std::move(spec), 1, max_stuck, rows, relative_probability);
 }
 
 bool wellPosed(const DenseResult& dense, int rows, double max_condition) {

@@ -48,6 +48,7 @@
 
 #include "support/chain_spec.hpp"
 #include "support/dense_reference.hpp"
+#include "support/random_chain.hpp"
 
 namespace zwang::testing {
 
@@ -63,8 +64,15 @@ struct FrictionSetup {
 
 // Friction data as the model would read it from the spec's URDF: breakaway =
 // kinetic = <dynamics friction>, damping = <dynamics damping>; Θ₀ = joints
-// with |q̇_j| ≤ velocity_tolerance; no limits.
+// with |q̇_j| ≤ velocity_tolerance; no limits. A mimic joint (resolved law
+// q_m = a·q_l + b) is never in Θ₀ and its friction folds into its leader's:
+// breakaway f_l + |a|·f_m, kinetic likewise, viscous b_l + a²·b_m, its own 0
+// (the same motion: its torque does a times its work at the leader).
 FrictionSetup frictionSetupFromSpec(const ChainSpec& spec, const Eigen::VectorXd& qd, double velocity_tolerance = 1e-6);
+// That folding on any setup (per-dof values as given, e.g. a solve's
+// overrides): each mimic joint's breakaway, kinetic and viscous friction onto
+// its resolved leader (|a|, |a|, a²), its own set to 0, and it leaves Θ₀.
+void foldMimicFriction(const ChainSpec& spec, FrictionSetup& setup);
 
 // −f_c,j sign(q̇_j) − b_j q̇_j on the moving joints, 0 on the stuck ones.
 Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd& qd);
@@ -139,6 +147,13 @@ FrictionDraw randomFrictionDraw(std::mt19937_64& rng, int min_dof = 2, int max_d
 // another link with the given probability.
 FrictionDraw randomTreeFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, int max_stuck, int max_rows,
                                     double relative_probability);
+
+// The same on a random tree with mimic joints (addRandomMimics, drawn after
+// the tree): the stuck joints are independent ones, the mimic joints' q and q̇
+// follow their leaders, the setup folds their friction into the leaders'
+// (frictionSetupFromSpec); rows at most the independent joints.
+FrictionDraw randomTreeMimicFrictionDraw(std::mt19937_64& rng, int min_dof, int max_dof, int max_stuck, int max_rows,
+                                         double relative_probability, const RandomMimicOptions& mimics = {});
 
 // The task itself is well posed (as test_dense filters): H and the coupling
 // matrix conditioned below max_condition and every constraint row independent

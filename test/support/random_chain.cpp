@@ -185,4 +185,27 @@ ChainSpec randomTree(std::mt19937_64& rng, const RandomTreeOptions& options) {
   return spec;
 }
 
+int addRandomMimics(std::mt19937_64& rng, ChainSpec& spec, const RandomMimicOptions& options) {
+  std::vector<int> moving = spec.movingJoints();  // indices into spec.joints
+  const int n = static_cast<int>(moving.size());
+  const int most = std::min(options.max_mimics, n - 1);
+  if (most < 1) return 0;
+  const int k = uniformInt(rng, std::min(options.min_mimics, most), most);
+  for (int s = 0; s < n; ++s)  // Fisher–Yates with the portable uniformInt
+    std::swap(moving[static_cast<std::size_t>(s)], moving[static_cast<std::size_t>(uniformInt(rng, s, n - 1))]);
+  // moving[0, k): the mimic joints, in the order they are given leaders; the rest independent.
+  for (int i = 0; i < k; ++i) {
+    JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(i)])];
+    const bool chain = i > 0 && uniform01(rng) < options.chain_probability;
+    const int leader = chain ? uniformInt(rng, 0, i - 1) : uniformInt(rng, k, n - 1);
+    joint.mimic = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(leader)])].name;
+    const double a = uniform(rng, -options.max_multiplier, options.max_multiplier);
+    const double b = uniform(rng, -options.max_offset, options.max_offset);
+    joint.mimic_multiplier = a;
+    joint.mimic_offset = b;
+  }
+  spec.check();
+  return k;
+}
+
 }  // namespace zwang::testing

@@ -71,4 +71,18 @@ struct RandomTreeOptions {
 // offsets and joints as randomChain.
 ChainSpec randomTree(std::mt19937_64& rng, const RandomTreeOptions& options = {});
 
+struct RandomMimicOptions {
+  int min_mimics = 1;  // at most dof − 1: one joint at least stays independent
+  int max_mimics = 3;
+  double max_multiplier = 2.0;     // a uniform in [−max, max]
+  double max_offset = 0.5;         // b uniform in [−max, max]
+  double chain_probability = 0.3;  // that a mimic joint follows another mimic joint (a chain m → k → l)
+};
+
+// Make min..max of the spec's moving joints mimic joints (JointSpec::mimic):
+// each follows an independent moving joint or, with chain_probability, a mimic
+// joint chosen before it (so there is never a cycle), with a random multiplier
+// and offset. Returns the number made.
+int addRandomMimics(std::mt19937_64& rng, ChainSpec& spec, const RandomMimicOptions& options = {});
+
 }  // namespace zwang::testing

@@ -65,10 +65,12 @@ DynamicsInput randomProblem(std::mt19937_64& rng, const ChainSpec& spec, const R
     }
     in.constraints.push_back(c);
   }
+  spec.followMimicLaws(in.q, in.qd);  // a mimic joint's q and q̇ are its leader's (no draws)
   return in;
 }
 
 Model modelFromSpec(const ChainSpec& spec) {
+  // A chain's <mimic> joints are loaded as mimic joints (UrdfOptions::mimic = MimicJoints::Model, the default).
   return spec.isChain() ? loadUrdfString(toUrdf(spec)) : modelFromSpecByBuilder(spec);
 }
 
@@ -108,6 +110,10 @@ Model modelFromSpecByBuilder(const ChainSpec& spec) {
     joint.velocity_limit = js.velocity;
     builder.addJoint(joint, child.name, inertia, parent);
   }
+  // Mimic laws once every joint exists (a leader may come after its follower),
+  // as written: chains of mimics are the builder's to resolve.
+  for (const JointSpec& js : spec.joints)
+    if (!js.isFixed() && js.isMimic()) builder.setMimic(js.name, js.mimic, js.mimic_multiplier, js.mimic_offset);
   return builder.build();
 }
 
@@ -133,8 +139,10 @@ double relativeError(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
 }
 
 bool wellPosed(const DenseResult& dense, const DynamicsInput& input) {
-  if (!dense.wellConditioned(1e6) || dense.constraint_rank < input.constraintRows()) return false;
-  return input.constraintRows() == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
+  // Every row of G: the input's and one per mimic joint.
+  const auto rows = static_cast<int>(dense.G.rows());
+  if (!dense.wellConditioned(1e6) || dense.constraint_rank < rows || rows < input.constraintRows()) return false;
+  return rows == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
 }
 
 RandomInverseDynamics::RandomInverseDynamics(std::mt19937_64& rng)

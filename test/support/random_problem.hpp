@@ -20,13 +20,15 @@ struct RandomProblemOptions {
 
 // q, q̇, τ, gravity, wrenches and constraints drawn for `spec`. Constraint
 // columns are random unit 6-vectors or axis-aligned unit forces/moments;
-// targets and wrenches of a few units.
+// targets and wrenches of a few units. Mimic joints' q and q̇ follow their
+// leaders (ChainSpec::followMimicLaws; no draws of their own beyond the rest).
 DynamicsInput randomProblem(std::mt19937_64& rng, const ChainSpec& spec, const RandomProblemOptions& options = {});
 
-// The chain through the URDF loader (writer → loader: both are exercised); a
-// tree through the ModelBuilder (modelFromSpecByBuilder).
+// The chain through the URDF loader (writer → loader: both are exercised,
+// <mimic> included); a tree through the ModelBuilder (modelFromSpecByBuilder).
 Model modelFromSpec(const ChainSpec& spec);
-// The spec built joint by joint with the ModelBuilder, as the URDF loader would.
+// The spec built joint by joint with the ModelBuilder, as the URDF loader
+// would; then ModelBuilder::setMimic for each mimic joint, as written.
 Model modelFromSpecByBuilder(const ChainSpec& spec);
 
 // The same problem as a zwang Task (rows in the same order).
@@ -34,8 +36,8 @@ Task taskFromInput(const Model& model, const DynamicsInput& input);
 
 // A draw the solver comparisons keep (test_dense, test_kdl): the dense KKT
 // system well conditioned (condition at most 1e6) and every constraint row
-// reachable — G of full row rank with its smallest singular value at least
-// 1e-6 (a row the joints cannot affect, e.g. a moment about a prismatic-only
+// reachable — G (the input's rows and the mimic rows) of full row rank with
+// its smallest singular value at least 1e-6 (a row the joints cannot affect, e.g. a moment about a prismatic-only
 // chain, has G ≈ 0 and is singular by nature).
 bool wellPosed(const DenseResult& dense, const DynamicsInput& input);
 

@@ -61,8 +61,11 @@ void writeJoint(std::ostringstream& out, const JointSpec& joint, const LinkSpec&
     if (joint.type != "continuous") out << " lower=\"" << num(joint.lower) << "\" upper=\"" << num(joint.upper) << "\"";
     out << " effort=\"" << num(joint.effort) << "\" velocity=\"" << num(joint.velocity) << "\"/>\n";
   }
-  out << "    <dynamics damping=\"" << num(joint.damping) << "\" friction=\"" << num(joint.friction) << "\"/>\n"
-      << "  </joint>\n";
+  out << "    <dynamics damping=\"" << num(joint.damping) << "\" friction=\"" << num(joint.friction) << "\"/>\n";
+  if (!joint.isFixed() && joint.isMimic())
+    out << "    <mimic joint=\"" << xmlEscape(joint.mimic) << "\" multiplier=\"" << num(joint.mimic_multiplier)
+        << "\" offset=\"" << num(joint.mimic_offset) << "\"/>\n";
+  out << "  </joint>\n";
 }
 
 void writeTransmission(std::ostringstream& out, const JointSpec& joint) {

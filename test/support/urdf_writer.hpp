@@ -13,6 +13,7 @@ namespace zwang::testing {
 // <transmission> whose <actuator> holds <drake:rotor_inertia value/> and
 // <drake:gear_ratio value/> (docs/conventions.md, "Joints, links, frames"; xmlns:drake is declared on
 // <robot>). A link with zero mass and zero inertia is written without <inertial>.
+// A mimic joint (JointSpec::mimic) gets <mimic joint multiplier offset/>.
 std::string toUrdf(const ChainSpec& spec);
 
 }  // namespace zwang::testing

@@ -104,6 +104,9 @@ class Task {
   /// Internal rows the model's mimic joints add, q̈_m − a·q̈_leader = 0, one per
   /// mimic joint (Model::mimicJoints), after the user's rows in the balance.
   int mimicRows() const { return mimic_rows_; }
+  /// True when the mimic rows are those of `model`'s mimic joints (same joints,
+  /// leaders and multipliers): every solve checks it.
+  bool mimicLawsMatch(const Model& model) const;
   /// Rows of the balance: the user's constraint rows, then the mimic rows.
   int balanceRows() const { return constraintRows() + mimic_rows_; }
   /// Number of wrenches added.
@@ -175,6 +178,8 @@ class Task {
   std::vector<int> first_column_;
   bool has_relative_ = false;
   int mimic_rows_ = 0;
+  std::vector<Mimic> mimic_laws_;  // the law of each mimic row (its mimic joint below)
+  std::vector<int> mimic_joint_of_row_;
   std::vector<AppliedWrench> wrenches_;
   Eigen::VectorXd b_;
   void addMimicRows(const Model& model);

@@ -83,8 +83,13 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
   if (Status s = checkVector("q", q, model.dof()); !s) return s;
   if (Status s = checkVector("qd", qd, model.dof()); !s) return s;
   if (Status s = checkVector("tau", tau, model.dof()); !s) return s;
-  if (task.mimicRows() != static_cast<int>(model.mimicJoints().size()))
-    return Status::error(StatusCode::ModelMismatch, "task was made for a model with %d mimic joints, this one has %d",
+  if (task.balanceRows() > ws.balanceCapacity())  // a workspace made for a model with fewer mimic joints
+    return Status::error(StatusCode::WorkspaceTooSmall,
+                         "task has %d balance rows (%d constraint, %d mimic), the workspace was made for at most %d",
+                         task.balanceRows(), task.constraintRows(), task.mimicRows(), ws.balanceCapacity());
+  if (!task.mimicLawsMatch(model))
+    return Status::error(StatusCode::ModelMismatch,
+                         "task was made for a model with other mimic joints (%d; this one has %d, or other laws)",
                          task.mimicRows(), static_cast<int>(model.mimicJoints().size()));
   if (Status s = checkMimicState(model, q, qd); !s) return s;
   if (Status s = checkFinite("gravity", task.gravity); !s) return s;

@@ -148,8 +148,8 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
 
 // ---- The maximiser: K_ΘΘ and q̈_Θ(0) gathered from the columns, the scales
 // its tests are relative to, and the box QP. μ* into fs.mu.
-QpReport maximiseDual(const Workspace& ws, const std::vector<int>& stuck, const FrictionOptions& options,
-                      double acc_scale, FrictionScratch& fs) {
+QpReport maximiseDual(const Task& task, const Workspace& ws, const std::vector<int>& stuck,
+                      const FrictionOptions& options, double acc_scale, FrictionScratch& fs) {
   const auto k = static_cast<Eigen::Index>(stuck.size());
   auto K = fs.K.topLeftCorner(k, k);
   for (Eigen::Index a = 0; a < k; ++a) fs.qdd0_stuck[a] = fs.qdd0[stuck[static_cast<std::size_t>(a)]];
@@ -174,6 +174,15 @@ QpReport maximiseDual(const Workspace& ws, const std::vector<int>& stuck, const 
     double min_D = kInf;
     for (Eigen::Index a = 0; a < k; ++a) min_D = std::min(min_D, jointInertia(ws, stuck[static_cast<std::size_t>(a)]));
     curvature_scale = std::max(1.0 / min_D, fs.dqdd.leftCols(k).cwiseAbs().maxCoeff());
+    // The task's part of ∂q̈/∂μ, Sᵀ A δν / D, is a sum of terms of size
+    // |SᵀA|·|δν|/D, which an ill-conditioned balance makes large while their
+    // sum, where the task pins a stuck joint, is rounding of them (a stop the
+    // task pushes into through relative rows: K_jj ~ 1e-12 of the scale
+    // without this term, 1e-14 with it, found by test_mimic).
+    const int m = task.solverColumns();
+    if (m > 0)
+      curvature_scale = std::max(curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
+                                                      ws.SA.topRows(m).cwiseAbs().maxCoeff() / min_D);
   }
   const double tolerance = options.kkt_tolerance * acc_scale;
   auto mu = fs.mu.head(k);
@@ -284,7 +293,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(fs.qdd0[j]));
   const double acc_scale = 1.0 + acc_max;
   const double acc_tolerance = 1e-9 * acc_scale;  // what counts as q̈_j = 0 (a sticking joint)
-  const QpReport report = maximiseDual(ws, fr.stuck, options, acc_scale, fs);
+  const QpReport report = maximiseDual(task, ws, fr.stuck, options, acc_scale, fs);
   fr.iterations = report.iterations;
   fr.converged = k == 0 || report.converged;
 

@@ -36,8 +36,23 @@ void Task::addMimicRows(const Model& model) {
         groups_.push_back(g);
       }
     }
+    mimic_laws_.push_back(law);
+    mimic_joint_of_row_.push_back(m);
     ++mimic_rows_;
   }
+}
+
+bool Task::mimicLawsMatch(const Model& model) const {
+  const std::vector<int>& joints = model.mimicJoints();
+  if (joints.size() != mimic_joint_of_row_.size()) return false;
+  for (std::size_t r = 0; r < joints.size(); ++r) {
+    const Mimic& law = model.joint(joints[r]).mimic;
+    const Mimic& mine = mimic_laws_[r];
+    // Exact comparison: the rows were built from these very numbers.
+    if (joints[r] != mimic_joint_of_row_[r] || law.leader != mine.leader || law.multiplier != mine.multiplier)
+      return false;
+  }
+  return true;
 }
 
 namespace {

@@ -10,10 +10,11 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
       mimic_rows_(static_cast<int>(model.mimicJoints().size())) {
   const auto bodies = static_cast<std::size_t>(model.bodyCount());
   const int n = dof_, m = balanceCapacity();
-  solution.qdd.setZero(n);
+  const int nv = model.nv(), k = model.baseVelocitySize();
+  solution.qdd.setZero(nv);
   solution.nu.setZero(0);
-  solution.tau_constraint.setZero(n);
-  solution.tau_control.setZero(n);
+  solution.tau_constraint.setZero(nv);
+  solution.tau_control.setZero(nv);
 
   Xworld.assign(bodies, Transform{});
   S.assign(bodies, Vec6::Zero());
@@ -28,6 +29,13 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   inverse_D.assign(bodies, 0.0);
   u.assign(bodies, 0.0);
   const int columns = columnCapacity();
+  S_base.setZero(6, k);
+  IAS_base.setZero(6, k);
+  D_base.compute(MatrixXmax6::Identity(k, k));  // sized once: compute() on k × k later allocates nothing
+  u_base.setZero(k);
+  qdd_base.setZero(k);
+  SA_base.setZero(6, columns);
+  SA_base_D.setZero(6, columns);
   SA.setZero(columns, static_cast<Eigen::Index>(bodies));
   Ahat.setZero(6, columns);
   U.setZero(columns);
@@ -55,15 +63,15 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   f.assign(bodies, Vec6::Zero());
   constraint_wrench.assign(bodies, Vec6::Zero());
   Ic.assign(bodies, Mat6::Zero());
-  H.setZero(n, n);
-  tau.setZero(n);
+  H.setZero(nv, nv);
+  tau.setZero(nv);
 
   friction.mu.setZero(n);
   friction.state.assign(static_cast<std::size_t>(n), JointState::Moving);
   friction.tau_friction.setZero(n);
-  friction.dqdd_dmu.setZero(n, n);
+  friction.dqdd_dmu.setZero(nv, n);
   friction.stuck.reserve(static_cast<std::size_t>(n));
-  friction_scratch_ = std::make_unique<internal::FrictionScratch>(n, static_cast<int>(bodies), columns);
+  friction_scratch_ = std::make_unique<internal::FrictionScratch>(n, nv, static_cast<int>(bodies), columns);
 }
 
 Workspace::~Workspace() = default;

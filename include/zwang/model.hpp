@@ -207,7 +207,8 @@ class Model {
   /// one internal balance row per mimic joint, q̈_m − a·q̈_leader = 0.
   const std::vector<int>& mimicJoints() const { return mimic_joints_; }
   /// Set each mimic joint's q and q̇ from its leader's (q = a·q_leader + b, q̇ =
-  /// a·q̇_leader); the other entries are left as they are. Either may be empty.
+  /// a·q̇_leader); the other entries are left as they are. q has nq() entries
+  /// and q̇ nv() (a floating base's first); either may be empty (left alone).
   void followLeaders(Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qd) const;
   /// What was doubtful in the data the model was built from (each once, in the
   /// order found); empty for clean data.

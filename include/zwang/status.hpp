@@ -18,6 +18,7 @@ enum class StatusCode {
   BadOption,          ///< an option or per-solve override is out of range
   Infeasible,         ///< the task drives a joint into its position limit (outputs finite, not physical)
   MimicMismatch,      ///< a mimic joint's q or q̇ does not follow its leader's (Model::followLeaders)
+  BadConfiguration,   ///< q is no pose: a free base's quaternion off unit length
 };
 
 /// The result of a hot-path call: a code and, on error, a message naming the input at fault.

@@ -4,9 +4,12 @@
 /// thread: the Model is shared, the Workspace is not.
 ///
 /// The members are named after the report's Algorithm 1 (chapter 4.2); index i
-/// is a body (0 = the fixed base), joint i−1 moves body i (from its parent).
+/// is a body (0 = the base, fixed or floating), joint i−1 moves body i (from
+/// its parent). A floating base is the joint of body 0 to the world, with k = 6
+/// (free) or 3 (planar) coordinates: its quantities are the `*_base` members.
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <memory>
 #include <vector>
 
@@ -61,13 +64,25 @@ struct BalanceFactorisation {
 
 /// What a solve computes (Workspace::solution).
 struct Solution {
-  Eigen::VectorXd qdd;  ///< q̈
+  /// q̈ (nv entries: a floating base's first, as the derivative of its velocity
+  /// coordinates, docs/conventions.md "Floating base"; then one per joint).
+  Eigen::VectorXd qdd;
+  /// A floating base's classical acceleration [p̈; ω̇] of its origin, world
+  /// axes (zero for a fixed base).
+  Vec6 base_acceleration_world = Vec6::Zero();
   /// ν, constraint magnitudes, in the task's row order. Sized to the task's
   /// rows; a solve resizes it only when the task's row count changed since the
   /// last solve (the one allocation a solve can make; none for a fixed task).
   Eigen::VectorXd nu;
-  Eigen::VectorXd tau_constraint;  ///< τ_c = Σ J_iᵀ A_i ν_i, the joint torques of the constraint forces
-  Eigen::VectorXd tau_control;     ///< τ + τ_c, what is sent to the motors
+  /// τ_c = Σ J_iᵀ A_i ν_i, the generalized forces of the constraint forces
+  /// (nv: a floating base's first, in its own coordinates).
+  Eigen::VectorXd tau_constraint;
+  /// τ + τ_c, what is sent to the motors. A floating base's entries are the
+  /// generalized force its coordinates would need: no motor gives it, so a
+  /// task a robot can do with its joints alone leaves them at τ_base
+  /// (normally 0); constraints whose force the ground supplies (contacts)
+  /// make up the rest.
+  Eigen::VectorXd tau_control;
   double gauss = 0.0;              ///< Z(q̈), the Gauss function (acceleration energy) at the solution
   BalanceReport balance;           ///< how the balance went: rank, condition, damping, residual, consistent
   /// A warning, not an error: joints whose q lies outside [lower, upper]
@@ -126,6 +141,15 @@ class Workspace {
   std::vector<double> D;          ///< D_i = d_i + S_iᵀ I^A_i S_i
   std::vector<double> inverse_D;  ///< 1 / D_i (the sweeps multiply)
   std::vector<double> u;          ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
+  // --- a floating base: the joint of body 0 to the world, k = 6 or 3 coordinates
+  Matrix6Xmax S_base;                         ///< S₀ (6 × k), base coordinates of the base's motion
+  Matrix6Xmax IAS_base;                       ///< I^A₀ S₀ (6 × k)
+  Eigen::LLT<MatrixXmax6> D_base;             ///< D₀ = S₀ᵀ I^A₀ S₀ (k × k), factorised
+  VectorXmax6 u_base;                         ///< τ₀ − S₀ᵀ(F^A₀ + I^A₀ Ẍ_bias,0) (k)
+  VectorXmax6 qdd_base;                       ///< q̈₀ in the sweep's coordinates (k)
+  Eigen::MatrixXd SA_base;                    ///< S₀ᵀ A₀ (k × columns; 6 rows kept)
+  Eigen::MatrixXd SA_base_D;                  ///< D₀⁻¹ S₀ᵀ A₀ (k × columns; 6 rows kept)
+  double base_D_inverse_norm = 0.0;           ///< ‖D₀⁻¹‖₁, the size rounding in 𝓛 is relative to
   Eigen::MatrixXd SA;             ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
   ConstraintMatrix Ahat;          ///< A_i (6 × capacity), updated in place from A_N down to A_0
   /// U_0, acceleration energy of bias forces and torques: the report's U (not

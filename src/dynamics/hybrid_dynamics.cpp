@@ -2,6 +2,7 @@
 // (src/dynamics/popov_vereshchagin.cpp holds each stage, next to the report's lines).
 #include "zwang/hybrid_dynamics.hpp"
 
+#include "dynamics/floating_base.hpp"
 #include "dynamics/popov_vereshchagin.hpp"
 
 namespace zwang {
@@ -17,6 +18,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   if (Status s = inwardSweep(model, task, tau, ws); !s) return s;  // lines 11–22
   balance(task, ws);                                               // lines 23–25
   outwardAccelerations(model, task, ws, out.qdd);                  // lines 26–30
+  if (model.hasFloatingBase()) out.base_acceleration_world = baseClassicalAcceleration(task, ws);
   taskResidual(task, ws);                                          // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(task.solverColumns()), out.tau_constraint);

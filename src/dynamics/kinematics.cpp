@@ -36,7 +36,7 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
 void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws) {
   for (const Task::AppliedWrench& w : task.wrenches()) {
     const int body = model.frame(w.frame).body;
-    if (body == 0) continue;  // a wrench on the fixed base moves nothing
+    if (body == 0 && !model.hasFloatingBase()) continue;  // a wrench on the fixed base moves nothing
     ws.Fbias[static_cast<std::size_t>(body)] -= wrenchInBase(model, ws, w.frame, w.expressed, w.value);
   }
 }

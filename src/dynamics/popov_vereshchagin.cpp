@@ -23,7 +23,11 @@
 //    after the user's rows, as four columns: a unit effort along each joint on
 //    its body and the opposite on its parent (mimicPieceInBodyForm). Its ν is
 //    the coupling torque the mechanism carries; the motor torques the leader
-//    carries are folded onto it at the end (carryMimicTorques).
+//    carries are folded onto it at the end (carryMimicTorques);
+//  * a floating base (free or planar): body 0 moves, joined to the world by an
+//    unactuated joint of k coordinates; each sweep ends (or starts) with that
+//    joint's step (src/dynamics/floating_base.cpp). The state vectors put the
+//    base's coordinates first: the stages below index the joints' part.
 #include "dynamics/popov_vereshchagin.hpp"
 
 #include <algorithm>
@@ -32,6 +36,7 @@
 
 #include "dynamics/balance.hpp"
 #include "dynamics/checks.hpp"
+#include "dynamics/floating_base.hpp"
 #include "dynamics/sweeps.hpp"
 
 namespace zwang::internal {
@@ -41,11 +46,25 @@ inline std::size_t at(int i) { return static_cast<std::size_t>(i); }
 }  // namespace
 
 namespace {
+// A free base's quaternion must be unit: within 1e-6 of norm 1 (what float32
+// round trips and long integrations leave) it is used normalised; beyond, the
+// caller's state is not a pose.
+Status checkBaseQuaternion(const Model& model, const VectorRef& q) {
+  if (model.baseType() != BaseType::Free) return {};
+  const double norm = q.segment<4>(3).norm();
+  if (!(std::abs(norm - 1.0) <= 1e-6))
+    return Status::error(StatusCode::BadConfiguration,
+                         "q: the base quaternion (entries 3-6, w x y z) has norm %.17g, not 1 (normalise it)", norm);
+  return {};
+}
+
 // A mimic joint's q and q̇ must follow its leader's: the mechanism cannot be
 // anywhere else, and solving such a state would be a silent wrong answer.
 // Allowed: the rounding of a·q + b and what an integrator's steps add to it
 // (1e-9 of the terms' size; Model::followLeaders sets the entries exactly).
-Status checkMimicState(const Model& model, const VectorRef& q, const VectorRef& qd) {
+Status checkMimicState(const Model& model, const VectorRef& q_all, const VectorRef& qd_all) {
+  const auto q = q_all.tail(model.dof());
+  const auto qd = qd_all.tail(model.dof());
   for (const int m : model.mimicJoints()) {
     const Joint& joint = model.joint(m);
     const Mimic& law = joint.mimic;
@@ -80,9 +99,10 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
                          "task has %d constraint rows, the workspace was made for at most %d", task.constraintRows(),
                          ws.constraintCapacity());
   if (Status s = checkBalanceOptions(task.balance); !s) return s;
-  if (Status s = checkVector("q", q, model.dof()); !s) return s;
-  if (Status s = checkVector("qd", qd, model.dof()); !s) return s;
-  if (Status s = checkVector("tau", tau, model.dof()); !s) return s;
+  if (Status s = checkVector("q", q, model.nq()); !s) return s;
+  if (Status s = checkVector("qd", qd, model.nv()); !s) return s;
+  if (Status s = checkVector("tau", tau, model.nv()); !s) return s;
+  if (Status s = checkBaseQuaternion(model, q); !s) return s;
   if (task.balanceRows() > ws.balanceCapacity())  // a workspace made for a model with fewer mimic joints
     return Status::error(StatusCode::WorkspaceTooSmall,
                          "task has %d balance rows (%d constraint, %d mimic), the workspace was made for at most %d",
@@ -195,8 +215,12 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
 }  // namespace
 
 void outwardSweep(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd, Workspace& ws) {
-  outwardKinematics(model, q, qd, ws, true);  // lines 3–6
-  for (int i = 1; i <= model.dof(); ++i)
+  const int n = model.dof(), nqb = model.baseConfigurationSize(), nvb = model.baseVelocitySize();
+  const bool moving = qd.size() == model.nv();
+  const bool floating = model.hasFloatingBase();
+  if (floating) baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, true);  // lines 3–6, base
+  outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, true);                  // lines 3–6
+  for (int i = floating ? 0 : 1; i <= n; ++i)
     ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);  // line 7, without F_ext
   applyExternalWrenches(model, task, ws);                                           // line 7: − F_ext
   // Lines 8–9 (I^A_i = I_i, F^A_i = F_bias,i) are folded into the inward
@@ -204,8 +228,10 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
   constraintsInBodyForm(model, task, ws);
 }
 
-Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
+Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau_all, Workspace& ws) {
   const int N = model.dof();
+  const bool floating = model.hasFloatingBase();
+  const auto tau = tau_all.tail(N);
   const int m = task.solverColumns();
   ws.U.head(m).setZero();  // U_N = 0
   ws.L_scale.head(m).setZero();
@@ -257,7 +283,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     // F^a_i. The first child to arrive (the last in depth-first order: its
     // subtree ends where p's does) starts p's sums from I_p and F_bias,p.
     const int p = model.parent(i);
-    if (p > 0) {
+    if (p > 0 || floating) {  // a fixed base takes nothing
       Mat6& IA_parent = ws.IA[at(p)];
       const Vec6 IAS_D = IAS * inverse_D;
       if (model.subtreeEnd(i) == model.subtreeEnd(p)) {
@@ -270,6 +296,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
       }
     }
   }
+  if (floating) return baseInward(model, task, tau_all.head(model.baseVelocitySize()), ws);  // lines 13–21, base
   return {};
 }
 
@@ -333,8 +360,14 @@ void balance(const Task& task, Workspace& ws) {
   if (condensed) expandToColumns(task, ws.nu_rows.head(m), ws.nu);
 }
 
-void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
-  ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd_all) {
+  if (model.hasFloatingBase()) {  // lines 28–29 for the base joint
+    baseAcceleration(model, task, ws);
+    publishBaseAcceleration(model, ws, ws.qdd_base, qdd_all.head(model.baseVelocitySize()));
+  } else {
+    ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  }
+  auto qdd = qdd_all.tail(model.dof());
   for (int i = 1; i <= model.dof(); ++i) {
     const Vec6& a_parent = ws.a[at(model.parent(i))];
     const int first = task.firstColumn(i), k = task.activeColumns(i) - first;
@@ -344,14 +377,17 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   }
 }
 
-void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd) {
+void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd_all) {
   ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  if (model.hasFloatingBase()) ws.a[0] += baseTrueAcceleration(model, ws, qdd_all.head(model.baseVelocitySize()));
+  const auto qdd = qdd_all.tail(model.dof());
   for (int i = 1; i <= model.dof(); ++i)
     ws.a[at(i)] = ws.a[at(model.parent(i))] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];  // line 29
 }
 
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
-                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
+                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> du_base,
+                       Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
                        Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da) {
   // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
   // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
@@ -362,6 +398,8 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   const int N = model.dof();
   const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(joints.size());
+  const bool floating = model.hasFloatingBase();
+  const int kb = model.baseVelocitySize();
   dU.setZero();
   dF.setZero();
   du.setZero();
@@ -386,6 +424,13 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
       dF.col(c) += IAS * du_D;                                          // lines 17–18
     }
   }
+  if (floating) {  // the base joint: every column's δF^a has reached body 0
+    for (Eigen::Index c = 0; c < k; ++c) {
+      du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));                // δu₀ (no torque at the base)
+      const VectorXmax6 du_D = ws.D_base.solve(du_base.col(c).head(kb));
+      for (int r = 0; r < m; ++r) dU(r, c) += ws.SA_base.col(r).head(kb).dot(du_D);  // line 20
+    }
+  }
   dU.topRows(m) *= -1.0;     // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
@@ -399,22 +444,31 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
     balanceApplyColumns(ws.balance_factorisation, dU.topRows(m), dnu.topRows(m), ws.balance_factorisation.work.head(m));
   }
   // Lines 28–29 for the differences: δẌ per body, one column at a time (the
-  // bodies' δẌ hang from their parents'; da holds one column's, δẌ₀ = 0).
+  // bodies' δẌ hang from their parents'; da holds one column's; δẌ₀ = 0 on
+  // a fixed base, S₀ δq̈₀ on a floating one, the world's acceleration fixed).
   da.col(0).setZero();
   for (Eigen::Index c = 0; c < k; ++c) {
+    if (floating) {
+      VectorXmax6 rhs = du_base.col(c).head(kb);
+      rhs.noalias() += ws.SA_base.topLeftCorner(kb, m) * dnu.col(c).head(m);
+      const VectorXmax6 dq_base = ws.D_base.solve(rhs);
+      da.col(0) = ws.S_base * dq_base;
+      publishBaseAcceleration(model, ws, dq_base, dqdd.col(c).head(kb));
+    }
     for (int i = 1; i <= N; ++i) {
       const int first = task.firstColumn(i), ki = task.activeColumns(i);
       double constraint = 0.0;
       for (int r = first; r < ki; ++r) constraint += ws.SA(r, i) * dnu(r, c);
       const auto parent_da = da.col(model.parent(i));
       const double dq = (du(i, c) - ws.IAS[at(i)].dot(parent_da) + constraint) * ws.inverse_D[at(i)];
-      dqdd(i - 1, c) = dq;
+      dqdd(kb + i - 1, c) = dq;
       da.col(i) = parent_da + ws.S[at(i)] * dq;
     }
   }
 }
 
-void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out) {
+void jointsOutsideLimits(const Model& model, const VectorRef& q_all, Solution& out) {
+  const auto q = q_all.tail(model.dof());
   out.joints_outside_limits = 0;
   out.first_joint_outside_limits = -1;
   for (int j = 0; j < model.dof(); ++j) {
@@ -474,15 +528,29 @@ void taskResidual(const Task& task, Workspace& ws) {
   report.consistent = met;
 }
 
+namespace {
+// A floating base's share of τ_c: the wrench its children carry into it plus
+// its own columns', on the base coordinates.
+void baseConstraintForce(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
+                         const Vec6& from_children, Eigen::Ref<Eigen::VectorXd> tau_c_base) {
+  const int k_beyond = task.activeColumns(1), k = task.activeColumns(0);
+  Vec6 F0 = from_children;
+  F0.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+  baseGeneralizedForce(model, ws, F0, tau_c_base);
+}
+}  // namespace
+
 void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
-                       Eigen::Ref<Eigen::VectorXd> tau_c) {
+                       Eigen::Ref<Eigen::VectorXd> tau_c_all) {
   // The wrenches A ν of each body's own constraints, summed inward and
   // projected on each joint: the physical torque (docs/solver.md, "Constraint torques: why not eq. 4.4").
   // On a tree each body carries its own wrenches and its children's: the
   // body's slot of `carried` collects them, then passes them to the parent.
   const int N = model.dof();
+  const int kb = model.baseVelocitySize();
+  auto tau_c = tau_c_all.tail(N);
   if (task.solverColumns() == 0) {
-    tau_c.setZero();
+    tau_c_all.setZero();
     return;
   }
   if (model.isChain()) {  // one running sum from the tip inward
@@ -492,6 +560,7 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
       carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
       tau_c[i - 1] = ws.S[at(i)].dot(carried);
     }
+    if (kb > 0) baseConstraintForce(model, task, ws, nu_solver, carried, tau_c_all.head(kb));
     return;
   }
   std::vector<Vec6>& carried = ws.constraint_wrench;
@@ -499,13 +568,18 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
     const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
     carried[at(i)].noalias() = ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
   }
+  Vec6 into_base = Vec6::Zero();
   for (int i = N; i >= 1; --i) {
     tau_c[i - 1] = ws.S[at(i)].dot(carried[at(i)]);
-    if (model.parent(i) > 0) carried[at(model.parent(i))] += carried[at(i)];
+    if (model.parent(i) > 0)
+      carried[at(model.parent(i))] += carried[at(i)];
+    else
+      into_base += carried[at(i)];
   }
+  if (kb > 0) baseConstraintForce(model, task, ws, nu_solver, into_base, tau_c_all.head(kb));
 }
 
-double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
+double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd_all, const VectorRef& tau_all,
                      const Workspace& ws) {
   // Z with true accelerations and gravity as a force (the physical Gauss
   // function; the gravity-shifted sweep's version differs by a constant):
@@ -513,8 +587,12 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
   // in 3-vector pieces: with y = ½a + [−g; 0] = [y_l; y_a] and a = [a_l; α],
   // I y = [m y_l − h × y_a; h × y_l + Ī y_a].
   const Vec3& g = task.gravity;
-  double Z = 0.0;
-  for (int i = 1; i <= model.dof(); ++i) {
+  const int kb = model.baseVelocitySize();
+  const auto qdd = qdd_all.tail(model.dof());
+  const auto tau = tau_all.tail(model.dof());
+  // A floating base: body 0's terms, and −τ_baseᵀ q̈_base (conjugate coordinates).
+  double Z = kb > 0 ? -tau_all.head(kb).dot(qdd_all.head(kb)) : 0.0;
+  for (int i = kb > 0 ? 0 : 1; i <= model.dof(); ++i) {
     const RigidInertia& I = ws.I[at(i)];
     const Vec6& a_sweep = ws.a[at(i)];
     const Vec3 a_lin = a_sweep.head<3>() + g;  // true acceleration: sweep − [−g; 0]
@@ -524,6 +602,7 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
     const Vec6& F = ws.Fbias[at(i)];
     Z += a_lin.dot(I.mass * y_lin - I.h.cross(y_ang) + F.head<3>()) +
          alpha.dot(I.h.cross(y_lin) + I.Ibar * y_ang + F.tail<3>());
+    if (i == 0) continue;  // the base: no joint terms of its own beyond −τ_baseᵀ q̈_base
     const double qdd_i = qdd[i - 1];
     Z += (0.5 * model.joint(i - 1).rotor_inertia * qdd_i - tau[i - 1]) * qdd_i;
   }
@@ -541,7 +620,8 @@ void publishNu(const Task& task, Workspace& ws) {
   }
 }
 
-void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control) {
+void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control_all) {
+  auto tau_control = tau_control_all.tail(model.dof());
   // Power-equivalent: a torque τ_m at the mimic joint moves the robot as
   // a·τ_m at its leader does (q̇_m = a·q̇_l), the difference being a coupling
   // torque the mechanism supplies. So the leader's motor carries it.

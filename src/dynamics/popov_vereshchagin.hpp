@@ -45,12 +45,14 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 
 // k extra right-hand sides through the same sweeps, all at once: column c is
 // a unit torque at joint joints[c] (ascending), everything else zero. Gives
-// δν (dnu: solver columns × k) and δq̈ = ∂q̈/∂τ_joint (dqdd: n × k); du
-// (bodies × k), dF (6 × k), da (6 × bodies) and dU (solver columns × k) are scratch. Needs inwardSweep
+// δν (dnu: solver columns × k) and δq̈ = ∂q̈/∂τ_joint (dqdd: nv × k, a
+// floating base's rows first); du (bodies × k), du_base (6 × k), dF (6 × k),
+// da (6 × bodies) and dU (solver columns × k) are scratch. Needs inwardSweep
 // and balance first. O((N + m²)·k): the sensitivity K_Θ of the friction
 // extension, as matrix–row products over the k columns rather than k sweeps.
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
-                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
+                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> du_base,
+                       Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
                        Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da);
 
 // The joints whose q lies outside their limits, into the solution (a warning).

@@ -22,6 +22,7 @@
 #include <limits>
 
 #include "dynamics/checks.hpp"
+#include "dynamics/floating_base.hpp"
 #include "dynamics/popov_vereshchagin.hpp"
 #include "friction/friction_scratch.hpp"
 #include "qp/box_qp.hpp"
@@ -102,25 +103,28 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
   fr.impact_joint = -1;
   fs.tau_effective = tau;
   fr.tau_friction.setZero();
+  // The joints' entries of the state vectors follow a floating base's.
+  const int iq = model.baseConfigurationSize(), iv = model.baseVelocitySize();
   for (int j = 0; j < n; ++j) {
     const Joint& joint = model.joint(j);
     if (joint.mimic.active()) {  // friction and limits are its leader's (above)
       fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
       continue;
     }
-    const bool at_lower = options.joint_limits && q[j] <= joint.lower + options.limit_tolerance;
-    const bool at_upper = options.joint_limits && q[j] >= joint.upper - options.limit_tolerance;
-    if (std::abs(qd[j]) <= options.velocity_tolerance) {
+    const double qj = q[iq + j], qdj = qd[iv + j];
+    const bool at_lower = options.joint_limits && qj <= joint.lower + options.limit_tolerance;
+    const bool at_upper = options.joint_limits && qj >= joint.upper - options.limit_tolerance;
+    if (std::abs(qdj) <= options.velocity_tolerance) {
       const auto a = static_cast<Eigen::Index>(fr.stuck.size());
       fr.stuck.push_back(j);
       fs.lo[a] = at_lower ? -kInf : -fs.breakaway[j];  // the stop pushes positively without bound
       fs.hi[a] = at_upper ? kInf : fs.breakaway[j];
       fr.state[static_cast<std::size_t>(j)] = JointState::Stick;
     } else {
-      fr.tau_friction[j] = -fs.kinetic[j] * (qd[j] > 0 ? 1.0 : -1.0) - fs.viscous[j] * qd[j];
-      fs.tau_effective[j] += fr.tau_friction[j];
+      fr.tau_friction[j] = -fs.kinetic[j] * (qdj > 0 ? 1.0 : -1.0) - fs.viscous[j] * qdj;
+      fs.tau_effective[iv + j] += fr.tau_friction[j];
       fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
-      if ((at_lower && qd[j] < 0) || (at_upper && qd[j] > 0)) {
+      if ((at_lower && qdj < 0) || (at_upper && qdj > 0)) {
         fr.limit_impact = true;  // it needs an impulse to stop: reported, not modelled
         if (fr.impact_joint < 0) fr.impact_joint = j;
       }
@@ -141,21 +145,22 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   outwardAccelerations(model, task, ws, fs.qdd0);
   fs.nu0.head(m) = ws.nu.head(m);
   if (k > 0)
-    unitTorqueColumns(model, task, ws, stuck, fs.du.leftCols(k), fs.dU.topLeftCorner(m, k), fs.dnu.topLeftCorner(m, k),
-                      fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da);
+    unitTorqueColumns(model, task, ws, stuck, fs.du.leftCols(k), fs.du_base.leftCols(k), fs.dU.topLeftCorner(m, k),
+                      fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da);
   return {};
 }
 
 // ---- The maximiser: K_ΘΘ and q̈_Θ(0) gathered from the columns, the scales
 // its tests are relative to, and the box QP. μ* into fs.mu.
-QpReport maximiseDual(const Task& task, const Workspace& ws, const std::vector<int>& stuck,
+QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
                       const FrictionOptions& options, double acc_scale, FrictionScratch& fs) {
   const auto k = static_cast<Eigen::Index>(stuck.size());
+  const int iv = model.baseVelocitySize();  // the joints' rows of q̈ follow a floating base's
   auto K = fs.K.topLeftCorner(k, k);
-  for (Eigen::Index a = 0; a < k; ++a) fs.qdd0_stuck[a] = fs.qdd0[stuck[static_cast<std::size_t>(a)]];
+  for (Eigen::Index a = 0; a < k; ++a) fs.qdd0_stuck[a] = fs.qdd0[iv + stuck[static_cast<std::size_t>(a)]];
   {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers: k² of them)
     const int* rows = stuck.data();
-    const double* dqdd = fs.dqdd.data();
+    const double* dqdd = fs.dqdd.data() + iv;
     const Eigen::Index dqdd_stride = fs.dqdd.outerStride();
     double* p = K.data();
     const Eigen::Index p_stride = K.outerStride();
@@ -209,7 +214,7 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
   carryMimicTorques(model, fs.tau_control_first);
   for (Eigen::Index a = 0; a < k; ++a) {
     const int j = stuck[static_cast<std::size_t>(a)];
-    fs.effort_offset[a] = fs.tau_control_first[j] - fs.mu[a];
+    fs.effort_offset[a] = fs.tau_control_first[model.baseVelocitySize() + j] - fs.mu[a];
     fs.margin_limit[a] = options.margin * fs.breakaway[j];
   }
 }
@@ -232,7 +237,10 @@ void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index k, Wor
 
 // ---- Outputs: μ* per joint, the state of each stuck joint, the torques the
 // joints feel; returns Σ μ*_j q̈*_j (the dual's term beyond Z).
-double frictionStates(const Eigen::VectorXd& qdd, double acc_tolerance, FrictionScratch& fs, FrictionResult& fr) {
+double frictionStates(const Model& model, const Eigen::VectorXd& qdd_all, double acc_tolerance, FrictionScratch& fs,
+                      FrictionResult& fr) {
+  const int iv = model.baseVelocitySize();
+  const auto qdd = qdd_all.tail(model.dof());
   fr.mu.setZero();
   fs.tau_joint = fs.tau_effective;  // the torques the joints feel: τ − kinetic − Wᵀμ
   double mu_dot_qdd = 0.0;
@@ -241,7 +249,7 @@ double frictionStates(const Eigen::VectorXd& qdd, double acc_tolerance, Friction
     const double mu = fs.mu[static_cast<Eigen::Index>(a)], f = fs.breakaway[j];
     fr.mu[j] = mu;
     fr.tau_friction[j] = -mu;
-    fs.tau_joint[j] -= mu;
+    fs.tau_joint[iv + j] -= mu;
     mu_dot_qdd += mu * qdd[j];
     JointState& state = fr.state[static_cast<std::size_t>(j)];
     // Beyond what friction can give (to rounding of f): the stop pushes.
@@ -286,14 +294,15 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   fr.dqdd_dmu.setZero();
   for (Eigen::Index a = 0; a < k; ++a)  // μ_j enters as the torque −μ_j
     fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);
+  const int iv = model.baseVelocitySize();
 
   // The acceleration scale, of the stuck joints only (a light, fast joint
   // elsewhere in the chain must not set it): their accelerations q̈_Θ(0).
   double acc_max = 0.0;
-  for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(fs.qdd0[j]));
+  for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(fs.qdd0[iv + j]));
   const double acc_scale = 1.0 + acc_max;
   const double acc_tolerance = 1e-9 * acc_scale;  // what counts as q̈_j = 0 (a sticking joint)
-  const QpReport report = maximiseDual(task, ws, fr.stuck, options, acc_scale, fs);
+  const QpReport report = maximiseDual(model, task, ws, fr.stuck, options, acc_scale, fs);
   fr.iterations = report.iterations;
   fr.converged = k == 0 || report.converged;
 
@@ -312,11 +321,12 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   }
 
   motionAtMaximiser(model, task, k, ws, fs);
+  if (model.hasFloatingBase()) out.base_acceleration_world = baseClassicalAcceleration(task, ws);
   taskResidual(task, ws);
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(m), out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
-  const double mu_dot_qdd = frictionStates(out.qdd, acc_tolerance, fs, fr);
+  const double mu_dot_qdd = frictionStates(model, out.qdd, acc_tolerance, fs, fr);
   for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader
     fr.state[static_cast<std::size_t>(j)] = fr.state[static_cast<std::size_t>(model.joint(j).mimic.leader)];
   // g(μ*) = Z₀(q̈*) + μ*ᵀ W q̈* = Z with the joint torques τ − kinetic − Wᵀμ (eq. 5.7).

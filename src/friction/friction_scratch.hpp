@@ -10,19 +10,21 @@
 namespace zwang::internal {
 
 struct FrictionScratch {
-  FrictionScratch(int dof, int bodies, int capacity)  // capacity: solver columns
+  // dof: joints; nv: velocity coordinates (a floating base's first); capacity: solver columns
+  FrictionScratch(int dof, int nv, int bodies, int capacity)
       : breakaway(dof),
         kinetic(dof),
         viscous(dof),
-        tau_effective(dof),
+        tau_effective(nv),
         lo(dof),
         hi(dof),
-        qdd0(dof),
+        qdd0(nv),
         nu0(capacity),
         du(bodies, dof),
+        du_base(6, dof),
         dU(capacity, dof),
         dnu(capacity, dof),
-        dqdd(dof, dof),
+        dqdd(nv, dof),
         dF(6, dof),
         da(6, bodies),
         K(dof, dof),
@@ -32,10 +34,10 @@ struct FrictionScratch {
         margin_limit(dof),
         effort_offset(dof),
         nu_first(capacity),
-        tau_constraint_first(dof),
-        tau_control_first(dof),
+        tau_constraint_first(nv),
+        tau_control_first(nv),
         choice(dof),
-        tau_joint(dof) {}
+        tau_joint(nv) {}
 
   // The model of friction, per joint (the options' overrides, else the model's)
   Eigen::VectorXd breakaway, kinetic, viscous;  // f_j, f_c,j, b_j
@@ -46,9 +48,10 @@ struct FrictionScratch {
   Eigen::VectorXd qdd0;  // q̈(μ = 0)
   Eigen::VectorXd nu0;   // ν(μ = 0), per solver column
   Eigen::MatrixXd du;    // bodies × k: δu_i per unit torque (sweep scratch)
+  Eigen::MatrixXd du_base;  // k_base × k: δu₀ of a floating base per unit torque (sweep scratch)
   Eigen::MatrixXd dU;    // capacity × k: δU₀ per unit torque
   Eigen::MatrixXd dnu;   // capacity × k: δν per unit torque
-  Eigen::MatrixXd dqdd;  // dof × k: δq̈ per unit torque
+  Eigen::MatrixXd dqdd;  // nv × k: δq̈ per unit torque (a floating base's rows first)
   Matrix6X dF;           // 6 × k: δF^A per unit torque (sweep scratch)
   Matrix6X da;           // 6 × bodies: δẌ of one unit torque (sweep scratch)
 

@@ -344,10 +344,11 @@ void resolveMimicChains(std::vector<Joint>& joints, std::vector<int>& mimic_join
 }  // namespace
 
 void Model::followLeaders(Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qd) const {
+  const int iq = baseConfigurationSize(), iv = baseVelocitySize();  // the joints' entries follow the base's
   for (const int m : mimic_joints_) {
     const Mimic& law = joints_[static_cast<std::size_t>(m)].mimic;
-    if (q.size() == dof()) q[m] = law.multiplier * q[law.leader] + law.offset;
-    if (qd.size() == dof()) qd[m] = law.multiplier * qd[law.leader];
+    if (q.size() == nq()) q[iq + m] = law.multiplier * q[iq + law.leader] + law.offset;
+    if (qd.size() == nv()) qd[iv + m] = law.multiplier * qd[iv + law.leader];
   }
 }
 

@@ -33,6 +33,7 @@ const char* codeName(StatusCode code) {
     case StatusCode::BadOption: return "BadOption";
     case StatusCode::Infeasible: return "Infeasible";
     case StatusCode::MimicMismatch: return "MimicMismatch";
+    case StatusCode::BadConfiguration: return "BadConfiguration";
   }
   return "Unknown";
 }

@@ -175,7 +175,8 @@ bool documented(StatusCode code) {
     case StatusCode::Degenerate:
     case StatusCode::BadOption:
     case StatusCode::Infeasible:
-    case StatusCode::MimicMismatch: return true;
+    case StatusCode::MimicMismatch:
+    case StatusCode::BadConfiguration: return true;
   }
   return false;
 }

@@ -13,6 +13,12 @@ using Vec3 = Eigen::Vector3d;              ///< 3-vector: a position, or the lin
 using Mat3 = Eigen::Matrix3d;              ///< 3×3 matrix: a rotation or a rotational inertia.
 using Vec6 = Eigen::Matrix<double, 6, 1>;  ///< Spatial vector, linear part first: motion [v; ω] or force [f; n].
 using Mat6 = Eigen::Matrix<double, 6, 6>;  ///< 6×6 spatial matrix: an inertia or a transform.
+/// 6 × k, k ≤ 6, without heap memory: the motion subspace of a multi-DOF joint.
+using Matrix6Xmax = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
+/// k × k, k ≤ 6, without heap memory: a multi-DOF joint's D.
+using MatrixXmax6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+/// k-vector, k ≤ 6, without heap memory: a multi-DOF joint's u or q̈.
+using VectorXmax6 = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 
 /// Spatial (Plücker) algebra, linear part first; it does not depend on the model.
 namespace spatial {

@@ -1,0 +1,177 @@
+// A floating base as the joint of body 0 to the world: Algorithm 1's lines
+// for a joint of k = 6 (free) or 3 (planar) coordinates, the last step of the
+// inward sweep and the first of the outward ones. Read next to the report's
+// Algorithm 1 and src/dynamics/popov_vereshchagin.cpp. Differences from the
+// 1-DOF joints:
+//  * D₀ = S₀ᵀ I^A₀ S₀ is a k × k matrix (factorised once, Cholesky) and u₀ a
+//    k-vector; the base has no motor and no rotor inertia, but takes a
+//    generalized force τ_base (normally 0);
+//  * the coordinates the sweep uses for the base are not the user's
+//    (docs/conventions.md, "Floating base"). Free: S₀ = 1 in base
+//    coordinates (the sweep's q̇₀ is the base's spatial velocity Ẋ₀ itself
+//    and Ẍ_bias,0 = 0), so P^A₀ = 1 − I^A₀ S₀ D₀⁻¹ S₀ᵀ = 0: nothing passes
+//    past a free base and the world's acceleration drops out. The user's
+//    v_B = ᴮX₀ Ẋ₀ and v̇_B = ᴮX₀ Ẍ₀ (the derivative of a motion vector's body
+//    coordinates is its spatial derivative, since v × v = 0).
+//    Planar: S₀ = [e_x 0; e_y 0; p × e_z e_z] (plane axes e, base origin p),
+//    the user's coordinates; S₀ changes with p, so Ẍ_bias,0 = Ṡ₀ q̇₀ =
+//    [ṗ × e_z ψ̇; 0];
+//  * gravity stays the world's acceleration [−g; 0] (the report's line 2),
+//    now under a moving base.
+#include "dynamics/floating_base.hpp"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "dynamics/sweeps.hpp"
+
+namespace zwang::internal {
+
+namespace {
+
+// The base's pose ⁰X₀ from its coordinates.
+Transform basePose(const Model& model, const VectorRef& q_base) {
+  if (model.baseType() == BaseType::Free) {
+    // The solve has checked the quaternion is unit to 1e-6 (checkSolveInputs);
+    // it is used normalised, so that R is a rotation to rounding.
+    Eigen::Quaterniond quat(q_base[3], q_base[4], q_base[5], q_base[6]);
+    quat.normalize();
+    return Transform::fromPose(quat.toRotationMatrix(), q_base.head<3>());
+  }
+  // Planar: plane ∘ translate(x, y, 0) ∘ rot_z(ψ).
+  const Transform& plane = model.basePlacement();  // ᴾX_world
+  const Mat3 R_plane = plane.E.transpose();
+  const Vec3 p = plane.r + R_plane * Vec3(q_base[0], q_base[1], 0.0);
+  const Mat3 R = R_plane * Eigen::AngleAxisd(q_base[2], Vec3::UnitZ()).toRotationMatrix();
+  return Transform::fromPose(R, p);
+}
+
+}  // namespace
+
+void baseKinematics(const Model& model, const VectorRef& q_base, const VectorRef& v_base, Workspace& ws,
+                    bool with_inertia) {
+  const Transform X = ws.Xworld[0] = basePose(model, q_base);
+  const Vec3 p = X.r;
+  const bool moving = v_base.size() == model.baseVelocitySize();
+  Vec6& v0 = ws.v[0];
+  Vec6& c0 = ws.c[0];
+  c0.setZero();
+  if (model.baseType() == BaseType::Free) {
+    ws.S_base.setIdentity(6, 6);
+    if (moving) {
+      Vec6 vB;
+      vB << v_base.head<3>(), v_base.tail<3>();
+      v0 = X.inverseApplyMotion(vB);  // ⁰X_B v_B
+    } else {
+      v0.setZero();
+    }
+  } else {
+    const Mat3 R_plane = model.basePlacement().E.transpose();
+    const Vec3 ex = R_plane.col(0), ey = R_plane.col(1), ez = R_plane.col(2);
+    ws.S_base.resize(6, 3);
+    ws.S_base.col(0) << ex, Vec3::Zero();
+    ws.S_base.col(1) << ey, Vec3::Zero();
+    ws.S_base.col(2) << p.cross(ez), ez;
+    if (moving) {
+      v0 = ws.S_base * v_base;
+      const Vec3 p_dot = ex * v_base[0] + ey * v_base[1];
+      c0.head<3>() = p_dot.cross(ez) * v_base[2];  // Ṡ₀ q̇₀: only S₀'s third column moves with p
+    } else {
+      v0.setZero();
+    }
+  }
+  if (with_inertia) ws.I[0] = spatial::inverseTransformInertia(X, model.inertia(0));
+}
+
+Status baseInward(const Model& model, const Task& task, const VectorRef& tau_base, Workspace& ws) {
+  const int k = model.baseVelocitySize();
+  const int m = task.solverColumns();
+  if (model.dof() == 0) {  // no child summed into body 0: lines 8–9 here
+    ws.IA[0] = ws.I[0].matrix();
+    ws.FA[0] = ws.Fbias[0];
+  }
+  const Mat6& IA = ws.IA[0];
+  Vec6 pA = ws.FA[0];
+  pA.noalias() += IA * ws.c[0];  // F^A₀ + I^A₀ Ẍ_bias,0
+  const Matrix6Xmax& S = ws.S_base;
+  ws.IAS_base.noalias() = IA * S;
+  const MatrixXmax6 D = S.transpose() * ws.IAS_base;  // line 13 (no rotor inertia at the base)
+  ws.D_base.compute(D);
+  if (ws.D_base.info() != Eigen::Success || !(ws.D_base.matrixLLT().diagonal().minCoeff() > 1e-150))
+    return Status::error(StatusCode::Degenerate,
+                         "the %s base has no inertia to move here (D₀ is not positive definite): the robot "
+                         "needs mass whose motion the base coordinates reach",
+                         toString(model.baseType()));
+  // u₀ = τ₀ − S₀ᵀ(F^A₀ + I^A₀ Ẍ_bias,0), τ₀ in the sweep's coordinates: for a
+  // free base the wrench ⁰X_B* τ_B whose power with Ẋ₀ is τ_Bᵀ v_B.
+  if (model.baseType() == BaseType::Free) {
+    Vec6 tauB;
+    tauB << tau_base.head<3>(), tau_base.tail<3>();
+    ws.u_base = ws.Xworld[0].inverseApplyForce(tauB) - pA;
+  } else {
+    ws.u_base = tau_base - S.transpose() * pA;
+  }
+  const MatrixXmax6 D_inverse = ws.D_base.solve(MatrixXmax6::Identity(k, k));
+  ws.base_D_inverse_norm = D_inverse.cwiseAbs().colwise().sum().maxCoeff();
+  const VectorXmax6 u_D = ws.D_base.solve(ws.u_base);
+
+  // Lines 19–21 for every column (all act on body 0's subtree, the whole tree).
+  ConstraintMatrix& A = ws.Ahat;
+  auto sA = ws.SA_base.topLeftCorner(k, m);
+  sA.noalias() = S.transpose() * A.leftCols(m);  // (S₀ᵀ A₀)
+  auto sA_D = ws.SA_base_D.topLeftCorner(k, m);
+  sA_D.noalias() = D_inverse * sA;
+  for (int col = 0; col < m; ++col) {
+    ws.L_scale[col] += sA.col(col).squaredNorm() * ws.base_D_inverse_norm;
+    ws.U[col] += A.col(col).dot(ws.c[0]) + sA.col(col).dot(u_D);  // line 20
+    for (int r = col; r < m; ++r) ws.L(r, col) += sA.col(r).dot(sA_D.col(col));  // line 21, lower triangle
+  }
+  if (model.baseType() == BaseType::Free)
+    A.leftCols(m).setZero();  // P^A₀ = 0 exactly: I^A₀ (I^A₀)⁻¹ = 1
+  else
+    A.leftCols(m).noalias() -= ws.IAS_base * sA_D;  // line 19
+  return {};
+}
+
+void baseAcceleration(const Model& model, const Task& task, Workspace& ws) {
+  const int m = task.solverColumns();
+  const Vec6 a_world = gravityAcceleration(task.gravity);
+  VectorXmax6 rhs = ws.u_base;
+  rhs.noalias() -= ws.IAS_base.transpose() * a_world;
+  rhs.noalias() += ws.SA_base.topLeftCorner(model.baseVelocitySize(), m) * ws.nu.head(m);  // S₀ᵀ A₀ ν
+  ws.qdd_base = ws.D_base.solve(rhs);                                                     // line 28
+  ws.a[0] = a_world + ws.S_base * ws.qdd_base + ws.c[0];                                  // line 29
+}
+
+void publishBaseAcceleration(const Model& model, const Workspace& ws, const VectorXmax6& qdd_sweep,
+                             Eigen::Ref<Eigen::VectorXd> qdd_base) {
+  if (model.baseType() == BaseType::Free) {
+    const Vec6 a = qdd_sweep;            // S₀ = 1 and Ẍ_bias,0 = 0: the true Ẍ₀ itself
+    qdd_base = ws.Xworld[0].applyMotion(a);  // v̇_B = ᴮX₀ Ẍ₀
+  } else {
+    qdd_base = qdd_sweep;
+  }
+}
+
+Vec6 baseTrueAcceleration(const Model& model, const Workspace& ws, const VectorRef& qdd_base) {
+  if (model.baseType() == BaseType::Free) {
+    Vec6 vB_dot;
+    vB_dot << qdd_base.head<3>(), qdd_base.tail<3>();
+    return ws.Xworld[0].inverseApplyMotion(vB_dot);  // ⁰X_B v̇_B
+  }
+  return ws.S_base * qdd_base + ws.c[0];
+}
+
+Vec6 baseClassicalAcceleration(const Task& task, const Workspace& ws) {
+  return classicalAtPoint(ws.a[0] - gravityAcceleration(task.gravity), ws.v[0], ws.Xworld[0].r);
+}
+
+void baseGeneralizedForce(const Model& model, const Workspace& ws, const Vec6& F0, Eigen::Ref<Eigen::VectorXd> out) {
+  if (model.baseType() == BaseType::Free)
+    out = ws.Xworld[0].applyForce(F0);  // τ_B = ⁰X_Bᵀ F₀ = ᴮX₀* F₀
+  else
+    out = ws.S_base.transpose() * F0;
+}
+
+}  // namespace zwang::internal

@@ -1,0 +1,49 @@
+// A floating base: the joint of body 0 to the world, with k = 6 (free) or 3
+// (planar) unactuated coordinates, as one more step of each sweep of
+// Algorithm 1 (src/dynamics/floating_base.cpp). Not installed.
+#pragma once
+
+#include "zwang/status.hpp"
+#include "zwang/workspace.hpp"
+
+namespace zwang::internal {
+
+using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
+
+// Lines 3–6 for the base joint: the base's pose ⁰X₀ (into ws.Xworld[0]), its
+// motion subspace S₀ (ws.S_base), velocity Ẋ₀ (ws.v[0]), bias acceleration
+// (ws.c[0]) and, when `with_inertia`, its inertia ws.I[0]. `q_base` has
+// baseConfigurationSize() entries, `v_base` baseVelocitySize() (or none: at rest).
+void baseKinematics(const Model& model, const VectorRef& q_base, const VectorRef& v_base, Workspace& ws,
+                    bool with_inertia);
+
+// Lines 13–21 for the base joint, after the joints' inward sweep has summed
+// the children's I^a and F^a into body 0: D₀, u₀ (with the generalized force
+// `tau_base` on the base coordinates), S₀ᵀA₀, and their terms of U₀ and 𝓛₀;
+// the columns projected past the base (zero for a free base). Degenerate when
+// D₀ is not positive definite.
+Status baseInward(const Model& model, const Task& task, const VectorRef& tau_base, Workspace& ws);
+
+// Lines 28–29 for the base joint, from ws.nu: q̈₀ (ws.qdd_base) and Ẍ₀ (ws.a[0]).
+void baseAcceleration(const Model& model, const Task& task, Workspace& ws);
+
+// The base's q̈ in the user's coordinates (the derivative of its velocity
+// coordinates) from a q̈₀ in the sweep's coordinates. Linear (no bias term:
+// free bases have none, planar ones use the user's coordinates), so it maps
+// differences too.
+void publishBaseAcceleration(const Model& model, const Workspace& ws, const VectorXmax6& qdd_sweep,
+                             Eigen::Ref<Eigen::VectorXd> qdd_base);
+
+// The base's true spatial acceleration (base coordinates of the sweep, without
+// gravity's shift) from its q̈ in the user's coordinates.
+Vec6 baseTrueAcceleration(const Model& model, const Workspace& ws, const VectorRef& qdd_base);
+
+// The base's classical acceleration [p̈; ω̇] of its origin, world axes, after
+// the final sweep (ws.a[0]).
+Vec6 baseClassicalAcceleration(const Task& task, const Workspace& ws);
+
+// The generalized force on the base coordinates of a wrench F₀ (base
+// coordinates of the sweep: world axes, world origin) acting on body 0.
+void baseGeneralizedForce(const Model& model, const Workspace& ws, const Vec6& F0, Eigen::Ref<Eigen::VectorXd> out);
+
+}  // namespace zwang::internal

@@ -85,12 +85,14 @@ std::uint64_t splitMix64(std::uint64_t& state) noexcept;
 ///               quaternion (Shoemake's method, three draws);
 ///   Planar    : x, y uniform in [−1, 1] m, ψ uniform in [−π, π];
 ///   Joints    : one draw per independent joint in model order, uniform in its
-///               range: continuous joints in [−π, π]; other joints within their
-///               limits, an infinite limit replaced so that the range is at least
-///               2h wide (h = π rad, or 1 m for prismatic joints): lower by
-///               min(−h, upper − 2h), upper by max(h, lower + 2h). A leader's
-///               range is narrowed to keep its mimic joints within their limits
-///               when it can be; mimic joints are then set from their leaders.
+///               range: its limits (none for a continuous joint), narrowed to
+///               keep the mimic joints that follow it within their limits when
+///               that is possible; then each infinite end replaced so that the
+///               range is at least 2h wide (h = π rad, or 1 m for prismatic
+///               joints): lower by min(−h, upper − 2h), upper by max(h, lower +
+///               2h). So continuous joints and joints without limits draw from
+///               [−π, π] (prismatic: [−1, 1] m). Mimic joints draw nothing: they
+///               are set from their leaders.
 /// Each draw is u = (splitMix64(state) >> 11)·2⁻⁵³ ∈ [0, 1), mapped to
 /// (1 − u)·lo + u·hi. q_out has nq() entries.
 Status randomConfiguration(const Model& model, std::uint64_t& state, Eigen::Ref<Eigen::VectorXd> q_out) noexcept;

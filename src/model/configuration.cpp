@@ -27,7 +27,7 @@ struct EntryName {
 };
 
 EntryName configurationEntry(const Model& model, Eigen::Index k) {
-  static const char* const kFree[] = {"base position x", "base position y", "base position z", "base quaternion w",
+  static const char* const kFree[] = {"base position x",   "base position y",   "base position z",  "base quaternion w",
                                       "base quaternion x", "base quaternion y", "base quaternion z"};
   static const char* const kPlanar[] = {"base x", "base y", "base yaw psi"};
   EntryName name;
@@ -35,7 +35,8 @@ EntryName configurationEntry(const Model& model, Eigen::Index k) {
   if (k < base)
     std::snprintf(name.text, sizeof name.text, "%s", model.baseType() == BaseType::Free ? kFree[k] : kPlanar[k]);
   else
-    std::snprintf(name.text, sizeof name.text, "joint '%.60s'", model.joints()[static_cast<std::size_t>(k - base)].name.c_str());
+    std::snprintf(name.text, sizeof name.text, "joint '%.60s'",
+                  model.joints()[static_cast<std::size_t>(k - base)].name.c_str());
   return name;
 }
 
@@ -49,14 +50,16 @@ EntryName velocityEntry(const Model& model, Eigen::Index k) {
   if (k < base)
     std::snprintf(name.text, sizeof name.text, "%s", model.baseType() == BaseType::Free ? kFree[k] : kPlanar[k]);
   else
-    std::snprintf(name.text, sizeof name.text, "joint '%.60s'", model.joints()[static_cast<std::size_t>(k - base)].name.c_str());
+    std::snprintf(name.text, sizeof name.text, "joint '%.60s'",
+                  model.joints()[static_cast<std::size_t>(k - base)].name.c_str());
   return name;
 }
 
 Status checkConfigurationSize(const Model& model, const char* what, Eigen::Index size) {
   if (size == model.nq()) return {};
-  return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has nq = %d (%d base coordinates + %d joints)",
-                       what, static_cast<long>(size), model.nq(), model.baseConfigurationSize(), model.dof());
+  return Status::error(StatusCode::SizeMismatch,
+                       "%s has %ld entries, the model has nq = %d (%d base coordinates + %d joints)", what,
+                       static_cast<long>(size), model.nq(), model.baseConfigurationSize(), model.dof());
 }
 
 Status checkVelocity(const Model& model, const char* what, const ConstVector& v) {
@@ -87,11 +90,16 @@ Status checkConfigurationNamed(const Model& model, const char* what, const Const
                            configurationEntry(model, k).text, q[k]);
   if (model.baseType() == BaseType::Free) {
     const double norm = quaternionNorm(q);
+    if (norm == 0.0)
+      return Status::error(StatusCode::BadOption,
+                           "%s: base quaternion (entries 3-6, w x y z) is zero: not an orientation (the identity is "
+                           "w = 1, x = y = z = 0)",
+                           what);
     if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance))
       return Status::error(StatusCode::BadOption,
                            "%s: base quaternion (entries 3-6, w x y z) has norm %.9g, not 1 within %g "
-                           "(normalizeConfiguration fixes it%s)",
-                           what, norm, kQuaternionNormTolerance, norm == 0.0 ? " unless it is zero" : "");
+                           "(normalizeConfiguration fixes it)",
+                           what, norm, kQuaternionNormTolerance);
   }
   return {};
 }
@@ -134,9 +142,8 @@ Vec3 leftJacobianTimes(const Vec3& w, const Vec3& u) {
 // (V is singular only at θ = 2π, never reached by a logarithm).
 Vec3 inverseLeftJacobianTimes(const Vec3& w, const Vec3& u) {
   const double theta = w.norm(), t2 = theta * theta;
-  const double c = theta < kSeriesBelow
-                       ? 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
-                       : (1.0 - 0.5 * theta * std::cos(0.5 * theta) / std::sin(0.5 * theta)) / t2;
+  const double c = theta < kSeriesBelow ? 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
+                                        : (1.0 - 0.5 * theta * std::cos(0.5 * theta) / std::sin(0.5 * theta)) / t2;
   const Vec3 wu = w.cross(u);
   return u - 0.5 * wu + c * w.cross(wu);
 }
@@ -234,12 +241,12 @@ Status integrate(const Model& model, const ConstVector& q, const ConstVector& v,
   }
   for (int k = 0; k < nqb; ++k)
     if (!std::isfinite(base[k]))
-      return Status::error(StatusCode::NonFinite, "q_out[%d] (%s) overflows to %g: v*dt is too large", k,
+      return Status::error(StatusCode::NonFinite, "q_out[%d] (%s) would be %g: v*dt is too large", k,
                            configurationEntry(model, k).text, base[k]);
   for (int j = 0; j < model.dof(); ++j) {
     const double next = q[nqb + j] + v[nvb + j] * dt;
     if (!std::isfinite(next))
-      return Status::error(StatusCode::NonFinite, "q_out[%d] (%s) overflows to %g: v*dt is too large", nqb + j,
+      return Status::error(StatusCode::NonFinite, "q_out[%d] (%s) would be %g: v*dt is too large", nqb + j,
                            configurationEntry(model, nqb + j).text, next);
   }
 
@@ -257,25 +264,31 @@ Status difference(const Model& model, const ConstVector& q0, const ConstVector& 
                          "v_out has %ld entries, the model has nv = %d (%d base velocity coordinates + %d joints)",
                          static_cast<long>(v_out.size()), model.nv(), model.baseVelocitySize(), model.dof());
 
+  // Everything is computed and checked before v_out is touched: differences
+  // of finite numbers may still overflow (1e308 − (−1e308)), and an error
+  // leaves v_out unchanged.
   const int nqb = model.baseConfigurationSize(), nvb = model.baseVelocitySize();
+  Vec6 base;
   if (model.baseType() == BaseType::Free) {
     // M0⁻¹ M1 = (R0ᵀ R1, R0ᵀ (p1 − p0)) = exp([u; w]) with ω = log(R0ᵀ R1) and
     // R0ᵀ (p1 − p0) = V(ω) u.
     const Eigen::Quaterniond R0 = baseQuaternion(q0), R1 = baseQuaternion(q1);
     const Vec3 w = logRotation(R0.conjugate() * R1);
     const Vec3 p = R0.conjugate() * Vec3(q1.head<3>() - q0.head<3>());
-    v_out.head<3>() = inverseLeftJacobianTimes(w, p);
-    v_out.segment<3>(3) = w;
+    base << inverseLeftJacobianTimes(w, p), w;
   } else if (model.baseType() == BaseType::Planar) {
-    v_out[0] = q1[0] - q0[0];
-    v_out[1] = q1[1] - q0[1];
-    v_out[2] = wrapAngle(q1[2] - q0[2]);
+    base.head<3>() << q1[0] - q0[0], q1[1] - q0[1], wrapAngle(q1[2] - q0[2]);
   }
-  // Differences of finite numbers may still overflow (1e308 − (−1e308)).
+  for (int k = 0; k < nvb; ++k)
+    if (!std::isfinite(base[k]))
+      return Status::error(StatusCode::NonFinite, "v_out[%d] (%s) would be %g: q1 and q0 are too far apart", k,
+                           velocityEntry(model, k).text, base[k]);
   for (int j = 0; j < model.dof(); ++j)
     if (!std::isfinite(q1[nqb + j] - q0[nqb + j]))
-      return Status::error(StatusCode::NonFinite, "v_out[%d] (%s) overflows: q1 - q0 = %g", nvb + j,
+      return Status::error(StatusCode::NonFinite, "v_out[%d] (%s) would be %g: q1 and q0 are too far apart", nvb + j,
                            velocityEntry(model, nvb + j).text, q1[nqb + j] - q0[nqb + j]);
+
+  v_out.head(nvb) = base.head(nvb);
   v_out.tail(model.dof()) = q1.tail(model.dof()) - q0.tail(model.dof());
   return {};
 }

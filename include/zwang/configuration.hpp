@@ -105,7 +105,7 @@ Status normalizeConfiguration(const Model& model, Eigen::Ref<Eigen::VectorXd> q)
 /// Ok when q is a configuration of this model: nq() entries (SizeMismatch),
 /// all finite (NonFinite, naming the entry and what it is), and, with a free
 /// base, a quaternion whose norm is within kQuaternionNormTolerance of 1
-/// (BadOption, with the norm found). Joint limits and mimic laws are not
+/// (BadOption, with the norm found, or saying that it is zero). Joint limits and mimic laws are not
 /// checked here: a solve reports joints outside their limits, and refuses a
 /// mimic joint off its law (MimicMismatch) together with its velocity.
 Status checkConfiguration(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q) noexcept;

@@ -115,7 +115,8 @@ Eigen::Quaterniond baseQuaternion(const ConstVector& q) {
 // exp([w]×) as a unit quaternion: [cos(θ/2), sin(θ/2)/θ · w], θ = |w|.
 Eigen::Quaterniond expRotation(const Vec3& w) {
   const double theta = w.norm();
-  const double half_sinc = theta < kSeriesBelow ? 0.5 - theta * theta / 48.0 : std::sin(0.5 * theta) / theta;
+  const double t2 = theta * theta;
+  const double half_sinc = theta < kSeriesBelow ? 0.5 - t2 / 48.0 + t2 * t2 / 3840.0 : std::sin(0.5 * theta) / theta;
   const Vec3 xyz = half_sinc * w;
   return Eigen::Quaterniond(std::cos(0.5 * theta), xyz.x(), xyz.y(), xyz.z());
 }

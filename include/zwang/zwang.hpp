@@ -2,6 +2,7 @@
 /// zwang: constrained hybrid dynamics (Popov–Vereshchagin) with static friction.
 #pragma once
 
+#include "zwang/configuration.hpp"
 #include "zwang/friction.hpp"
 #include "zwang/hybrid_dynamics.hpp"
 #include "zwang/inverse_dynamics.hpp"

@@ -27,7 +27,7 @@ namespace zwang {
 
 // Every function here is noexcept and allocates nothing: bad input comes back
 // as a Status naming the input and the entry at fault (SizeMismatch, NonFinite,
-// BadOption), never as an exception. On an error the output is left unchanged.
+// BadConfiguration), never as an exception. On an error the output is left unchanged.
 
 /// How far the norm of a free base's quaternion may be from 1 before
 /// checkConfiguration (and with it every helper here and the solver) refuses q.
@@ -99,13 +99,13 @@ Status randomConfiguration(const Model& model, std::uint64_t& state, Eigen::Ref<
 
 /// Normalise a free base's quaternion (entries 3–6 of q) in place; nothing
 /// else changes (fixed and planar bases: only the size is checked). NonFinite
-/// when a quaternion entry is not finite, BadOption when the quaternion is zero.
+/// when a quaternion entry is not finite, BadConfiguration when the quaternion is zero.
 Status normalizeConfiguration(const Model& model, Eigen::Ref<Eigen::VectorXd> q) noexcept;
 
 /// Ok when q is a configuration of this model: nq() entries (SizeMismatch),
 /// all finite (NonFinite, naming the entry and what it is), and, with a free
 /// base, a quaternion whose norm is within kQuaternionNormTolerance of 1
-/// (BadOption, with the norm found, or saying that it is zero). Joint limits and mimic laws are not
+/// (BadConfiguration, with the norm found, or saying that it is zero). Joint limits and mimic laws are not
 /// checked here: a solve reports joints outside their limits, and refuses a
 /// mimic joint off its law (MimicMismatch) together with its velocity.
 Status checkConfiguration(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q) noexcept;

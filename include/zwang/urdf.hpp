@@ -76,7 +76,7 @@ struct UrdfOptions {
     std::string attach_beyond_tip = "UrdfOptions::attach_beyond_tip";   ///< the name of the attach_beyond_tip option
     std::string lock_mimic = "UrdfOptions::mimic = MimicJoints::Lock";  ///< how to ask for MimicJoints::Lock
     std::string refuse_mimic = "UrdfOptions::mimic = MimicJoints::Refuse";  ///< how MimicJoints::Refuse was asked for
-  } names;                                                              ///< see Names
+  } names;                                                                  ///< see Names
 };
 
 /// Throw ModelError with a message naming the file (or "<string>"), the link or

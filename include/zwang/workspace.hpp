@@ -83,8 +83,8 @@ struct Solution {
   /// (normally 0); constraints whose force the ground supplies (contacts)
   /// make up the rest.
   Eigen::VectorXd tau_control;
-  double gauss = 0.0;              ///< Z(q̈), the Gauss function (acceleration energy) at the solution
-  BalanceReport balance;           ///< how the balance went: rank, condition, damping, residual, consistent
+  double gauss = 0.0;     ///< Z(q̈), the Gauss function (acceleration energy) at the solution
+  BalanceReport balance;  ///< how the balance went: rank, condition, damping, residual, consistent
   /// A warning, not an error: joints whose q lies outside [lower, upper]
   /// (solved as given; the limits act only on stuck joints at a stop, in
   /// solveWithFriction). The count, and the first such joint (−1: none).
@@ -142,16 +142,16 @@ class Workspace {
   std::vector<double> inverse_D;  ///< 1 / D_i (the sweeps multiply)
   std::vector<double> u;          ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
   // --- a floating base: the joint of body 0 to the world, k = 6 or 3 coordinates
-  Matrix6Xmax S_base;                         ///< S₀ (6 × k), base coordinates of the base's motion
-  Matrix6Xmax IAS_base;                       ///< I^A₀ S₀ (6 × k)
-  Eigen::LLT<MatrixXmax6> D_base;             ///< D₀ = S₀ᵀ I^A₀ S₀ (k × k), factorised
-  VectorXmax6 u_base;                         ///< τ₀ − S₀ᵀ(F^A₀ + I^A₀ Ẍ_bias,0) (k)
-  VectorXmax6 qdd_base;                       ///< q̈₀ in the sweep's coordinates (k)
-  Eigen::MatrixXd SA_base;                    ///< S₀ᵀ A₀ (k × columns; 6 rows kept)
-  Eigen::MatrixXd SA_base_D;                  ///< D₀⁻¹ S₀ᵀ A₀ (k × columns; 6 rows kept)
-  double base_D_inverse_norm = 0.0;           ///< ‖D₀⁻¹‖₁, the size rounding in 𝓛 is relative to
-  Eigen::MatrixXd SA;             ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
-  ConstraintMatrix Ahat;          ///< A_i (6 × capacity), updated in place from A_N down to A_0
+  Matrix6Xmax S_base;                ///< S₀ (6 × k), base coordinates of the base's motion
+  Matrix6Xmax IAS_base;              ///< I^A₀ S₀ (6 × k)
+  Eigen::LLT<MatrixXmax6> D_base;    ///< D₀ = S₀ᵀ I^A₀ S₀ (k × k), factorised
+  VectorXmax6 u_base;                ///< τ₀ − S₀ᵀ(F^A₀ + I^A₀ Ẍ_bias,0) (k)
+  VectorXmax6 qdd_base;              ///< q̈₀ in the sweep's coordinates (k)
+  Eigen::MatrixXd SA_base;           ///< S₀ᵀ A₀ (k × columns; 6 rows kept)
+  Eigen::MatrixXd SA_base_D;         ///< D₀⁻¹ S₀ᵀ A₀ (k × columns; 6 rows kept)
+  double base_D_inverse_norm = 0.0;  ///< ‖D₀⁻¹‖₁, the size rounding in 𝓛 is relative to
+  Eigen::MatrixXd SA;                ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
+  ConstraintMatrix Ahat;             ///< A_i (6 × capacity), updated in place from A_N down to A_0
   /// U_0, acceleration energy of bias forces and torques: the report's U (not
   /// Featherstone's or Pinocchio's U = I^A S, which is IAS here).
   Eigen::VectorXd U;

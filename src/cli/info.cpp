@@ -89,8 +89,8 @@ Json infoJson(const Model& model, const std::string& path) {
                       {"viscous_friction", j.viscous_friction},
                       {"rotor_inertia", j.rotor_inertia},
                       {"mimic", j.mimic.active() ? Json({{"leader", model.joint(j.mimic.leader).name},
-                                                        {"multiplier", j.mimic.multiplier},
-                                                        {"offset", j.mimic.offset}})
+                                                         {"multiplier", j.mimic.multiplier},
+                                                         {"offset", j.mimic.offset}})
                                                  : Json(nullptr)}});
   }
   Json frames = Json::array();

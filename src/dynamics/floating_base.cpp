@@ -124,7 +124,7 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
   sA_D.noalias() = D_inverse * sA;
   for (int col = 0; col < m; ++col) {
     ws.L_scale[col] += sA.col(col).squaredNorm() * ws.base_D_inverse_norm;
-    ws.U[col] += A.col(col).dot(ws.c[0]) + sA.col(col).dot(u_D);  // line 20
+    ws.U[col] += A.col(col).dot(ws.c[0]) + sA.col(col).dot(u_D);                 // line 20
     for (int r = col; r < m; ++r) ws.L(r, col) += sA.col(r).dot(sA_D.col(col));  // line 21, lower triangle
   }
   if (model.baseType() == BaseType::Free)
@@ -140,14 +140,14 @@ void baseAcceleration(const Model& model, const Task& task, Workspace& ws) {
   VectorXmax6 rhs = ws.u_base;
   rhs.noalias() -= ws.IAS_base.transpose() * a_world;
   rhs.noalias() += ws.SA_base.topLeftCorner(model.baseVelocitySize(), m) * ws.nu.head(m);  // S₀ᵀ A₀ ν
-  ws.qdd_base = ws.D_base.solve(rhs);                                                     // line 28
-  ws.a[0] = a_world + ws.S_base * ws.qdd_base + ws.c[0];                                  // line 29
+  ws.qdd_base = ws.D_base.solve(rhs);                                                      // line 28
+  ws.a[0] = a_world + ws.S_base * ws.qdd_base + ws.c[0];                                   // line 29
 }
 
 void publishBaseAcceleration(const Model& model, const Workspace& ws, const VectorXmax6& qdd_sweep,
                              Eigen::Ref<Eigen::VectorXd> qdd_base) {
   if (model.baseType() == BaseType::Free) {
-    const Vec6 a = qdd_sweep;            // S₀ = 1 and Ẍ_bias,0 = 0: the true Ẍ₀ itself
+    const Vec6 a = qdd_sweep;                // S₀ = 1 and Ẍ_bias,0 = 0: the true Ẍ₀ itself
     qdd_base = ws.Xworld[0].applyMotion(a);  // v̇_B = ᴮX₀ Ẍ₀
   } else {
     qdd_base = qdd_sweep;

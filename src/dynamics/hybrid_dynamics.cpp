@@ -19,7 +19,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   balance(task, ws);                                               // lines 23–25
   outwardAccelerations(model, task, ws, out.qdd);                  // lines 26–30
   if (model.hasFloatingBase()) out.base_acceleration_world = baseClassicalAcceleration(task, ws);
-  taskResidual(task, ws);                                          // how well Aᵀ Ẍ = b is met
+  taskResidual(task, ws);  // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(task.solverColumns()), out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques

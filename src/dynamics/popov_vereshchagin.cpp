@@ -30,6 +30,8 @@
 //    base's coordinates first: the stages below index the joints' part.
 #include "dynamics/popov_vereshchagin.hpp"
 
+#include "zwang/configuration.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -46,18 +48,6 @@ inline std::size_t at(int i) { return static_cast<std::size_t>(i); }
 }  // namespace
 
 namespace {
-// A free base's quaternion must be unit: within 1e-6 of norm 1 (what float32
-// round trips and long integrations leave) it is used normalised; beyond, the
-// caller's state is not a pose.
-Status checkBaseQuaternion(const Model& model, const VectorRef& q) {
-  if (model.baseType() != BaseType::Free) return {};
-  const double norm = q.segment<4>(3).norm();
-  if (!(std::abs(norm - 1.0) <= 1e-6))
-    return Status::error(StatusCode::BadConfiguration,
-                         "q: the base quaternion (entries 3-6, w x y z) has norm %.17g, not 1 (normalise it)", norm);
-  return {};
-}
-
 // A mimic joint's q and q̇ must follow its leader's: the mechanism cannot be
 // anywhere else, and solving such a state would be a silent wrong answer.
 // Allowed: the rounding of a·q + b and what an integrator's steps add to it
@@ -99,10 +89,9 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
                          "task has %d constraint rows, the workspace was made for at most %d", task.constraintRows(),
                          ws.constraintCapacity());
   if (Status s = checkBalanceOptions(task.balance); !s) return s;
-  if (Status s = checkVector("q", q, model.nq()); !s) return s;
+  if (Status s = checkConfiguration(model, q); !s) return s;  // size, finite, a free base's unit quaternion
   if (Status s = checkVector("qd", qd, model.nv()); !s) return s;
   if (Status s = checkVector("tau", tau, model.nv()); !s) return s;
-  if (Status s = checkBaseQuaternion(model, q); !s) return s;
   if (task.balanceRows() > ws.balanceCapacity())  // a workspace made for a model with fewer mimic joints
     return Status::error(StatusCode::WorkspaceTooSmall,
                          "task has %d balance rows (%d constraint, %d mimic), the workspace was made for at most %d",
@@ -219,7 +208,7 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
   const bool moving = qd.size() == model.nv();
   const bool floating = model.hasFloatingBase();
   if (floating) baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, true);  // lines 3–6, base
-  outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, true);                  // lines 3–6
+  outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, true);                 // lines 3–6
   for (int i = floating ? 0 : 1; i <= n; ++i)
     ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);  // line 7, without F_ext
   applyExternalWrenches(model, task, ws);                                           // line 7: − F_ext
@@ -426,7 +415,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
   if (floating) {  // the base joint: every column's δF^a has reached body 0
     for (Eigen::Index c = 0; c < k; ++c) {
-      du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));                // δu₀ (no torque at the base)
+      du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));  // δu₀ (no torque at the base)
       const VectorXmax6 du_D = ws.D_base.solve(du_base.col(c).head(kb));
       for (int r = 0; r < m; ++r) dU(r, c) += ws.SA_base.col(r).head(kb).dot(du_D);  // line 20
     }

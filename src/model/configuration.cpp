@@ -57,12 +57,18 @@ EntryName velocityEntry(const Model& model, Eigen::Index k) {
 
 Status checkConfigurationSize(const Model& model, const char* what, Eigen::Index size) {
   if (size == model.nq()) return {};
+  if (!model.hasFloatingBase())  // worded as the solver's other state vectors are
+    return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %d joints", what,
+                         static_cast<long>(size), model.dof());
   return Status::error(StatusCode::SizeMismatch,
                        "%s has %ld entries, the model has nq = %d (%d base coordinates + %d joints)", what,
                        static_cast<long>(size), model.nq(), model.baseConfigurationSize(), model.dof());
 }
 
 Status checkVelocity(const Model& model, const char* what, const ConstVector& v) {
+  if (v.size() != model.nv() && !model.hasFloatingBase())
+    return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %d joints", what,
+                         static_cast<long>(v.size()), model.dof());
   if (v.size() != model.nv())
     return Status::error(StatusCode::SizeMismatch,
                          "%s has %ld entries, the model has nv = %d (%d base velocity coordinates + %d joints)", what,
@@ -91,12 +97,12 @@ Status checkConfigurationNamed(const Model& model, const char* what, const Const
   if (model.baseType() == BaseType::Free) {
     const double norm = quaternionNorm(q);
     if (norm == 0.0)
-      return Status::error(StatusCode::BadOption,
+      return Status::error(StatusCode::BadConfiguration,
                            "%s: base quaternion (entries 3-6, w x y z) is zero: not an orientation (the identity is "
                            "w = 1, x = y = z = 0)",
                            what);
     if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance))
-      return Status::error(StatusCode::BadOption,
+      return Status::error(StatusCode::BadConfiguration,
                            "%s: base quaternion (entries 3-6, w x y z) has norm %.9g, not 1 within %g "
                            "(normalizeConfiguration fixes it)",
                            what, norm, kQuaternionNormTolerance);
@@ -191,10 +197,10 @@ void leaderRange(const Model& model, int j, double& lo, double& hi) {
   if (!(lo <= hi)) lo = own_lo, hi = own_hi;
 }
 
-// The mimic joints set from their leaders, on the joint part of q.
+// The mimic joints set from their leaders (Model::followLeaders reads past the base's entries).
 void followLeaders(const Model& model, Vector q) {
   Eigen::Map<Eigen::VectorXd> no_velocity(nullptr, 0);
-  model.followLeaders(q.tail(model.dof()), no_velocity);
+  model.followLeaders(q, no_velocity);
 }
 
 // Uniform in [0, 1) from the top 53 bits of one draw.
@@ -349,7 +355,7 @@ Status normalizeConfiguration(const Model& model, Vector q) noexcept {
                            k, configurationEntry(model, k).text, q[k]);
   const double norm = quaternionNorm(q);
   if (norm == 0.0)
-    return Status::error(StatusCode::BadOption,
+    return Status::error(StatusCode::BadConfiguration,
                          "q: base quaternion (entries 3-6, w x y z) is zero: no orientation to normalise");
   q.segment<4>(3) /= norm;
   return {};

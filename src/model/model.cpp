@@ -292,8 +292,8 @@ const char* toString(BaseType type) {
 ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement) {
   if (model_.base_type_ != BaseType::Fixed)
     throw ModelError(std::string("the base already floats (a ") + toString(model_.base_type_) +
-                     " joint under the root link '" + model_.frames_[0].name + "'): it cannot get a " +
-                     toString(type) + " base as well");
+                     " joint under the root link '" + model_.frames_[0].name + "'): it cannot get a " + toString(type) +
+                     " base as well");
   if (!finite(placement)) throw ModelError("base placement is not finite");
   if (type == BaseType::Free && !(placement.E.isIdentity(0.0) && placement.r.isZero(0.0)))
     throw ModelError("a free base takes no placement (its pose is its configuration)");
@@ -387,9 +387,8 @@ Model ModelBuilder::build() const {
   }
   Model model = model_;
   if (model.hasFloatingBase())
-    for (const ModelWarning& w :
-         validate::rigidInertia("base body of link '" + model.frames_[0].name + "' (with the links welded to it)",
-                                model.inertias_[0]))
+    for (const ModelWarning& w : validate::rigidInertia(
+             "base body of link '" + model.frames_[0].name + "' (with the links welded to it)", model.inertias_[0]))
       model.warnings_.push_back(w);
   resolveMimicChains(model.joints_, model.mimic_joints_);
   return model;

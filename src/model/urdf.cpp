@@ -481,19 +481,19 @@ double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const Ur
                            " (its position when '" + uj.mimic->joint_name + "' is at rest)";
   if (!chain_before.empty())
     report.fail("joint '" + uj.name + "' on the chain mimics joint '" + uj.mimic->joint_name + "' (" + mimicLaw(uj) +
-                "): refused (" + options.names.refuse_mimic + "); choose a " +
-                options.names.tip + " before it (e.g. '" + chain_before + "') or set " + lock);
-  report.fail("joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" + mimicLaw(uj) +
-              "): refused (" + options.names.refuse_mimic + "); model it (the default), set " + lock +
-              ", or choose a " + options.names.tip + " for a chain without it");
+                "): refused (" + options.names.refuse_mimic + "); choose a " + options.names.tip +
+                " before it (e.g. '" + chain_before + "') or set " + lock);
+  report.fail("joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" + mimicLaw(uj) + "): refused (" +
+              options.names.refuse_mimic + "); model it (the default), set " + lock + ", or choose a " +
+              options.names.tip + " for a chain without it");
 }
 
 // A note on a locked mimic joint (MimicLocked, which strict mode lets pass).
 ModelWarning mimicLockedNote(const urdf::Joint& uj, double q, const UrdfOptions& options) {
   return {WarningCode::MimicLocked, "joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" +
                                         mimicLaw(uj) + "): locked at q = " + fmt(q) + " (" + options.names.lock_mimic +
-                                        "), link '" + uj.child_link_name +
-                                        "' welded to link '" + uj.parent_link_name + "'"};
+                                        "), link '" + uj.child_link_name + "' welded to link '" + uj.parent_link_name +
+                                        "'"};
 }
 
 // ᶜX_p of a joint locked at position q (revolute and continuous turn about the
@@ -646,7 +646,8 @@ void addMimicLaws(const Reporter& report, const urdf::ModelInterface& urdf_model
     const std::string who = "joint '" + name + "' (" + mimicLaw(uj) + ") mimics joint '" + leader + "'";
     const urdf::JointConstSharedPtr leader_joint = urdf_model.getJoint(leader);
     if (!leader_joint) report.fail(who + ", which the URDF does not have");
-    if (!isMoving(*leader_joint)) report.fail(who + ", which is not a moving joint (a fixed, floating or planar joint)");
+    if (!isMoving(*leader_joint))
+      report.fail(who + ", which is not a moving joint (a fixed, floating or planar joint)");
     if (std::find(moving.begin(), moving.end(), leader) == moving.end())
       report.fail(who + ", which is not in " + what + ": load a tree or chain that holds both, or set " +
                   options.names.lock_mimic);
@@ -940,8 +941,8 @@ void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, c
                 (locked ? " (its mimic joints are locked)" : ""));
   checkRotorNames(report, urdf_model, options, moving, "the chain from '" + root->name + "' to '" + tip_name + "'");
   addChain(report, builder, placement, chain, rotor, options);
-  addMimicLaws(report, urdf_model, options, moving,
-               "the chain from '" + root->name + "' to '" + tip_name + "'", builder);
+  addMimicLaws(report, urdf_model, options, moving, "the chain from '" + root->name + "' to '" + tip_name + "'",
+               builder);
   handleBeyondTip(report, builder, placement, tip_name, options);
   warnMassOffChain(placement, urdf_model, root->name, options);
 }

@@ -112,8 +112,8 @@ void bindModel(py::module_& m) {
       .def_property_readonly(
           "mimic",
           [](const Joint& j) -> py::object {
-    if (!j.mimic.active()) return py::none();
-    return py::make_tuple(j.mimic.leader, j.mimic.multiplier, j.mimic.offset);
+            if (!j.mimic.active()) return py::none();
+            return py::make_tuple(j.mimic.leader, j.mimic.multiplier, j.mimic.offset);
           },
           "None, or (leader joint index, multiplier, offset) when the joint follows q = multiplier*q_leader + offset")
       .def("__repr__", &jointRepr);

@@ -33,7 +33,7 @@ def test_wrong_length_carries_the_cpp_status(panda, ws, name):
 def test_non_finite(panda, ws, bad):
     q = np.array(READY)
     q[3] = bad
-    with pytest.raises(zwang.SolveError, match=r"q\[3\] is .*not finite") as e:
+    with pytest.raises(zwang.SolveError, match=r"q\[3\] \(joint 'panda_joint4'\) is .*not finite") as e:
         solve(panda, ws, q=q)
     assert e.value.code == "NonFinite"
     with pytest.raises(zwang.SolveError, match="gravity"):

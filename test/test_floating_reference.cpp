@@ -618,7 +618,7 @@ TEST_CASE("floating reference: Jacobians, J̇v, constraints, Gauss minimum, inve
   options.relative_probability = 0.3;
   options.base_tau_probability = 0.3;
   double jac = 0.0, jdot = 0.0, rows = 0.0, gauss_gap = 0.0, kkt = 0.0, id = 0.0, fixed = 0.0;
-  int constrained = 0, fixed_count = 0;
+  int constrained = 0, fixed_count = 0, absolute_rows = 0, relative_rows = 0;
   for (int trial = 0; trial < 150; ++trial) {
     const FloatingProblem p = randomFloatingProblem(rng, options);
     const FloatingKinematics kin = floatingKinematics(p.spec, p.base, p.input.q, p.input.v);
@@ -660,16 +660,30 @@ TEST_CASE("floating reference: Jacobians, J̇v, constraints, Gauss minimum, inve
       continue;
     ++constrained;
     kkt = std::max(kkt, relErr(r.H * r.qdd + r.C, p.input.tau + r.G.transpose() * r.nu));
-    // Each absolute row holds in terms of the link's classical acceleration: Aᵀ Ẍ = b.
-    int row = 0;
+    // Each row holds in terms of classical accelerations (acc_world) and velocities: Aᵀ Ẍ = b, for a relative row
+    // with Ẍ = [p̈_rel; ω̇_rel] of dense_reference.hpp (ConstraintInput) in the row's axes.
     for (const ConstraintInput& c : p.input.constraints) {
-      const int li = p.spec.linkIndex(c.link);
-      if (c.relative_to.empty()) {
-        const Vector6d acc = c.axes == Axes::World ? r.acc_world[static_cast<std::size_t>(li)]
-                                                   : r.acc_local[static_cast<std::size_t>(li)];
-        rows = std::max(rows, relErr(c.A.transpose() * acc, c.b));
+      const auto a = static_cast<std::size_t>(p.spec.linkIndex(c.link));
+      Eigen::Vector3d acc_lin = r.acc_world[a].head<3>(), acc_ang = r.acc_world[a].tail<3>();
+      Eigen::Matrix3d R = c.axes == Axes::Local ? kin.poses[a].linear() : Eigen::Matrix3d(Eigen::Matrix3d::Identity());
+      if (!c.relative_to.empty()) {
+        const auto b = static_cast<std::size_t>(p.spec.linkIndex(c.relative_to));
+        auto pointVelocity = [&](std::size_t i) -> Eigen::Vector3d {
+          return kin.v[i].head<3>() + kin.v[i].tail<3>().cross(kin.poses[i].translation());
+        };
+        const Eigen::Vector3d d = kin.poses[a].translation() - kin.poses[b].translation();
+        const Eigen::Vector3d d_dot = pointVelocity(a) - pointVelocity(b);
+        const Eigen::Vector3d w_a = kin.v[a].tail<3>(), w_r = kin.v[b].tail<3>();
+        const Eigen::Vector3d alpha_r = r.acc_world[b].tail<3>();
+        acc_lin =
+            acc_lin - r.acc_world[b].head<3>() - alpha_r.cross(d) - 2.0 * w_r.cross(d_dot) + w_r.cross(w_r.cross(d));
+        acc_ang = acc_ang - alpha_r - w_r.cross(w_a - w_r);
+        if (c.axes == Axes::Reference) R = kin.poses[b].linear();
       }
-      row += static_cast<int>(c.A.cols());
+      Vector6d acc;
+      acc << R.transpose() * acc_lin, R.transpose() * acc_ang;
+      rows = std::max(rows, relErr(c.A.transpose() * acc, c.b));
+      (c.relative_to.empty() ? absolute_rows : relative_rows) += static_cast<int>(c.A.cols());
     }
     // Gauss: any other acceleration that meets the rows costs more (Z grows by ½ δᵀHδ).
     const Eigen::MatrixXd N = Eigen::FullPivLU<Eigen::MatrixXd>(r.G).kernel();
@@ -706,13 +720,14 @@ TEST_CASE("floating reference: Jacobians, J̇v, constraints, Gauss minimum, inve
   }
   std::printf(
       "floating reference self-checks: link velocities vs pose differences %.2e, J̇v vs differences of Jv %.2e; "
-      "%d constrained draws: KKT residual %.2e, rows vs classical accelerations %.2e, |Z(v̇ + δ) − Z(v̇)| / (½δᵀHδ) − 1 for δ in ker G %.2e; "
+      "%d constrained draws: KKT residual %.2e, %d absolute and %d relative rows vs classical accelerations %.2e, |Z(v̇ + δ) − Z(v̇)| / (½δᵀHδ) − 1 for δ in ker G %.2e; "
       "inverse dynamics = τ + Gᵀν %.2e; Fixed kind vs denseDynamics (%d draws) %.2e\n",
-      jac, jdot, constrained, kkt, rows, gauss_gap, id, fixed_count, fixed);
+      jac, jdot, constrained, kkt, absolute_rows, relative_rows, rows, gauss_gap, id, fixed_count, fixed);
   CHECK(jac < 1e-8);
   CHECK(jdot < 1e-8);
   CHECK(constrained >= 40);
   CHECK(kkt < 1e-9);
+  CHECK(relative_rows >= 30);
   CHECK(rows < 1e-9);
   CHECK(gauss_gap < 1e-6);
   CHECK(id < 1e-9);

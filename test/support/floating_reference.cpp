@@ -442,6 +442,7 @@ FloatingInput randomFloatingInput(std::mt19937_64& rng, const ChainSpec& spec, c
   problem.max_wrenches = options.max_wrenches;
   problem.gravity_probability = options.gravity_probability;
   problem.relative_probability = options.relative_probability;
+  if (spec.links.size() < 2) problem.max_wrenches = problem.max_constraint_rows = 0;  // randomProblem skips the base
   DynamicsInput joints = randomProblem(rng, spec, problem);
   // Move some wrenches and constraints onto the base link (randomProblem keeps off the fixed base).
   for (WrenchInput& w : joints.wrenches)

@@ -63,7 +63,7 @@ struct FloatingBase {
   // Planar: ⁰T_P, the plane frame's pose in the world (x, y span the plane, z
   // is the yaw axis). Must be identity otherwise (std::invalid_argument).
   // (zwang's ModelBuilder::setBase takes ᴾX_world, the Plücker transform from
-  // world to plane coordinates: the inverse of this pose.)
+  // world to plane coordinates: Transform::fromPose(plane.linear(), plane.translation()).)
   Eigen::Isometry3d plane = Eigen::Isometry3d::Identity();
 
   int nqBase() const { return kind == BaseKind::Free ? 7 : kind == BaseKind::Planar ? 3 : 0; }
@@ -184,7 +184,8 @@ struct RandomFloatingOptions {
   double base_link_probability = 0.2;  // that each wrench or constraint is moved onto the base link
 };
 
-// A random floating base (kind, plane) and input for `spec`.
+// A random floating base (kind, plane) and input for `spec` (a spec with the base link only gets no wrenches or
+// constraints).
 FloatingBase randomFloatingBase(std::mt19937_64& rng, const RandomFloatingOptions& options = {});
 FloatingInput randomFloatingInput(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& base,
                                   const RandomFloatingOptions& options = {});

@@ -87,6 +87,10 @@ struct Writer {
 }  // namespace
 
 std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity) {
+  return toMjcf(spec, gravity, FloatingBase{BaseKind::Fixed, Eigen::Isometry3d::Identity()});
+}
+
+std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const FloatingBase& base) {
   spec.check();  // among others: every joint's parent link comes before its child, so the links form a tree
   Writer writer{spec, std::vector<std::vector<int>>(spec.links.size()), {}};
   for (std::size_t k = 0; k < spec.joints.size(); ++k) {
@@ -96,7 +100,16 @@ std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity) {
       throw std::invalid_argument("toMjcf('" + spec.name + "'): link " + child.name + " moves on joint " + joint.name +
                                   " but has no mass (MuJoCo refuses a moving body without mass)");
     writer.child_joints[static_cast<std::size_t>(spec.parentLink(k))].push_back(static_cast<int>(k));
+    if (base.kind != BaseKind::Fixed && (joint.name == kMjcfFreeJoint || joint.name == kMjcfPlanarX ||
+                                         joint.name == kMjcfPlanarY || joint.name == kMjcfPlanarYaw))
+      throw std::invalid_argument("toMjcf('" + spec.name + "'): joint " + joint.name +
+                                  " has the name of a floating-base joint");
   }
+  if (base.kind != BaseKind::Fixed && !(spec.links[0].mass > 0.0))
+    throw std::invalid_argument("toMjcf('" + spec.name + "'): the floating root link " + spec.links[0].name +
+                                " has no mass (MuJoCo refuses a moving body without mass)");
+  if (base.kind != BaseKind::Planar && !base.plane.matrix().isIdentity(0.0))
+    throw std::invalid_argument("toMjcf('" + spec.name + "'): a plane pose is only for a Planar base");
 
   std::ostringstream& out = writer.out;
   out << "<mujoco model=\"" << xmlEscape(spec.name)
@@ -112,8 +125,23 @@ std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity) {
       << "    <flag contact=\"disable\" constraint=\"disable\" limit=\"disable\" frictionloss=\"disable\" "
          "equality=\"disable\" passive=\"disable\"/>\n"
       << "  </option>\n"
-      << "  <worldbody>\n"
-      << "    <body name=\"" << xmlEscape(spec.links[0].name) << "\" pos=\"0 0 0\" quat=\"1 0 0 0\">\n";
+      << "  <worldbody>\n";
+  if (base.kind == BaseKind::Planar) {
+    out << "    <body name=\"" << xmlEscape(spec.links[0].name) << "\" pos=\"" << vec(base.plane.translation())
+        << "\" quat=\"" << quat(base.plane.linear()) << "\">\n";
+  } else {
+    out << "    <body name=\"" << xmlEscape(spec.links[0].name) << "\" pos=\"0 0 0\" quat=\"1 0 0 0\">\n";
+  }
+  if (base.kind == BaseKind::Free) {
+    out << "      <freejoint name=\"" << kMjcfFreeJoint << "\"/>\n";
+  } else if (base.kind == BaseKind::Planar) {
+    const char* names[] = {kMjcfPlanarX, kMjcfPlanarY, kMjcfPlanarYaw};
+    const char* types[] = {"slide", "slide", "hinge"};
+    const char* axes[] = {"1 0 0", "0 1 0", "0 0 1"};
+    for (int k = 0; k < 3; ++k)
+      out << "      <joint name=\"" << names[k] << "\" type=\"" << types[k] << "\" pos=\"0 0 0\" axis=\"" << axes[k]
+          << "\" limited=\"false\" armature=\"0\" damping=\"0\" stiffness=\"0\" frictionloss=\"0\"/>\n";
+  }
   writer.inertial(spec.links[0], "      ");
   for (const int k : writer.child_joints[0]) writer.body(k, "      ");
   out << "    </body>\n"

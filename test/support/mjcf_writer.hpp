@@ -31,6 +31,7 @@
 #include <Eigen/Core>
 
 #include "support/chain_spec.hpp"
+#include "support/floating_reference.hpp"
 
 namespace zwang::testing {
 
@@ -42,5 +43,25 @@ namespace zwang::testing {
 // the dofs depth first, children in joint order, so a caller maps vectors by
 // joint name.
 std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity);
+
+// The same with links[0] floating (floating_reference.hpp): the root body is
+// attached to the world by
+//  - Free: a <freejoint name=kMjcfFreeJoint/> (qpos = [p; quat w x y z] as
+//    ours, but qvel = [ṗ in world axes; ω in body axes] and qacc its rate,
+//    qfrc_* = [force in world axes; moment about the body origin in body
+//    axes]; test_floating_reference.cpp converts), the body at the identity;
+//  - Planar: the body at the plane pose (pos, quat), then three joints at the
+//    body origin in this order: slide "1 0 0" (kMjcfPlanarX), slide "0 1 0"
+//    (kMjcfPlanarY), hinge "0 0 1" (kMjcfPlanarYaw), so the pose is
+//    P ∘ translate(x, y, 0) ∘ rot_z(ψ) and qpos, qvel, qacc are ours;
+//  - Fixed: exactly toMjcf(spec, gravity).
+// No armature, damping, limits or friction on the base joints. Throws
+// std::invalid_argument when a floating root link has no mass or a spec joint
+// has one of the base joints' names.
+inline constexpr const char* kMjcfFreeJoint = "floating_base_free";
+inline constexpr const char* kMjcfPlanarX = "floating_base_x";
+inline constexpr const char* kMjcfPlanarY = "floating_base_y";
+inline constexpr const char* kMjcfPlanarYaw = "floating_base_yaw";
+std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const FloatingBase& base);
 
 }  // namespace zwang::testing

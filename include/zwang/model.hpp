@@ -267,6 +267,10 @@ class ModelBuilder {
   /// joint, a joint that mimics itself, or a multiplier or offset that is not finite.
   ModelBuilder& setMimic(const std::string& joint, const std::string& leader, double multiplier, double offset);
 
+  /// Add the base link's own inertia (given in its frame) to body 0. It enters
+  /// the dynamics only when the base floats (setBase); the links welded to the
+  /// base add theirs through addFixedFrame.
+  ModelBuilder& addBaseLinkInertia(const RigidInertia& inertia);
   /// Let the base float: a free-flyer or a planar joint between the world and
   /// body 0 (unactuated). `placement` is the plane's frame for a Planar base
   /// (ᴾX_world; must be identity for Free). ModelError when the base already

@@ -177,8 +177,9 @@ class Workspace {
   Eigen::VectorXd row_size;      ///< the size of the terms of each row's error (taskResidual)
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
-  std::vector<Vec6> a;  ///< Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0])
-  std::vector<Vec6> f;  ///< accumulated forces (RNEA)
+  std::vector<Vec6> a;  ///< Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0] on a fixed base)
+  Vec6 a_world = Vec6::Zero();  ///< the world's acceleration in the sweep, [−g; 0]: what ws.a is shifted by
+  std::vector<Vec6> f;          ///< accumulated forces (RNEA)
   /// The constraint wrenches A ν on each body and its subtree (constraint torques)
   std::vector<Vec6> constraint_wrench;
 

@@ -18,7 +18,7 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
 
   // In base coordinates (src/dynamics/sweeps.hpp): no transforms between bodies.
   internal::outwardKinematics(model, q, qd, ws, true);
-  ws.a[0] = internal::gravityAcceleration(task.gravity);  // gravity as base acceleration
+  ws.a_world = ws.a[0] = internal::gravityAcceleration(task.gravity);  // gravity as base acceleration
   // A body whose parent is the body before it (every body of a chain, most of
   // a tree's) takes the parent's value from a register, not from the store
   // just made: a load that waits on that store costs more than the sum.

@@ -110,10 +110,10 @@ Status frameVelocity(const Model& model, const Workspace& ws, int frame, Express
 Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept {
   if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
-  // ws.a holds the sweep's accelerations, true + [−g; 0] (= ws.a[0]).
+  // ws.a holds the sweep's accelerations, true + [−g; 0] (= ws.a_world).
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   const auto b = static_cast<std::size_t>(model.frame(frame).body);
-  acceleration = express(X, expressed, internal::classicalAtPoint(ws.a[b] - ws.a[0], ws.v[b], X.r));
+  acceleration = express(X, expressed, internal::classicalAtPoint(ws.a[b] - ws.a_world, ws.v[b], X.r));
   return {};
 }
 

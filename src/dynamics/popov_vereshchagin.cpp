@@ -350,6 +350,7 @@ void balance(const Task& task, Workspace& ws) {
 }
 
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd_all) {
+  ws.a_world = gravityAcceleration(task.gravity);
   if (model.hasFloatingBase()) {  // lines 28–29 for the base joint
     baseAcceleration(model, task, ws);
     publishBaseAcceleration(model, ws, ws.qdd_base, qdd_all.head(model.baseVelocitySize()));
@@ -367,7 +368,7 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
 }
 
 void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd_all) {
-  ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  ws.a_world = ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
   if (model.hasFloatingBase()) ws.a[0] += baseTrueAcceleration(model, ws, qdd_all.head(model.baseVelocitySize()));
   const auto qdd = qdd_all.tail(model.dof());
   for (int i = 1; i <= model.dof(); ++i)

@@ -289,6 +289,13 @@ const char* toString(BaseType type) {
   return "unknown";
 }
 
+ModelBuilder& ModelBuilder::addBaseLinkInertia(const RigidInertia& inertia) {
+  // Throws on an impossible inertia; its warnings come with build(), when the base floats.
+  (void)validate::rigidInertia("link '" + model_.frames_[0].name + "'", inertia);
+  model_.inertias_[0] += inertia;
+  return *this;
+}
+
 ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement) {
   if (model_.base_type_ != BaseType::Fixed)
     throw ModelError(std::string("the base already floats (a ") + toString(model_.base_type_) +

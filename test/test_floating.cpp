@@ -1,0 +1,154 @@
+// Floating bases (issue #15) in the solver, against the dense floating-base
+// reference (test/support/floating_reference.*, itself checked against
+// MuJoCo's free joints in test_floating_reference): random free and planar
+// trees with and without constraints; q̈ (the base's included), ν, τ_c and the
+// base's classical acceleration; the closure H q̈ + C = τ + τ_c; physics
+// (momentum, free fall); friction on a floating tree through the same sweeps.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <random>
+
+#include "support/dense_reference.hpp"
+#include "support/floating_reference.hpp"
+#include "support/random_chain.hpp"
+#include "support/random_problem.hpp"
+#include "zwang/zwang.hpp"
+
+using namespace zwang;
+using namespace zwang::testing;
+
+namespace {
+
+// The spec's model with its base let float as `base` says.
+Model floatingModel(const ChainSpec& spec, const FloatingBase& base) {
+  ModelBuilder builder(modelFromSpecByBuilder(spec));
+  const LinkSpec& root = spec.links[0];  // the fixed-base builder leaves the root link's own inertia out
+  const Eigen::Matrix3d R = rpyToMatrix(root.inertial_rpy);
+  builder.addBaseLinkInertia(RigidInertia::fromMassComInertia(root.mass, root.com, R * root.inertia * R.transpose()));
+  if (base.kind == BaseKind::Free) builder.setBase(BaseType::Free);
+  if (base.kind == BaseKind::Planar)
+    builder.setBase(BaseType::Planar, Transform::fromPose(base.plane.linear(), base.plane.translation()));
+  return builder.build();
+}
+
+// The same problem as a zwang Task (rows in the same order).
+Task floatingTask(const Model& model, const FloatingInput& input) {
+  DynamicsInput as_fixed;
+  as_fixed.gravity = input.gravity;
+  as_fixed.wrenches = input.wrenches;
+  as_fixed.constraints = input.constraints;
+  return taskFromInput(model, as_fixed);
+}
+
+// Kept draws: the KKT system well conditioned and every row reachable (the
+// smallest singular value of G at least 1e-6, as for the fixed base).
+bool wellPosed(const FloatingResult& dense) {
+  const auto rows = static_cast<int>(dense.G.rows());
+  if (!dense.wellConditioned(1e6) || dense.constraint_rank < rows) return false;
+  return rows == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
+}
+
+}  // namespace
+
+TEST_CASE("floating trees: solveHybridDynamics against the dense floating-base reference", "[floating]") {
+  std::mt19937_64 rng(20261124);
+  RandomFloatingOptions options;
+  options.max_constraint_rows = 12;
+  options.max_constraint_frames = 4;
+  options.relative_probability = 0.3;
+  options.base_tau_probability = 0.2;
+  int compared = 0, draws = 0, free = 0, planar = 0, constrained = 0, rows = 0, relative = 0;
+  double e_qdd = 0, e_nu = 0, e_tau_c = 0, e_closure = 0, e_base_world = 0, e_gauss = 0;
+  while (compared < 400 && draws < 3000) {
+    ++draws;
+    const FloatingProblem p = randomFloatingProblem(rng, options);
+    const FloatingResult dense = floatingDynamics(p.spec, p.base, p.input);
+    if (!wellPosed(dense)) continue;
+    const Model model = floatingModel(p.spec, p.base);
+    const Task task = floatingTask(model, p.input);
+    Workspace ws(model, task);
+    const Status s = solveHybridDynamics(model, task, p.input.q, p.input.v, p.input.tau, ws);
+    INFO("draw " << draws << ": " << s.message);
+    REQUIRE(s);
+    ++compared;
+    (p.base.kind == BaseKind::Free ? free : planar) += 1;
+    const int m = task.constraintRows();
+    if (m > 0) ++constrained;
+    rows += m;
+    for (const ConstraintInput& c : p.input.constraints)
+      if (!c.relative_to.empty()) relative += static_cast<int>(c.A.cols());
+    e_qdd = std::max(e_qdd, relativeError(ws.solution.qdd, dense.qdd));
+    e_nu = std::max(e_nu, relativeError(ws.solution.nu, dense.nu.head(m)));
+    e_tau_c = std::max(e_tau_c, relativeError(ws.solution.tau_constraint, dense.tau_c));
+    e_base_world = std::max(e_base_world, relativeError(ws.solution.base_acceleration_world, dense.base_acc_world));
+    // Closure: τ_control drives the unconstrained robot along q̈.
+    const Eigen::VectorXd tau_id = floatingInverseDynamics(p.spec, p.base, p.input.q, p.input.v, ws.solution.qdd,
+                                                           p.input.gravity, p.input.wrenches);
+    e_closure = std::max(e_closure, relativeError(ws.solution.tau_control, tau_id));
+    e_gauss = std::max(e_gauss, std::abs(ws.solution.gauss - dense.gauss) / std::max(1.0, std::abs(dense.gauss)));
+  }
+  std::printf(
+      "floating trees vs the dense floating-base reference: %d compared (%d draws; %d free, %d planar), %d with "
+      "rows (%d rows, %d relative)\n  max rel. error qdd %.2g, nu %.2g, tau_c %.2g, base classical acc %.2g, "
+      "closure %.2g, Gauss %.2g\n",
+      compared, draws, free, planar, constrained, rows, relative, e_qdd, e_nu, e_tau_c, e_base_world, e_closure,
+      e_gauss);
+  CHECK(compared >= 300);
+  CHECK(free > 100);
+  CHECK(planar > 100);
+  CHECK(constrained > 100);
+  CHECK(relative > 50);
+  CHECK(e_qdd < 1e-9);
+  CHECK(e_nu < 1e-9);
+  CHECK(e_tau_c < 1e-9);
+  CHECK(e_base_world < 1e-9);
+  CHECK(e_closure < 1e-9);
+  CHECK(e_gauss < 1e-9);
+}
+
+TEST_CASE("floating trees: physics without a reference model", "[floating]") {
+  std::mt19937_64 rng(7);
+  RandomFloatingOptions options;
+  options.free_probability = 1.0;
+  options.max_constraint_rows = 0;
+  options.max_wrenches = 0;
+  double e_momentum = 0.0, e_fall = 0.0;
+  for (int draw = 0; draw < 100; ++draw) {
+    FloatingProblem p = randomFloatingProblem(rng, options);
+    p.input.tau.head(6).setZero();
+    const Model model = floatingModel(p.spec, p.base);
+    Task task(model);
+    Workspace ws(model, task);
+    // No gravity, no wrench, no constraint, no torque: the spatial momentum
+    // stays constant; its rate from our q̈, by a central difference of the
+    // reference's momentum along the motion.
+    task.gravity.setZero();
+    Eigen::VectorXd tau = Eigen::VectorXd::Zero(model.nv());
+    REQUIRE(solveHybridDynamics(model, task, p.input.q, p.input.v, tau, ws));
+    const double h = 1e-6;
+    const Eigen::VectorXd qdd = ws.solution.qdd;
+    const auto momentumAt = [&](double t) {
+      const Eigen::VectorXd q = integrateConfiguration(p.base, p.input.q, p.input.v + 0.5 * t * qdd, t);
+      return floatingMomentum(p.spec, p.base, q, p.input.v + t * qdd);
+    };
+    const Vector6d rate = (momentumAt(h) - momentumAt(-h)) / (2 * h);
+    const Vector6d h0 = floatingMomentum(p.spec, p.base, p.input.q, p.input.v);
+    e_momentum = std::max(e_momentum, rate.norm() / std::max(1.0, h0.norm()));
+    // At rest under gravity with no torque: every body falls at g.
+    task.gravity = Vec3(0.3, -1.0, -9.81);
+    const Eigen::VectorXd zero_v = Eigen::VectorXd::Zero(model.nv());
+    REQUIRE(solveHybridDynamics(model, task, p.input.q, zero_v, tau, ws));
+    for (int f = 0; f < static_cast<int>(model.frames().size()); ++f) {
+      Vec6 a;
+      REQUIRE(frameAcceleration(model, ws, f, Expressed::World, a));
+      e_fall = std::max(e_fall, (a.head<3>() - task.gravity).norm() / 9.81 + a.tail<3>().norm());
+    }
+  }
+  std::printf(
+      "floating physics: momentum rate (free, no gravity) %.2g (central differences, h = 1e-6), free fall "
+      "at g: every frame %.2g\n",
+      e_momentum, e_fall);
+  CHECK(e_momentum < 1e-6);  // the differences' own error, O(h²)·|q⃛| and rounding/h
+  CHECK(e_fall < 1e-12);
+}

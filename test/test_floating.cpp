@@ -152,3 +152,79 @@ TEST_CASE("floating trees: physics without a reference model", "[floating]") {
   CHECK(e_momentum < 1e-6);  // the differences' own error, O(h²)·|q⃛| and rounding/h
   CHECK(e_fall < 1e-12);
 }
+
+TEST_CASE("floating trees: friction through the same sweeps, checked by the dense reference", "[floating][friction]") {
+  // The motion at μ* must be the dense floating-base motion under τ plus the
+  // friction torques zwang reports, and μ* must satisfy maximum dissipation
+  // joint by joint: stick ⇒ q̈_j = 0 and |μ_j| ≤ f_j; slip± ⇒ μ_j = ±f_j with
+  // q̈_j of that sign.
+  std::mt19937_64 rng(424242);
+  RandomFloatingOptions options;
+  options.max_constraint_rows = 6;
+  options.relative_probability = 0.3;
+  int compared = 0, draws = 0, stuck_total = 0, constrained = 0;
+  int states[4] = {0, 0, 0, 0};
+  double e_motion = 0.0, e_stick = 0.0, e_bound = 0.0, kkt = 0.0;
+  while (compared < 200 && draws < 2000) {
+    ++draws;
+    FloatingProblem p = randomFloatingProblem(rng, options);
+    if (p.spec.dof() == 0) continue;
+    const int nvb = p.base.nvBase();
+    // 1–5 joints stuck exactly; breakaway friction 0–20 on every joint.
+    std::vector<int> order(static_cast<std::size_t>(p.spec.dof()));
+    for (std::size_t j = 0; j < order.size(); ++j) order[j] = static_cast<int>(j);
+    std::shuffle(order.begin(), order.end(), rng);
+    const int k = std::min<int>(static_cast<int>(order.size()), 1 + static_cast<int>(rng() % 5));
+    for (int a = 0; a < k; ++a) p.input.v[nvb + order[static_cast<std::size_t>(a)]] = 0.0;
+    const FloatingResult check = floatingDynamics(p.spec, p.base, p.input);
+    if (!wellPosed(check)) continue;
+    const Model plain = floatingModel(p.spec, p.base);
+    FrictionOptions fo;
+    fo.breakaway.resize(plain.dof());
+    fo.kinetic.resize(plain.dof());
+    fo.viscous.setZero(plain.dof());
+    for (int j = 0; j < plain.dof(); ++j)
+      fo.breakaway[j] = fo.kinetic[j] = 20.0 * std::uniform_real_distribution<>(0, 1)(rng);
+    fo.joint_limits = false;
+    const Task task = floatingTask(plain, p.input);
+    Workspace ws(plain, task);
+    const Status s = solveWithFriction(plain, task, p.input.q, p.input.v, p.input.tau, ws, fo);
+    INFO("draw " << draws << ": " << s.message);
+    REQUIRE(s);
+    ++compared;
+    if (task.constraintRows() > 0) ++constrained;
+    const FrictionResult& fr = ws.friction;
+    stuck_total += static_cast<int>(fr.stuck.size());
+    FloatingInput with_friction = p.input;
+    with_friction.tau.tail(plain.dof()) += fr.tau_friction;
+    const FloatingResult dense = floatingDynamics(p.spec, p.base, with_friction);
+    e_motion = std::max(e_motion, relativeError(ws.solution.qdd, dense.qdd));
+    const double acc_scale = 1.0 + ws.solution.qdd.cwiseAbs().maxCoeff();
+    for (const int j : fr.stuck) {
+      const double qdd = ws.solution.qdd[nvb + j], mu = fr.mu[j], f = fo.breakaway[j];
+      const JointState st = fr.state[static_cast<std::size_t>(j)];
+      states[st == JointState::Stick          ? 0
+             : st == JointState::SlipPositive ? 1
+             : st == JointState::SlipNegative ? 2
+                                              : 3]++;
+      if (st == JointState::Stick) e_stick = std::max(e_stick, std::abs(qdd) / acc_scale);
+      e_bound = std::max(e_bound, std::max(0.0, std::abs(mu) - f) / (1.0 + f));
+      if (st == JointState::SlipPositive) e_bound = std::max(e_bound, std::abs(mu - f) / (1.0 + f));
+      if (st == JointState::SlipNegative) e_bound = std::max(e_bound, std::abs(mu + f) / (1.0 + f));
+    }
+    kkt = std::max(kkt, fr.kkt_residual / acc_scale);
+  }
+  std::printf(
+      "floating trees with friction: %d compared (%d draws, %d with rows), %d stuck joints (stick %d, slip+ %d, "
+      "slip- %d, other %d)\n  motion vs dense at mu* %.2g, stick |qdd| %.2g, |mu| beyond its bound %.2g, "
+      "maximiser KKT %.2g\n",
+      compared, draws, constrained, stuck_total, states[0], states[1], states[2], states[3], e_motion, e_stick, e_bound,
+      kkt);
+  CHECK(compared >= 150);
+  CHECK(states[0] > 50);
+  CHECK(states[1] + states[2] > 50);
+  CHECK(e_motion < 1e-9);
+  CHECK(e_stick < 1e-9);
+  CHECK(e_bound < 1e-9);
+  CHECK(kkt < 1e-9);
+}

@@ -59,6 +59,7 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   balance_factorisation.work.setZero(m);
   rhs.setZero(m);
   nu.setZero(columns);
+  nu_motors.setZero(columns);
   a.assign(bodies, Vec6::Zero());
   f.assign(bodies, Vec6::Zero());
   constraint_wrench.assign(bodies, Vec6::Zero());

@@ -228,3 +228,70 @@ TEST_CASE("floating trees: friction through the same sweeps, checked by the dens
   CHECK(e_bound < 1e-9);
   CHECK(kkt < 1e-9);
 }
+
+TEST_CASE("floating trees: standing on contacts, every joint held by its motor (joint rows)", "[floating]") {
+  // Two links are feet (addContact, 6 world rows each: the ground's wrench);
+  // every joint is held by a joint row q̈_j = 0 (addJointConstraint: its
+  // motor). At rest the robot must stand still, τ_control must have nothing
+  // on the base, and — the independent check — the motors' τ_control with
+  // the contacts alone (the dense floating reference, no joint rows) must
+  // hold it still with the same ground wrenches.
+  std::mt19937_64 rng(99);
+  RandomFloatingOptions options;
+  options.free_probability = 1.0;
+  options.max_constraint_rows = 0;
+  options.max_wrenches = 0;
+  int compared = 0, draws = 0;
+  double e_still = 0.0, e_base = 0.0, e_ground = 0.0, e_nu = 0.0;
+  while (compared < 100 && draws < 1000) {
+    ++draws;
+    FloatingProblem p = randomFloatingProblem(rng, options);
+    if (p.spec.dof() < 4) continue;
+    const Model model = floatingModel(p.spec, p.base);
+    // Feet: the last link and one other link off the base.
+    const std::string foot_a = p.spec.links.back().name;
+    const std::string foot_b = p.spec.links[1 + rng() % (p.spec.links.size() - 2)].name;
+    FloatingInput contacts = p.input;
+    contacts.v.setZero();
+    contacts.tau.setZero();
+    contacts.constraints.clear();
+    for (const std::string& foot : {foot_a, foot_b}) {
+      ConstraintInput c;
+      c.link = foot;
+      c.A = Matrix6Xd::Identity(6, 6);
+      c.b = Eigen::VectorXd::Zero(6);
+      c.axes = Axes::World;
+      contacts.constraints.push_back(c);
+    }
+    const FloatingResult feet_only = floatingDynamics(p.spec, p.base, contacts);
+    if (!feet_only.wellConditioned(1e6) || feet_only.constraint_rank < 12) continue;
+    Task task(model);
+    task.gravity = p.input.gravity;
+    task.addContact(foot_a, ConstraintMatrix::Identity(6, 6), Expressed::World);
+    task.addContact(foot_b, ConstraintMatrix::Identity(6, 6), Expressed::World);
+    for (int j = 0; j < model.dof(); ++j) task.addJointConstraint(j);
+    Workspace ws(model, task);
+    const Status s = solveHybridDynamics(model, task, contacts.q, contacts.v, contacts.tau, ws);
+    INFO("draw " << draws << ": " << s.message);
+    REQUIRE(s);
+    ++compared;
+    e_still = std::max(e_still, ws.solution.qdd.cwiseAbs().maxCoeff());
+    e_base = std::max(e_base, ws.solution.tau_control.head(6).cwiseAbs().maxCoeff() /
+                                  std::max(1.0, ws.solution.tau_control.cwiseAbs().maxCoeff()));
+    FloatingInput driven = contacts;
+    driven.tau = ws.solution.tau_control;
+    const FloatingResult check = floatingDynamics(p.spec, p.base, driven);
+    e_ground = std::max(e_ground, check.qdd.cwiseAbs().maxCoeff());
+    e_nu = std::max(e_nu, relativeError(ws.solution.nu.head(12), check.nu.head(12)));
+  }
+  std::printf(
+      "floating trees standing on two feet (contacts) with every joint held by its motor: %d compared (%d "
+      "draws)\n  |qdd| %.2g, base entries of tau_control %.2g, the motors' tau_control with the contacts alone "
+      "(dense): |qdd| %.2g, ground wrenches %.2g\n",
+      compared, draws, e_still, e_base, e_ground, e_nu);
+  CHECK(compared >= 50);
+  CHECK(e_still < 1e-9);
+  CHECK(e_base < 1e-9);
+  CHECK(e_ground < 1e-9);
+  CHECK(e_nu < 1e-9);
+}

@@ -85,6 +85,24 @@ class Task {
   int addRelativeConstraint(const std::string& frame, const std::string& reference, const ConstraintMatrix& A,
                             Expressed expressed = Expressed::Reference);
 
+  /// Constrain the acceleration of moving joint `joint`: q̈_joint = b (one row,
+  /// b starts at 0). Its force is a torque (a force, for a prismatic joint)
+  /// along the joint, equal and opposite on the two bodies it connects: what
+  /// the joint's own motor gives. So a posture held joint by joint is held by
+  /// the motors, also on a floating base (docs/solver.md, "Joint rows and
+  /// contacts"). ModelError for a joint index out of range. Returns the row.
+  int addJointConstraint(int joint);
+  /// The same, with the joint given by name (ModelError for an unknown name).
+  int addJointConstraint(const std::string& joint);
+
+  /// A constraint whose force the environment supplies, not the motors: a foot
+  /// on the ground, a hand against a wall. It moves the robot like
+  /// addConstraint's, its ν is that contact force, and it is left out of
+  /// Solution::tau_constraint and tau_control (the motors do not give it).
+  int addContact(int frame, const ConstraintMatrix& A, Expressed expressed = Expressed::Local);
+  /// The same, with the frame given by name (ModelError for an unknown name).
+  int addContact(const std::string& frame, const ConstraintMatrix& A, Expressed expressed = Expressed::Local);
+
   /// Apply a wrench [f; n] at `frame`'s origin. Starts at zero. Returns its index.
   int addWrench(int frame, Expressed expressed = Expressed::Local);
   /// The same, with the frame given by name (ModelError for an unknown name).
@@ -125,11 +143,13 @@ class Task {
     ConstraintMatrix A;           ///< 6 × rows
     int reference = -1;           ///< the frame a relative constraint refers to (−1: the world)
     bool reference_side = false;  ///< this entry is the reference (or parent body's) side
-    /// A piece of a mimic row (rows = 1, A unused): coefficient·q̈_joint, read
-    /// as a unit force along joint's axis on the joint's body and its opposite
+    /// A piece of a joint row (rows = 1, A unused): coefficient·q̈_joint, read
+    /// as a unit effort along the joint on the joint's body and its opposite
     /// on the parent body (reference_side). −1: a frame constraint.
     int joint = -1;
-    double coefficient = 0.0;  ///< 1 for the mimic joint, −multiplier for its leader
+    double coefficient = 0.0;  ///< 1 for the joint of a joint row or a mimic joint, −multiplier for a leader
+    bool mimic_row = false;    ///< a piece of a mimic row (its first_row counts the mimic rows)
+    bool contact = false;      ///< the environment supplies its force (addContact)
   };
   /// One wrench, as the solver reads it.
   struct AppliedWrench {
@@ -158,6 +178,10 @@ class Task {
   bool hasRelative() const { return has_relative_; }
   /// The balance row of each solver column (the identity without relative constraints).
   const std::vector<int>& balanceRowOfColumn() const { return balance_row_; }
+  /// True when some constraint is a contact (addContact).
+  bool hasContacts() const { return has_contacts_; }
+  /// Per solver column: 1 when its force is a contact's (the environment's), else 0.
+  const std::vector<char>& contactColumns() const { return contact_column_; }
   /// The wrenches, in the order of addWrench.
   const std::vector<AppliedWrench>& wrenches() const { return wrenches_; }
   /// Joint count of the model the task was made for (checked by every solve).
@@ -169,6 +193,7 @@ class Task {
   int dof_;
   int frames_;
   std::vector<std::string> frame_names_;  // copied, so the Task does not dangle
+  std::vector<std::string> joint_names_;  // likewise
   std::vector<int> frame_bodies_;
   std::vector<ConstraintGroup> groups_;
   std::vector<int> subtree_end_;  // per body, copied from the model
@@ -178,7 +203,11 @@ class Task {
   std::vector<int> first_column_;
   bool has_relative_ = false;
   int mimic_rows_ = 0;
-  std::vector<Mimic> mimic_laws_;  // the law of each mimic row (its mimic joint below)
+  bool has_contacts_ = false;
+  std::vector<char> contact_column_;
+  std::vector<int> joint_bodies_parent_;  // per joint, the body it hangs from (copied from the model)
+  std::vector<int> body_frames_;          // per body, its frame
+  std::vector<Mimic> mimic_laws_;         // the law of each mimic row (its mimic joint below)
   std::vector<int> mimic_joint_of_row_;
   std::vector<AppliedWrench> wrenches_;
   Eigen::VectorXd b_;

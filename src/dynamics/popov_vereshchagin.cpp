@@ -21,7 +21,7 @@
 //    independently; the balance adds the columns of each row (condensedBalance);
 //  * mimic joints (q_m = a·q_l + b): one internal row q̈_m − a·q̈_l = 0 each,
 //    after the user's rows, as four columns: a unit effort along each joint on
-//    its body and the opposite on its parent (mimicPieceInBodyForm). Its ν is
+//    its body and the opposite on its parent (jointPieceInBodyForm). Its ν is
 //    the coupling torque the mechanism carries; the motor torques the leader
 //    carries are folded onto it at the end (carryMimicTorques);
 //  * a floating base (free or planar): body 0 moves, joined to the world by an
@@ -146,14 +146,16 @@ void relativeConstraintInBodyForm(const Model& model, const Task& task, const Ta
   }
 }
 
-// One piece of a mimic row (Task::addMimicRows): coefficient·q̈_j, read with
+// One piece of a joint row (Task::addJointConstraint) or a mimic row
+// (Task::addMimicRows): coefficient·q̈_j, read with
 // a unit effort F along joint j (F·S_j = 1): a couple about a revolute axis,
 // a force along a prismatic axis through the body origin. Since
 // Ẍ_body − Ẍ_parent = S q̈ + Ẍ_bias (line 29), F·(Ẍ_body − Ẍ_parent) = q̈ + F·Ẍ_bias:
 // the column is +F on the joint's body and −F on its parent, and F·Ẍ_bias
-// goes to the set point (on the body's side; the row's b is 0). A different F
+// goes to the set point (on the body's side, with the row's b). A different F
 // with F·S = 1 would differ by a force the joint itself transmits: same motion, same ν.
-void mimicPieceInBodyForm(const Model& model, const Task::ConstraintGroup& g, int col, Workspace& ws) {
+void jointPieceInBodyForm(const Model& model, const Task& task, const Task::ConstraintGroup& g, int col,
+                          Workspace& ws) {
   const int body = g.joint + 1;
   const Vec6& S = ws.S[at(body)];
   Vec6 F;
@@ -162,7 +164,9 @@ void mimicPieceInBodyForm(const Model& model, const Task::ConstraintGroup& g, in
   else
     F << S.head<3>(), ws.Xworld[at(body)].r.cross(S.head<3>());
   ws.A_body.col(col) = ((g.reference_side ? -1.0 : 1.0) * g.coefficient) * F;
-  ws.b_body[col] = g.reference_side ? 0.0 : g.coefficient * F.dot(ws.c[at(body)]);
+  // A joint row's set point q̈_j = b (a mimic row's is 0) joins F·Ẍ_bias on the body's side.
+  const double b = g.mimic_row ? 0.0 : task.targets()[g.first_row];
+  ws.b_body[col] = g.reference_side ? 0.0 : b + g.coefficient * F.dot(ws.c[at(body)]);
 }
 
 // The task's constraints as unit forces on their bodies in base coordinates,
@@ -175,7 +179,7 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
   int col = 0;
   for (const Task::ConstraintGroup& g : task.groups()) {
     if (g.joint >= 0) {
-      mimicPieceInBodyForm(model, g, col++, ws);
+      jointPieceInBodyForm(model, task, g, col++, ws);
       continue;
     }
     if (g.reference >= 0) {
@@ -530,8 +534,17 @@ void baseConstraintForce(const Model& model, const Task& task, const Workspace& 
 }
 }  // namespace
 
-void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_all,
                        Eigen::Ref<Eigen::VectorXd> tau_c_all) {
+  // The motors give every constraint force but the contacts' (the
+  // environment's): those columns count with ν = 0 here.
+  const int columns = task.solverColumns();
+  if (task.hasContacts()) {
+    ws.nu_motors.head(columns) = nu_all.head(columns);
+    for (int col = 0; col < columns; ++col)
+      if (task.contactColumns()[at(col)]) ws.nu_motors[col] = 0.0;
+  }
+  const VectorRef nu_solver = task.hasContacts() ? VectorRef(ws.nu_motors.head(columns)) : nu_all;
   // The wrenches A ν of each body's own constraints, summed inward and
   // projected on each joint: the physical torque (docs/solver.md, "Constraint torques: why not eq. 4.4").
   // On a tree each body carries its own wrenches and its children's: the

@@ -62,7 +62,9 @@ void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out);
 // met, into ws.solution.balance.
 void taskResidual(const Task& task, Workspace& ws);
 
-// τ_c = Σ J_iᵀ A_i ν_i for ν per solver column (one inward pass of the wrenches A ν).
+// τ_c = Σ J_iᵀ A_i ν_i for ν per solver column (one inward pass of the
+// wrenches A ν), over the constraints the motors carry: contacts' columns
+// count with ν = 0.
 void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c);
 

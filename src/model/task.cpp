@@ -11,7 +11,14 @@ Task::Task(const Model& model) : dof_(model.dof()), frames_(static_cast<int>(mod
     frame_names_.push_back(f.name);
     frame_bodies_.push_back(f.body);
   }
-  for (int b = 0; b < model.bodyCount(); ++b) subtree_end_.push_back(model.subtreeEnd(b));
+  for (int b = 0; b < model.bodyCount(); ++b) {
+    subtree_end_.push_back(model.subtreeEnd(b));
+    body_frames_.push_back(model.bodyFrame(b));
+  }
+  for (int j = 0; j < model.dof(); ++j) {
+    joint_bodies_parent_.push_back(model.parentBodyOfJoint(j));
+    joint_names_.push_back(model.joint(j).name);
+  }
   addMimicRows(model);
   reorder();
 }
@@ -33,6 +40,7 @@ void Task::addMimicRows(const Model& model) {
         g.reference_side = parent_side;
         g.joint = piece.joint;
         g.coefficient = piece.coefficient;
+        g.mimic_row = true;
         groups_.push_back(g);
       }
     }
@@ -89,7 +97,7 @@ int Task::addRelativeConstraint(int frame, int reference, const ConstraintMatrix
     throw ModelError("task: a relative constraint on frame '" + frame_names_[static_cast<std::size_t>(frame)] +
                      "' needs another frame to refer to, not itself");
   const int first = addConstraint(frame, A, expressed);  // checks frame and A, sorts
-  const auto user_group = [first](const ConstraintGroup& g) { return g.joint < 0 && g.first_row == first; };
+  const auto user_group = [first](const ConstraintGroup& g) { return !g.mimic_row && g.first_row == first; };
   for (ConstraintGroup& g : groups_)
     if (user_group(g)) g.reference = reference;
   ConstraintGroup side = *std::find_if(groups_.begin(), groups_.end(), user_group);
@@ -103,6 +111,43 @@ int Task::addRelativeConstraint(int frame, int reference, const ConstraintMatrix
 int Task::addRelativeConstraint(const std::string& frame, const std::string& reference, const ConstraintMatrix& A,
                                 Expressed expressed) {
   return addRelativeConstraint(lookup(frame_names_, frame), lookup(frame_names_, reference), A, expressed);
+}
+
+int Task::addJointConstraint(int joint) {
+  if (joint < 0 || joint >= dof_)
+    throw ModelError("task: joint index " + std::to_string(joint) + " out of range (the model has " +
+                     std::to_string(dof_) + " joints)");
+  const int row = constraintRows();
+  for (const bool parent_side : {false, true}) {
+    const int body = parent_side ? joint_bodies_parent_[static_cast<std::size_t>(joint)] : joint + 1;
+    ConstraintGroup g{body_frames_[static_cast<std::size_t>(body)], body, Expressed::World, row, 1, ConstraintMatrix()};
+    g.reference_side = parent_side;
+    g.joint = joint;
+    g.coefficient = 1.0;
+    groups_.push_back(g);
+  }
+  b_.conservativeResize(row + 1);
+  b_[row] = 0.0;
+  reorder();
+  return row;
+}
+
+int Task::addJointConstraint(const std::string& joint) {
+  const auto it = std::find(joint_names_.begin(), joint_names_.end(), joint);
+  if (it == joint_names_.end()) throw ModelError("task: the model has no moving joint '" + joint + "'");
+  return addJointConstraint(static_cast<int>(it - joint_names_.begin()));
+}
+
+int Task::addContact(int frame, const ConstraintMatrix& A, Expressed expressed) {
+  const int first = addConstraint(frame, A, expressed);
+  for (ConstraintGroup& g : groups_)
+    if (!g.mimic_row && g.joint < 0 && g.first_row == first) g.contact = true;
+  reorder();
+  return first;
+}
+
+int Task::addContact(const std::string& frame, const ConstraintMatrix& A, Expressed expressed) {
+  return addContact(lookup(frame_names_, frame), A, expressed);
 }
 
 int Task::addWrench(int frame, Expressed expressed) {
@@ -125,15 +170,18 @@ void Task::reorder() {
       std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.reference_side; });
   solver_row_.clear();
   balance_row_.clear();
+  contact_column_.clear();
   for (const ConstraintGroup& g : groups_)
     for (int k = 0; k < g.rows; ++k) {
       // A mimic piece's row follows the user's rows, however many there are.
-      const int row = g.joint >= 0 ? constraintRows() + g.first_row : g.first_row + k;
+      const int row = g.mimic_row ? constraintRows() + g.first_row : g.first_row + k;
       // With relative constraints the balance works on the rows (each the sum
       // of its sides); otherwise on the solver columns themselves.
       balance_row_.push_back(has_relative_ ? row : static_cast<int>(solver_row_.size()));
       solver_row_.push_back(row);
+      contact_column_.push_back(g.contact ? 1 : 0);
     }
+  has_contacts_ = std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.contact; });
   const auto bodies = static_cast<std::size_t>(dof_ + 1);
   active_.assign(bodies + 1, 0);  // active_[N + 1] = 0: no body beyond the last
   for (std::size_t body = 0; body <= bodies; ++body)

@@ -46,4 +46,22 @@ Vec6 baseClassicalAcceleration(const Task& task, const Workspace& ws);
 // coordinates of the sweep: world axes, world origin) acting on body 0.
 void baseGeneralizedForce(const Model& model, const Workspace& ws, const Vec6& F0, Eigen::Ref<Eigen::VectorXd> out);
 
+// The base's motion subspace in the USER's coordinates, after baseKinematics:
+// column k is the spatial velocity (base coordinates of the sweep) of a unit
+// rate of the k-th entry of v_base. Free: ⁰X_B (the sweep's S₀ = 1 uses other
+// coordinates); planar: S₀ itself. Its transpose maps a wrench on body 0 to
+// the base's generalized force (baseGeneralizedForce), so RNEA's τ_base, the
+// CRBA's base rows and the Jacobians' base columns are one family.
+void baseMotionColumns(const Model& model, const Workspace& ws, Matrix6Xmax& S_user);
+
+// A vector of nv() entries (q̇, q̈): its size, worded as the solver's other
+// state vectors are ("… the model has nv = 9 (3 base velocity coordinates +
+// 6 joints)"; a fixed base keeps "… the model has 6 joints"), and finite.
+Status checkVelocityVector(const Model& model, const char* name, const VectorRef& x);
+
+// A workspace made for a model with the same joints but another base (its
+// H and τ are nv × nv and nv): ModelMismatch, before anything is written.
+// Workspace::dof() alone cannot tell a fixed arm from the same arm floating.
+Status checkWorkspaceBase(const Model& model, const Workspace& ws);
+
 }  // namespace zwang::internal

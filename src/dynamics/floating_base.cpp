@@ -24,7 +24,6 @@
 
 #include <Eigen/Geometry>
 
-#include "dynamics/checks.hpp"
 #include "dynamics/sweeps.hpp"
 
 namespace zwang::internal {
@@ -187,8 +186,7 @@ void baseMotionColumns(const Model& model, const Workspace& ws, Matrix6Xmax& S_u
   for (int k = 0; k < 6; ++k) S_user.col(k) = X.inverseApplyMotion(Vec6::Unit(k));
 }
 
-Status checkVelocityVector(const Model& model, const char* name, const VectorRef& x) {
-  if (!model.hasFloatingBase()) return checkVector(name, x, model.dof());
+Status checkFloatingVelocityVector(const Model& model, const char* name, const VectorRef& x) {
   if (x.size() != model.nv())
     return Status::error(StatusCode::SizeMismatch,
                          "%s has %ld entries, the model has nv = %d (%d base velocity coordinates + %d joints)", name,
@@ -196,8 +194,7 @@ Status checkVelocityVector(const Model& model, const char* name, const VectorRef
   return checkVector(name, x, model.nv());  // the size holds: only the finiteness message can come back
 }
 
-Status checkWorkspaceBase(const Model& model, const Workspace& ws) {
-  if (ws.tau.size() == model.nv() && ws.H.rows() == model.nv()) return {};
+Status workspaceBaseMismatch(const Model& model, const Workspace& ws) {
   return Status::error(StatusCode::ModelMismatch,
                        "workspace was made for a model with nv = %ld, this one has nv = %d (a %s base and %d joints)",
                        static_cast<long>(ws.tau.size()), model.nv(), toString(model.baseType()), model.dof());

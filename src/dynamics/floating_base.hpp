@@ -3,8 +3,11 @@
 // Algorithm 1 (src/dynamics/floating_base.cpp). Not installed.
 #pragma once
 
+#include "zwang/configuration.hpp"
 #include "zwang/status.hpp"
 #include "zwang/workspace.hpp"
+
+#include "dynamics/checks.hpp"
 
 namespace zwang::internal {
 
@@ -54,14 +57,29 @@ void baseGeneralizedForce(const Model& model, const Workspace& ws, const Vec6& F
 // CRBA's base rows and the Jacobians' base columns are one family.
 void baseMotionColumns(const Model& model, const Workspace& ws, Matrix6Xmax& S_user);
 
-// A vector of nv() entries (q̇, q̈): its size, worded as the solver's other
-// state vectors are ("… the model has nv = 9 (3 base velocity coordinates +
-// 6 joints)"; a fixed base keeps "… the model has 6 joints"), and finite.
-Status checkVelocityVector(const Model& model, const char* name, const VectorRef& x);
+// The input checks of the algorithms besides the solver (RNEA, CRBA,
+// kinematics), for q (nq() entries) and the vectors of nv() entries (q̇, q̈).
+// A fixed base's are checked inline, exactly as before floating bases came:
+// its hot path pays for no call and no extra Status (each one zeroes its
+// 240-byte message). A floating base's q goes to checkConfiguration (the
+// quaternion too); its velocity vectors' sizes are worded as the solver's
+// other state vectors are ("… the model has nv = 9 (3 base velocity
+// coordinates + 6 joints)").
+Status checkFloatingVelocityVector(const Model& model, const char* name, const VectorRef& x);
+inline Status checkStateConfiguration(const Model& model, const VectorRef& q) {
+  return model.hasFloatingBase() ? checkConfiguration(model, q) : checkVector("q", q, model.dof());
+}
+inline Status checkVelocityVector(const Model& model, const char* name, const VectorRef& x) {
+  return model.hasFloatingBase() ? checkFloatingVelocityVector(model, name, x) : checkVector(name, x, model.dof());
+}
 
-// A workspace made for a model with the same joints but another base (its
-// H and τ are nv × nv and nv): ModelMismatch, before anything is written.
+// A workspace made for a model with the same joints but another base (its H
+// and τ are nv × nv and nv) must be refused before anything is written:
 // Workspace::dof() alone cannot tell a fixed arm from the same arm floating.
-Status checkWorkspaceBase(const Model& model, const Workspace& ws);
+inline bool workspaceFitsBase(const Model& model, const Workspace& ws) {
+  return ws.tau.size() == model.nv() && ws.H.rows() == model.nv();
+}
+// The ModelMismatch status for a workspace that does not fit (names both nv).
+Status workspaceBaseMismatch(const Model& model, const Workspace& ws);
 
 }  // namespace zwang::internal

@@ -6,8 +6,6 @@
 // put the base's coordinates first; the stages index the joints' part.
 #include "zwang/inverse_dynamics.hpp"
 
-#include "zwang/configuration.hpp"
-
 #include "dynamics/checks.hpp"
 #include "dynamics/floating_base.hpp"
 #include "dynamics/sweeps.hpp"
@@ -19,8 +17,8 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
                        const Eigen::Ref<const Eigen::VectorXd>& qdd_all, Workspace& ws) noexcept {
   if (ws.dof() != model.dof() || task.modelDof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace or task was made for another model");
-  if (Status s = internal::checkWorkspaceBase(model, ws); !s) return s;
-  if (Status s = checkConfiguration(model, q_all); !s) return s;  // size, finite, a free base's unit quaternion
+  if (!internal::workspaceFitsBase(model, ws)) return internal::workspaceBaseMismatch(model, ws);
+  if (Status s = internal::checkStateConfiguration(model, q_all); !s) return s;  // a free base's quaternion too
   if (Status s = internal::checkVelocityVector(model, "qd", qd_all); !s) return s;
   if (Status s = internal::checkVelocityVector(model, "qdd", qdd_all); !s) return s;
   if (Status s = internal::checkFinite("gravity", task.gravity); !s) return s;
@@ -77,28 +75,29 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
   return {};
 }
 
-Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) noexcept {
-  if (ws.dof() != model.dof())
-    return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
-                         model.dof());
-  if (Status s = internal::checkWorkspaceBase(model, ws); !s) return s;
-  if (Status s = checkConfiguration(model, q_all); !s) return s;  // size, finite, a free base's unit quaternion
-  const int N = model.dof(), nqb = model.baseConfigurationSize(), nvb = model.baseVelocitySize();
-  const bool floating = model.hasFloatingBase();
+namespace {
+
+// The CRBA's sweeps, compiled once per kind of base: on a fixed base nvb is
+// the constant 0 and the base's rows, columns and offsets vanish, so its
+// code (and time) is the one from before floating bases.
+template <bool kFloating>
+void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) {
+  const int N = model.dof();
+  const int nqb = kFloating ? model.baseConfigurationSize() : 0, nvb = kFloating ? model.baseVelocitySize() : 0;
   auto at = [](int i) { return static_cast<std::size_t>(i); };
 
   // Outward: poses, motion subspaces and inertias (no velocity: H depends on q only).
-  if (floating) internal::baseKinematics(model, q_all.head(nqb), q_all.head(0), ws, true);
+  if (kFloating) internal::baseKinematics(model, q_all.head(nqb), q_all.head(0), ws, true);
   internal::outwardKinematics(model, q_all.tail(N), Eigen::VectorXd(), ws, true);
   // The base's columns in the user's coordinates (6 × k; none for a fixed base).
   Matrix6Xmax S_base;
-  if (floating) internal::baseMotionColumns(model, ws, S_base);
+  if (kFloating) internal::baseMotionColumns(model, ws, S_base);
 
   // Inward: composite inertias, and row i of H from F_i = I^c_i S_i.
-  for (int i = floating ? 0 : 1; i <= N; ++i) ws.Ic[at(i)] = ws.I[at(i)].matrix();
+  for (int i = kFloating ? 0 : 1; i <= N; ++i) ws.Ic[at(i)] = ws.I[at(i)].matrix();
   for (int i = N; i >= 1; --i) {
     const int p = model.parent(i);
-    if (p > 0 || floating) ws.Ic[at(p)] += ws.Ic[at(i)];  // base coordinates: composite inertias add
+    if (kFloating || p > 0) ws.Ic[at(p)] += ws.Ic[at(i)];  // base coordinates: composite inertias add
     const Vec6 F = ws.Ic[at(i)] * ws.S[at(i)];
     const int row = nvb + i - 1;
     ws.H(row, row) = ws.S[at(i)].dot(F) + model.joint(i - 1).rotor_inertia;
@@ -117,6 +116,20 @@ Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::Vecto
     const Vec6 F = ws.Ic[0] * S_base.col(c);
     for (int r = c; r < nvb; ++r) ws.H(r, c) = ws.H(c, r) = S_base.col(r).dot(F);
   }
+}
+
+}  // namespace
+
+Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) noexcept {
+  if (ws.dof() != model.dof())
+    return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
+                         model.dof());
+  if (!internal::workspaceFitsBase(model, ws)) return internal::workspaceBaseMismatch(model, ws);
+  if (Status s = internal::checkStateConfiguration(model, q_all); !s) return s;  // a free base's quaternion too
+  if (model.hasFloatingBase())
+    compositeRigidBody<true>(model, q_all, ws);
+  else
+    compositeRigidBody<false>(model, q_all, ws);
   return {};
 }
 

@@ -1,7 +1,5 @@
 #include "zwang/kinematics.hpp"
 
-#include "zwang/configuration.hpp"
-
 #include "dynamics/checks.hpp"
 #include "dynamics/floating_base.hpp"
 #include "dynamics/sweeps.hpp"
@@ -53,7 +51,8 @@ Status checkWorkspace(const Model& model, const Workspace& ws) noexcept {
   if (ws.dof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
                          model.dof());
-  return internal::checkWorkspaceBase(model, ws);
+  if (!internal::workspaceFitsBase(model, ws)) return internal::workspaceBaseMismatch(model, ws);
+  return {};
 }
 
 Status checkFrame(const Model& model, int frame) noexcept {
@@ -87,19 +86,45 @@ Vec6 velocityAtPoint(const Vec6& m, const Vec3& p) {
   return out;
 }
 
+// J's columns after forwardKinematics, compiled once per kind of base: on a
+// fixed base nvb is the constant 0 and the base's columns vanish, so its code
+// (and time) is the one from before floating bases.
+template <bool kFloating>
+void jacobianColumns(const Model& model, const Workspace& ws, int frame, Expressed expressed,
+                     Eigen::Ref<Eigen::MatrixXd>& J) {
+  // Column nvb + j: the frame-origin velocity of a unit rate of joint j,
+  // S_{j+1} (base coordinates) seen at the frame origin p, for the joints
+  // that move it: those on the path from its body to the base.
+  const int nvb = kFloating ? model.baseVelocitySize() : 0;
+  const Transform X = internal::framePlacementInBase(model, ws, frame);
+  J.setZero();
+  for (int i = model.frame(frame).body; i >= 1; i = model.parent(i))
+    J.col(nvb + i - 1) = express(X, expressed, velocityAtPoint(ws.S[static_cast<std::size_t>(i)], X.r));
+  // A floating base moves every frame: its columns, in the user's velocity
+  // coordinates (a free base's v_B = [v; ω] in base axes), seen the same way.
+  if (kFloating) {
+    Matrix6Xmax S_base;
+    internal::baseMotionColumns(model, ws, S_base);
+    for (int k = 0; k < nvb; ++k) J.col(k) = express(X, expressed, velocityAtPoint(S_base.col(k), X.r));
+  }
+}
+
 }  // namespace
 
 Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
   if (Status s = checkWorkspace(model, ws); !s) return s;
-  if (Status s = checkConfiguration(model, q); !s) return s;  // size, finite, a free base's unit quaternion
+  if (Status s = internal::checkStateConfiguration(model, q); !s) return s;  // a free base's quaternion too
   if (qd.size() != 0)
     if (Status s = internal::checkVelocityVector(model, "qd", qd); !s) return s;
+  if (!model.hasFloatingBase()) {  // the joints' vectors are the whole state
+    internal::outwardKinematics(model, q, qd, ws, false);
+    return {};
+  }
+  // The base joint first (its pose and velocity are every body's start), then the joints.
   const int n = model.dof(), nqb = model.baseConfigurationSize(), nvb = model.baseVelocitySize();
   const bool moving = qd.size() == model.nv();
-  // The base joint first (its pose and velocity are every body's start), then the joints.
-  if (model.hasFloatingBase())
-    internal::baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, false);
+  internal::baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, false);
   internal::outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, false);
   return {};
 }
@@ -144,21 +169,10 @@ Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const E
   }
   if (Status s = checkFrame(model, frame); !s) return s;
   if (Status s = forwardKinematics(model, ws, q); !s) return s;
-  // Column nvb + j: the frame-origin velocity of a unit rate of joint j,
-  // S_{j+1} (base coordinates) seen at the frame origin p, for the joints
-  // that move it: those on the path from its body to the base.
-  const int nvb = model.baseVelocitySize();
-  const Transform X = internal::framePlacementInBase(model, ws, frame);
-  J.setZero();
-  for (int i = model.frame(frame).body; i >= 1; i = model.parent(i))
-    J.col(nvb + i - 1) = express(X, expressed, velocityAtPoint(ws.S[static_cast<std::size_t>(i)], X.r));
-  // A floating base moves every frame: its columns, in the user's velocity
-  // coordinates (a free base's v_B = [v; ω] in base axes), seen the same way.
-  if (model.hasFloatingBase()) {
-    Matrix6Xmax S_base;
-    internal::baseMotionColumns(model, ws, S_base);
-    for (int k = 0; k < nvb; ++k) J.col(k) = express(X, expressed, velocityAtPoint(S_base.col(k), X.r));
-  }
+  if (model.hasFloatingBase())
+    jacobianColumns<true>(model, ws, frame, expressed, J);
+  else
+    jacobianColumns<false>(model, ws, frame, expressed, J);
   return {};
 }
 

@@ -2,6 +2,10 @@
 /// Forward kinematics, frame velocities, accelerations and Jacobians.
 /// Velocities and accelerations are classical: [linear of the frame origin;
 /// angular], expressed in the frame's axes (Local) or the world axes (World).
+///
+/// Fixed and floating bases alike (docs/conventions.md, "Floating base"): q has
+/// Model::nq() entries and q̇ Model::nv(), the base's coordinates first; a
+/// floating base's pose and velocity move every frame, the base link's too.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -16,9 +20,13 @@ namespace zwang {
 // [0, model.frames().size()) is ModelMismatch "frame index F is not a frame of
 // this model (it has N frames)"; a workspace made for a model with another
 // number of joints is ModelMismatch "workspace was made for N joints, the
-// model has M". On an error the output parameter is left unchanged.
+// model has M" (or for the same joints on another base: "… nv = …"). q must
+// pass checkConfiguration (nq() entries, finite, a free base's quaternion unit
+// to 1e-6); q̇ has nv() finite entries. On an error the output parameter is
+// left unchanged.
 
-/// Poses (and velocities when qd is given) of every body into the workspace.
+/// Poses (and velocities when qd is given) of every body into the workspace:
+/// q has nq() entries, qd nv() (or none: every body at rest).
 Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd = Eigen::VectorXd()) noexcept;
 
@@ -26,11 +34,18 @@ Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<con
 Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isometry3d& pose) noexcept;
 /// After forwardKinematics with qd (or a solve): the frame's velocity.
 Status frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed, Vec6& velocity) noexcept;
-/// After a solve: the frame's true classical acceleration.
+/// After a solve or inverseDynamics: the frame's true classical acceleration
+/// (gravity's shift of the sweep removed).
 Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept;
 
-/// J (6×dof) with frameVelocity = J q̇. Runs forwardKinematics(q) itself.
+/// J (6 × nv()) with frameVelocity = J q̇. Runs forwardKinematics(q) itself.
+/// A floating base's columns come first, in the user's velocity coordinates:
+/// d(frame velocity)/d v_base, for a free base v_B = [v; ω] in base axes, for
+/// a planar one [ẋ, ẏ, ψ̇] in the plane's axes; then one column per joint, zero
+/// for the joints that do not move the frame. J of the wrong size is
+/// SizeMismatch "Jacobian output is 6x5, expected 6x13 (nv = 6 base velocity
+/// coordinates + 7 joints)" ("expected 6x7" on a fixed base).
 Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q, int frame,
                      Expressed expressed, Eigen::Ref<Eigen::MatrixXd> J) noexcept;
 

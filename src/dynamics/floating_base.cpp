@@ -174,4 +174,30 @@ void baseGeneralizedForce(const Model& model, const Workspace& ws, const Vec6& F
     out = ws.S_base.transpose() * F0;
 }
 
+void baseMotionColumns(const Model& model, const Workspace& ws, Matrix6Xmax& S_user) {
+  if (model.baseType() != BaseType::Free) {
+    S_user = ws.S_base;  // planar: the sweep's coordinates are the user's
+    return;
+  }
+  // ⁰X_B = [R  p×R; 0  R] (R = ⁰R_B, p the base origin): v_B's unit twists
+  // seen from the world origin.
+  const Transform& X = ws.Xworld[0];  // ᴮX₀
+  S_user.resize(6, 6);
+  for (int k = 0; k < 6; ++k) S_user.col(k) = X.inverseApplyMotion(Vec6::Unit(k));
+}
+
+Status checkFloatingVelocityVector(const Model& model, const char* name, const VectorRef& x) {
+  if (x.size() != model.nv())
+    return Status::error(StatusCode::SizeMismatch,
+                         "%s has %ld entries, the model has nv = %d (%d base velocity coordinates + %d joints)", name,
+                         static_cast<long>(x.size()), model.nv(), model.baseVelocitySize(), model.dof());
+  return checkVector(name, x, model.nv());  // the size holds: only the finiteness message can come back
+}
+
+Status workspaceBaseMismatch(const Model& model, const Workspace& ws) {
+  return Status::error(StatusCode::ModelMismatch,
+                       "workspace was made for a model with nv = %ld, this one has nv = %d (a %s base and %d joints)",
+                       static_cast<long>(ws.tau.size()), model.nv(), toString(model.baseType()), model.dof());
+}
+
 }  // namespace zwang::internal

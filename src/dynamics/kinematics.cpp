@@ -1,6 +1,7 @@
 #include "zwang/kinematics.hpp"
 
 #include "dynamics/checks.hpp"
+#include "dynamics/floating_base.hpp"
 #include "dynamics/sweeps.hpp"
 
 namespace zwang {
@@ -50,6 +51,7 @@ Status checkWorkspace(const Model& model, const Workspace& ws) noexcept {
   if (ws.dof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
                          model.dof());
+  if (!internal::workspaceFitsBase(model, ws)) return internal::workspaceBaseMismatch(model, ws);
   return {};
 }
 
@@ -76,15 +78,54 @@ Vec6 express(const Transform& Xf0, Expressed expressed, const Vec6& world) {
   return out;
 }
 
+// The classical velocity [linear of point p; angular], world axes, of a
+// spatial velocity (or motion subspace column) m in base coordinates.
+Vec6 velocityAtPoint(const Vec6& m, const Vec3& p) {
+  Vec6 out;
+  out << m.head<3>() + m.tail<3>().cross(p), m.tail<3>();
+  return out;
+}
+
+// J's columns after forwardKinematics, compiled once per kind of base: on a
+// fixed base nvb is the constant 0 and the base's columns vanish, so its code
+// (and time) is the one from before floating bases.
+template <bool kFloating>
+void jacobianColumns(const Model& model, const Workspace& ws, int frame, Expressed expressed,
+                     Eigen::Ref<Eigen::MatrixXd>& J) {
+  // Column nvb + j: the frame-origin velocity of a unit rate of joint j,
+  // S_{j+1} (base coordinates) seen at the frame origin p, for the joints
+  // that move it: those on the path from its body to the base.
+  const int nvb = kFloating ? model.baseVelocitySize() : 0;
+  const Transform X = internal::framePlacementInBase(model, ws, frame);
+  J.setZero();
+  for (int i = model.frame(frame).body; i >= 1; i = model.parent(i))
+    J.col(nvb + i - 1) = express(X, expressed, velocityAtPoint(ws.S[static_cast<std::size_t>(i)], X.r));
+  // A floating base moves every frame: its columns, in the user's velocity
+  // coordinates (a free base's v_B = [v; ω] in base axes), seen the same way.
+  if (kFloating) {
+    Matrix6Xmax S_base;
+    internal::baseMotionColumns(model, ws, S_base);
+    for (int k = 0; k < nvb; ++k) J.col(k) = express(X, expressed, velocityAtPoint(S_base.col(k), X.r));
+  }
+}
+
 }  // namespace
 
 Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
   if (Status s = checkWorkspace(model, ws); !s) return s;
-  if (Status s = internal::checkVector("q", q, model.dof()); !s) return s;
+  if (Status s = internal::checkStateConfiguration(model, q); !s) return s;  // a free base's quaternion too
   if (qd.size() != 0)
-    if (Status s = internal::checkVector("qd", qd, model.dof()); !s) return s;
-  internal::outwardKinematics(model, q, qd, ws, false);
+    if (Status s = internal::checkVelocityVector(model, "qd", qd); !s) return s;
+  if (!model.hasFloatingBase()) {  // the joints' vectors are the whole state
+    internal::outwardKinematics(model, q, qd, ws, false);
+    return {};
+  }
+  // The base joint first (its pose and velocity are every body's start), then the joints.
+  const int n = model.dof(), nqb = model.baseConfigurationSize(), nvb = model.baseVelocitySize();
+  const bool moving = qd.size() == model.nv();
+  internal::baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, false);
+  internal::outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, false);
   return {};
 }
 
@@ -100,10 +141,8 @@ Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isom
 Status frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed, Vec6& velocity) noexcept {
   if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
   const Transform X = internal::framePlacementInBase(model, ws, frame);
-  const Vec6& v = ws.v[static_cast<std::size_t>(model.frame(frame).body)];
-  Vec6 world;
-  world << v.head<3>() + v.tail<3>().cross(X.r), v.tail<3>();  // velocity of the frame origin p
-  velocity = express(X, expressed, world);
+  // Ẋ of the frame's body (a floating base's motion included), seen at the frame origin.
+  velocity = express(X, expressed, velocityAtPoint(ws.v[static_cast<std::size_t>(model.frame(frame).body)], X.r));
   return {};
 }
 
@@ -119,22 +158,21 @@ Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Exp
 
 Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q, int frame,
                      Expressed expressed, Eigen::Ref<Eigen::MatrixXd> J) noexcept {
-  if (J.rows() != 6 || J.cols() != model.dof())
-    return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",
-                         static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.dof());
+  if (J.rows() != 6 || J.cols() != model.nv()) {
+    if (!model.hasFloatingBase())
+      return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",
+                           static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.dof());
+    return Status::error(StatusCode::SizeMismatch,
+                         "Jacobian output is %ldx%ld, expected 6x%d (nv = %d base velocity coordinates + %d joints)",
+                         static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.nv(), model.baseVelocitySize(),
+                         model.dof());
+  }
   if (Status s = checkFrame(model, frame); !s) return s;
   if (Status s = forwardKinematics(model, ws, q); !s) return s;
-  // Column j: the frame-origin velocity of a unit rate of joint j, S_{j+1}
-  // (base coordinates) seen at the frame origin p, for the joints that move
-  // it: those on the path from its body to the base.
-  const Transform X = internal::framePlacementInBase(model, ws, frame);
-  J.setZero();
-  for (int i = model.frame(frame).body; i >= 1; i = model.parent(i)) {
-    const Vec6& S = ws.S[static_cast<std::size_t>(i)];
-    Vec6 world;
-    world << S.head<3>() + S.tail<3>().cross(X.r), S.tail<3>();
-    J.col(i - 1) = express(X, expressed, world);
-  }
+  if (model.hasFloatingBase())
+    jacobianColumns<true>(model, ws, frame, expressed, J);
+  else
+    jacobianColumns<false>(model, ws, frame, expressed, J);
   return {};
 }
 

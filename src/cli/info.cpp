@@ -135,8 +135,9 @@ void printInfoTable(const Model& model, const std::string& path) {
     std::printf("base: fixed (nq = nv = %d)\n", model.dof());
   } else {
     const int n = model.dof(), cq = model.baseConfigurationSize(), cv = model.baseVelocitySize();
-    std::printf("base: %s, link %s (q: %d base coordinates + %d joints = nq %d; v: %d + %d = nv %d)\n",
-                toString(model.baseType()), model.frame(0).name.c_str(), cq, n, model.nq(), cv, n, model.nv());
+    std::printf("base: %s, link %s (q: %d base coordinates + %d joint%s = nq %d; v: %d + %d = nv %d)\n",
+                toString(model.baseType()), model.frame(0).name.c_str(), cq, n, n == 1 ? "" : "s", model.nq(), cv, n,
+                model.nv());
     if (model.baseType() == BaseType::Planar)
       std::printf("  moving in the plane through %s with normal %s (x axis %s)\n",
                   triple(model.basePlacement().originOfTarget()).c_str(),

@@ -852,7 +852,7 @@ TEST_CASE("info: table and JSON", "[info]") {
     CHECK(jf["base_mass"].get<double>() == 1.16115091);  // counted on a fixed base too
     const Run planar = run({"info", problem("planar_cart.urdf")});
     REQUIRE(planar.exit_code == 0);
-    CHECK(contains(planar.out, "base: planar, link cart (q: 3 base coordinates + 1 joints = nq 4; v: 3 + 1 = nv 4)"));
+    CHECK(contains(planar.out, "base: planar, link cart (q: 3 base coordinates + 1 joint = nq 4; v: 3 + 1 = nv 4)"));
     CHECK(contains(planar.out, "moving in the plane through (0, 0, 1) with normal (0, -1, 0) (x axis (1, 0, 0))"));
     const Json jp = parse(run({"info", problem("planar_cart.urdf"), "--json"}).out);
     CHECK(jp["base_type"] == "planar");

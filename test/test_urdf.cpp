@@ -430,11 +430,17 @@ TEST_CASE("error: unknown root or tip, tip not below root", "[urdf][errors]") {
 }
 
 TEST_CASE("error: floating and planar joints on the chain", "[urdf][errors]") {
-  REQUIRE_THROWS_WITH(loadUrdfString(arm("", kInertial, "", "floating")),
-                      Contains("<string>") && Contains("joint 'j1'") && Contains("floating") &&
-                          Contains("not supported"));
-  REQUIRE_THROWS_WITH(loadUrdfString(arm(R"(<axis xyz="0 0 1"/>)", kInertial, "", "planar")),
-                      Contains("joint 'j1'") && Contains("planar") && Contains("not supported"));
+  // Below the root they are refused (at the root they are the base: test_urdf_floating).
+  const auto below = [](const std::string& type) {
+    return arm(kJointBody, kInertial,
+               "<joint name=\"j2\" type=\"" + type +
+                   R"("><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/></joint><link name="l2">)" + kInertial +
+                   "</link>");
+  };
+  REQUIRE_THROWS_WITH(loadUrdfString(below("floating")), Contains("<string>") && Contains("joint 'j2'") &&
+                                                             Contains("floating") && Contains("not supported"));
+  REQUIRE_THROWS_WITH(loadUrdfString(below("planar")),
+                      Contains("joint 'j2'") && Contains("planar") && Contains("not supported"));
   // Off the chain it is fine (it is not part of the model).
   const std::string extra = R"(<joint name="free" type="floating"><parent link="base"/><child link="ball"/></joint>
       <link name="ball">)" + kInertial +

@@ -42,6 +42,27 @@ enum class MimicJoints {
 /// Fixed joints are merged into their parent body, and every link that is
 /// loaded, or welded to one that is, is a named frame (also the links welded
 /// above the root).
+///
+/// The base (docs/conventions.md, "Floating base"; body 0 is the root link and
+/// the links welded to it):
+/// * A URDF whose root link's only joint is `floating` or `planar` (the
+///   "world → base_link" pattern) loads with a Free or Planar base under that
+///   joint's child link, which becomes body 0 (when the model starts at the
+///   URDF's root link, the default, or at that child link). The links above
+///   the joint are the world: not frames, their mass ignored. Free: the base
+///   pose is the configuration, the base link's pose in the root link's (the
+///   world's) frame; the joint's `<origin>` would only offset the zero of
+///   those coordinates, so it is folded in (q = [origin xyz, origin
+///   quaternion] puts the base where the URDF draws it). Planar: the joint
+///   frame (`<origin>`) is the plane (Model::basePlacement()), its `<axis>`
+///   must be its z axis, `0 0 1` (ModelError otherwise, saying how to turn
+///   the origin instead). A `floating` or `planar` joint anywhere else, among
+///   the joints loaded, is a ModelError naming it.
+/// * Otherwise `base` may give the root link a free-flyer or a planar joint
+///   (the world's x-y plane) for the many legged-robot URDFs that leave it out.
+/// * The root link's own `<inertial>` is body 0's (with the links welded to
+///   it): in the dynamics when the base floats, only counted
+///   (Model::inertia(0), the "base mass") on a fixed base.
 struct UrdfOptions {
   /// The model starts at this link (its base, body 0). Empty: the URDF's root link.
   std::string root;
@@ -68,6 +89,17 @@ struct UrdfOptions {
   /// (attach_beyond_tip) and the mimic joints (MimicJoints::Lock). Any other
   /// name is a ModelError.
   std::map<std::string, double> locked_positions;
+  /// Give the root link a floating base: BaseType::Free (a free-flyer) or
+  /// BaseType::Planar (x, y, yaw in the world's x-y plane). BaseType::Fixed
+  /// (the default) adds none: the base is fixed unless the URDF has a floating
+  /// or planar root joint (see above). Free or Planar on a URDF that has such
+  /// a root joint already is a ModelError, unless base_may_match_file.
+  BaseType base = BaseType::Fixed;
+  /// With `base` Free or Planar and a URDF that already has a floating or
+  /// planar root joint: false (default), ModelError ("drop the base option");
+  /// true, the file's joint is used when its type is the one `base` asks for,
+  /// ModelError otherwise. For callers that always name the base (the CLI's "base").
+  bool base_may_match_file = false;
   /// How the caller spells these options, for the hints in messages (the CLI
   /// says "--tip", Python "tip=").
   struct Names {
@@ -76,6 +108,7 @@ struct UrdfOptions {
     std::string attach_beyond_tip = "UrdfOptions::attach_beyond_tip";   ///< the name of the attach_beyond_tip option
     std::string lock_mimic = "UrdfOptions::mimic = MimicJoints::Lock";  ///< how to ask for MimicJoints::Lock
     std::string refuse_mimic = "UrdfOptions::mimic = MimicJoints::Refuse";  ///< how MimicJoints::Refuse was asked for
+    std::string base = "UrdfOptions::base";                                 ///< the name of the base option
   } names;                                                                  ///< see Names
 };
 

@@ -1,4 +1,4 @@
-// `zwang info MODEL.urdf [--root L] [--tip L] [--lock-mimic] [--json]`: what the
+// `zwang info MODEL.urdf [--root L] [--tip L] [--base B] [--lock-mimic] [--json]`: what the
 // loader made of a URDF tree or chain.
 #include <algorithm>
 #include <cctype>
@@ -56,8 +56,9 @@ void printTable(const std::vector<std::vector<std::string>>& rows) {
   }
 }
 
-// The base (body 0: the root and every link welded to it) never moves: its
-// mass does not enter the dynamics, so it is shown apart.
+// The base (body 0: the root and every link welded to it): a fixed base never
+// moves, so its mass does not enter the dynamics; a floating one's does.
+// Either way it is shown apart from the bodies the joints move.
 struct Masses {
   double moving = 0.0, base = 0.0;
   explicit Masses(const Model& model) : base(model.inertia(0).mass) {
@@ -100,21 +101,50 @@ Json infoJson(const Model& model, const std::string& path) {
   for (const ModelWarning& w : model.warnings())
     warnings.push_back({{"code", toString(w.code)}, {"message", w.message}});
   const Masses mass(model);
-  return {{"file", path},
-          {"model", model.name()},
-          {"dof", model.dof()},
-          {"chain", model.isChain()},
-          {"joints", std::move(joints)},
-          {"frames", std::move(frames)},
-          {"moving_mass", mass.moving},
-          {"base_mass", mass.base},
-          {"total_mass", mass.moving + mass.base},
-          {"warnings", std::move(warnings)}};
+  Json out = {{"file", path},       {"model", model.name()},
+              {"dof", model.dof()}, {"base_type", toString(model.baseType())},
+              {"nq", model.nq()},   {"nv", model.nv()}};
+  if (model.baseType() == BaseType::Planar) {
+    const Mat3 axes = model.basePlacement().rotationOfTarget();  // the plane's axes in the world
+    const Vec3 origin = model.basePlacement().originOfTarget();
+    const auto vec = [](const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); };
+    out["base_plane"] = {{"origin", vec(origin)},
+                         {"x_axis", vec(axes.col(0))},
+                         {"y_axis", vec(axes.col(1))},
+                         {"normal", vec(axes.col(2))}};
+  }
+  Json rest = {{"chain", model.isChain()},       {"joints", std::move(joints)}, {"frames", std::move(frames)},
+               {"moving_mass", mass.moving},     {"base_mass", mass.base},      {"total_mass", mass.moving + mass.base},
+               {"warnings", std::move(warnings)}};
+  for (auto& item : rest.items()) out[item.key()] = std::move(item.value());
+  return out;
+}
+
+// "(0, 0, 1)" for the table (rounding's 1e-16s shown as 0; the JSON has the exact numbers).
+std::string triple(const Vec3& v) {
+  const auto shown = [](double x) { return std::abs(x) < 1e-12 ? 0.0 : x; };
+  char text[96];
+  std::snprintf(text, sizeof text, "(%g, %g, %g)", shown(v.x()), shown(v.y()), shown(v.z()));
+  return text;
 }
 
 void printInfoTable(const Model& model, const std::string& path) {
-  std::printf("%s: %d moving joint%s%s, %zu frames (%s)\n\njoints\n", model.name().c_str(), model.dof(),
+  std::printf("%s: %d moving joint%s%s, %zu frames (%s)\n", model.name().c_str(), model.dof(),
               model.dof() == 1 ? "" : "s", model.isChain() ? "" : " in a tree", model.frames().size(), path.c_str());
+  if (!model.hasFloatingBase()) {
+    std::printf("base: fixed (nq = nv = %d)\n", model.dof());
+  } else {
+    const int n = model.dof(), cq = model.baseConfigurationSize(), cv = model.baseVelocitySize();
+    std::printf("base: %s, link %s (q: %d base coordinates + %d joint%s = nq %d; v: %d + %d = nv %d)\n",
+                toString(model.baseType()), model.frame(0).name.c_str(), cq, n, n == 1 ? "" : "s", model.nq(), cv, n,
+                model.nv());
+    if (model.baseType() == BaseType::Planar)
+      std::printf("  moving in the plane through %s with normal %s (x axis %s)\n",
+                  triple(model.basePlacement().originOfTarget()).c_str(),
+                  triple(model.basePlacement().rotationOfTarget().col(2)).c_str(),
+                  triple(model.basePlacement().rotationOfTarget().col(0)).c_str());
+  }
+  std::printf("\njoints\n");
   std::vector<std::vector<std::string>> rows{{"#", "name", "parent", "type", "axis", "lower", "upper", "effort",
                                               "velocity", "breakaway", "kinetic", "viscous", "rotor_inertia"}};
   for (int k = 0; k < model.dof(); ++k) {
@@ -142,8 +172,14 @@ void printInfoTable(const Model& model, const std::string& path) {
   for (const Frame& f : model.frames()) rows.push_back({f.name, std::to_string(f.body), bodyLink(model, f.body)});
   printTable(rows);
   const Masses mass(model);
-  std::printf("\nmoving mass %s kg (bodies 1-%d), base mass %s kg (welded to the fixed base, not in the dynamics)\n",
-              cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
+  if (model.hasFloatingBase())
+    std::printf(
+        "\nmoving mass %s kg (bodies 1-%d), base mass %s kg (body 0: the root link and the links welded to "
+        "it; it floats: in the dynamics)\n",
+        cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
+  else
+    std::printf("\nmoving mass %s kg (bodies 1-%d), base mass %s kg (welded to the fixed base, not in the dynamics)\n",
+                cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
   const std::size_t warnings = model.warnings().size();
   if (warnings > 0) std::printf("%zu warning%s (on stderr)\n", warnings, warnings == 1 ? "" : "s");
   std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (viscous), kg·m² or kg (rotor inertia)\n");
@@ -152,8 +188,9 @@ void printInfoTable(const Model& model, const std::string& path) {
 }  // namespace
 
 int commandInfo(int argc, char** argv) {
-  const Arguments args = parseArguments(
-      "info", argc, argv, 2, {"--json", "--strict", "--attach-beyond-tip", "--lock-mimic"}, {"--root", "--tip"});
+  const Arguments args =
+      parseArguments("info", argc, argv, 2, {"--json", "--strict", "--attach-beyond-tip", "--lock-mimic"},
+                     {"--root", "--tip", "--base"});
   if (args.help) {
     std::fputs(usageText("info"), stdout);
     return kExitOk;
@@ -168,6 +205,16 @@ int commandInfo(int argc, char** argv) {
   options.attach_beyond_tip = args.has("--attach-beyond-tip");
   options.mimic = args.has("--lock-mimic") ? MimicJoints::Lock : MimicJoints::Model;
   options.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
+  options.names.base = "--base";
+  if (args.has("--base")) {
+    const std::string base = args.value("--base");
+    if (base == "free")
+      options.base = BaseType::Free;
+    else if (base == "planar")
+      options.base = BaseType::Planar;
+    else if (base != "fixed")
+      throw UsageError("info", "--base: unknown value '" + printable(base, 40) + "' (expected free, planar or fixed)");
+  }
   Model model;
   try {
     model = loadUrdfFile(path, options);

@@ -1,6 +1,7 @@
 // Reading the JSON problem of `zwang solve` and binding it to its model.
 #include "problem.hpp"
 
+#include <cmath>
 #include <filesystem>
 
 #include "cli.hpp"
@@ -119,6 +120,61 @@ BalanceOptions parseBalance(const JsonReader& in, const Json& value, const std::
   return o;
 }
 
+// "base": {"type": "free", "position", "orientation", "linear_velocity",
+// "angular_velocity", "force"} or {"type": "planar", "position", "yaw",
+// "velocity", "force"}; every entry but "type" optional (the origin, the
+// identity orientation, at rest, no force).
+BaseSpec parseBase(const JsonReader& in, const Json& value, const std::string& path) {
+  if (!value.is_object()) in.fail(path, "expected an object, got " + describe(value));
+  if (!value.contains("type"))
+    in.fail(path, "missing key \"type\" (\"free\" or \"planar\": how the base moves in the world)");
+  const std::string tpath = childPath(path, "type");
+  const std::string type = in.string(value["type"], tpath);
+  BaseSpec b;
+  b.present = true;
+  const auto vector = [&](const char* key, long size, const std::string& what) -> Eigen::VectorXd {
+    if (!value.contains(key)) return Eigen::VectorXd::Zero(size);
+    return in.numbers(value[key], childPath(path, key), size, what);
+  };
+  if (type == "free") {
+    b.type = BaseType::Free;
+    in.object(value, path, {"type", "position", "orientation", "linear_velocity", "angular_velocity", "force"});
+    b.q.resize(7);
+    b.q.head<3>() = vector("position", 3, "x, y, z of the base origin in the world");
+    b.q.tail<4>() << 1.0, 0.0, 0.0, 0.0;
+    if (value.contains("orientation")) {
+      const std::string opath = childPath(path, "orientation");
+      const Eigen::Vector4d quaternion =
+          in.numbers(value["orientation"], opath, 4, "a unit quaternion w, x, y, z: base to world");
+      const double norm = quaternion.norm();
+      if (norm == 0.0) in.fail(opath, "is zero: give a unit quaternion [w, x, y, z] (the identity: [1, 0, 0, 0])");
+      if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
+        std::string unit;
+        for (int k = 0; k < 4; ++k) unit += (k ? ", " : "") + formatNumber(quaternion[k] / norm);
+        in.fail(opath, "has norm " + formatNumber(norm) + ", not 1 within " + formatNumber(kQuaternionNormTolerance) +
+                           ": write it normalised, [" + unit + "]");
+      }
+      b.q.tail<4>() = quaternion;
+    }
+    b.v.resize(6);
+    b.v.head<3>() = vector("linear_velocity", 3, "the base origin's velocity in base axes");
+    b.v.tail<3>() = vector("angular_velocity", 3, "in base axes");
+    b.force = vector("force", 6, "fx, fy, fz, nx, ny, nz: a wrench at the base origin in base axes");
+  } else if (type == "planar") {
+    b.type = BaseType::Planar;
+    in.object(value, path, {"type", "position", "yaw", "velocity", "force"});
+    b.q.resize(3);
+    b.q.head<2>() = vector("position", 2, "x, y in the plane");
+    b.q[2] = value.contains("yaw") ? in.number(value["yaw"], childPath(path, "yaw")) : 0.0;
+    b.v = vector("velocity", 3, "x, y and yaw rates in the plane's axes");
+    b.force = vector("force", 3, "fx, fy in the plane's axes and the torque about its normal");
+  } else {
+    in.fail(tpath, "unknown value \"" + printable(type, 40) + "\" (expected \"free\" or \"planar\"" +
+                       (type == "fixed" ? "; a fixed base needs no \"base\" section" : "") + ")");
+  }
+  return b;
+}
+
 // Per-joint overrides must be non-negative.
 Eigen::VectorXd nonNegative(const JsonReader& in, const Json& value, const std::string& path) {
   Eigen::VectorXd v = in.numbers(value, path);
@@ -148,7 +204,7 @@ Problem readProblem(const std::string& file) {
   if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
   in.object(doc, "",
             {"model", "root", "tip", "strict", "attach_beyond_tip", "lock_mimic", "gravity", "q", "qd", "tau",
-             "rotor_inertia", "breakaway", "wrenches", "constraints", "friction", "balance"});
+             "rotor_inertia", "breakaway", "wrenches", "constraints", "friction", "balance", "base"});
 
   Problem p;
   p.file = file;
@@ -184,6 +240,7 @@ Problem readProblem(const std::string& file) {
   }
   if (doc.contains("friction")) p.friction = parseFriction(in, doc["friction"], "friction");
   if (doc.contains("balance")) p.balance = parseBalance(in, doc["balance"], "balance");
+  if (doc.contains("base")) p.base = parseBase(in, doc["base"], "base");
   if (p.breakaway && !p.friction.present)
     in.fail("breakaway", "has no effect without a \"friction\" section (add \"friction\": {} to solve with friction)");
   return p;
@@ -198,18 +255,28 @@ BoundProblem bindProblem(const Problem& p) {
   urdf.attach_beyond_tip = p.attach_beyond_tip;
   urdf.mimic = p.lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
   urdf.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
+  urdf.names.base = "base.type";
+  urdf.base = p.base.type;          // Fixed when there is no "base"
+  urdf.base_may_match_file = true;  // "base" also names a floating root joint of the file
   Model model;
   try {
     model = loadUrdfFile(p.model_path, urdf);
   } catch (const ModelError& e) {
     in.fail("model", e.what());
   }
+  if (model.hasFloatingBase() && !p.base.present)
+    in.fail("base", std::string("missing: the URDF's root joint gives the robot a ") + toString(model.baseType()) +
+                        " base, whose state the problem must give: \"base\": {\"type\": \"" +
+                        toString(model.baseType()) + "\", …} (docs/cli.md, \"Floating base\")");
   const int n = model.dof();
   const std::string per_joint = "one per moving joint: " + jointList(model);
   auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key) {
-    if (v && v->size() != n)
-      in.fail(key, "has " + std::to_string(v->size()) + (v->size() == 1 ? " entry" : " entries") + ", expected " +
-                       std::to_string(n) + " (" + per_joint + ")");
+    if (!v || v->size() == n) return;
+    // A floating base's coordinates go in "base", not in front of the joints' as in the library.
+    const bool with_base = model.hasFloatingBase() && (v->size() == model.nq() || v->size() == model.nv());
+    in.fail(key, "has " + std::to_string(v->size()) + (v->size() == 1 ? " entry" : " entries") + ", expected " +
+                     std::to_string(n) + " (" + per_joint + ")" +
+                     (with_base ? "; the base's state goes in \"base\", not here" : ""));
   };
   checkLength(p.q, "q");
   checkLength(p.qd, "qd");
@@ -235,9 +302,16 @@ BoundProblem bindProblem(const Problem& p) {
 
   BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, {}, {}};
   const Model& m = b.model;
-  b.q = p.q ? *p.q : Eigen::VectorXd::Zero(n);
-  b.qd = p.qd ? *p.qd : Eigen::VectorXd::Zero(n);
-  b.tau = p.tau ? *p.tau : Eigen::VectorXd::Zero(n);
+  // The base's coordinates first, then the joints' (docs/conventions.md, "Floating base").
+  const auto stack = [n](const Eigen::VectorXd& base, const std::optional<Eigen::VectorXd>& joints) {
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(base.size() + n);
+    full.head(base.size()) = base;
+    if (joints) full.tail(n) = *joints;
+    return full;
+  };
+  b.q = stack(p.base.q, p.q);
+  b.qd = stack(p.base.v, p.qd);
+  b.tau = stack(p.base.force, p.tau);
   b.task = std::make_unique<Task>(m);
   Task& task = *b.task;
   if (p.gravity) task.gravity = *p.gravity;

@@ -33,6 +33,15 @@ struct FrictionSpec {
   FrictionOptions options;
 };
 
+// "base": the state of a floating base (docs/cli.md, "Floating base").
+struct BaseSpec {
+  bool present = false;             // the problem has a "base" section
+  BaseType type = BaseType::Fixed;  // "type": Free or Planar when present
+  Eigen::VectorXd q;                // the base's coordinates: 7 (free: x y z, w x y z) or 3 (planar: x y yaw)
+  Eigen::VectorXd v;                // its velocity coordinates: 6 (free: v, ω in base axes) or 3 (planar)
+  Eigen::VectorXd force;            // "force": τ of the base, 6 or 3 entries (default 0)
+};
+
 // The problem as written, checked for everything that does not need the model.
 struct Problem {
   std::string file;        // the problem file, as given on the command line
@@ -47,6 +56,7 @@ struct Problem {
   std::vector<ConstraintSpec> constraints;
   FrictionSpec friction;
   BalanceOptions balance;  // "balance" (defaults when absent)
+  BaseSpec base;           // "base" (a fixed base when absent, unless the URDF floats: then an error)
 };
 
 // Read, parse and check a problem file; CliError "FILE: PATH: what" on any fault.
@@ -56,7 +66,7 @@ Problem readProblem(const std::string& file);
 struct BoundProblem {
   Model model;
   std::unique_ptr<Task> task;
-  Eigen::VectorXd q, qd, tau;
+  Eigen::VectorXd q, qd, tau;  // full length: q has nq() entries, qd and tau nv() (the base's first)
   bool with_friction = false;  // run solveWithFriction (else solveHybridDynamics)
   FrictionOptions friction_options;
   std::vector<int> reported_frames;  // constrained, reference or loaded frames, first appearance order

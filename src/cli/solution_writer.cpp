@@ -62,9 +62,17 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
   Json joints = Json::array();
   for (const Joint& joint : model.joints()) joints.push_back(joint.name);
   out["joints"] = std::move(joints);
-  out["qdd"] = array(s.qdd);
-  out["tau_constraint"] = array(s.tau_constraint);
-  out["tau_control"] = array(s.tau_control);
+  // Per joint; a floating base's entries (they come first) go to "base".
+  const int n = model.dof(), nb = model.baseVelocitySize();
+  out["qdd"] = array(s.qdd.tail(n));
+  out["tau_constraint"] = array(s.tau_constraint.tail(n));
+  out["tau_control"] = array(s.tau_control.tail(n));
+  if (model.hasFloatingBase())
+    out["base"] = {{"type", toString(model.baseType())},
+                   {"acceleration", array(s.qdd.head(nb))},
+                   {"acceleration_world", array(s.base_acceleration_world)},
+                   {"tau_constraint", array(s.tau_constraint.head(nb))},
+                   {"tau_control", array(s.tau_control.head(nb))}};
   out["nu"] = array(s.nu);
   out["gauss"] = s.gauss;
   if (with_friction) {

@@ -8,8 +8,10 @@
 
 namespace zwang::cli {
 
-// Keys, in this order: joints, qdd, tau_constraint, tau_control, nu, gauss,
-// friction (only when `with_friction`), status, frames. Numbers are written
+// Keys, in this order: joints, qdd, tau_constraint, tau_control (per joint),
+// base (only for a floating base: its type, acceleration, acceleration_world,
+// tau_constraint, tau_control), nu, gauss, friction (only when
+// `with_friction`), status, frames. Numbers are written
 // by nlohmann::json in their shortest form that reads back exactly.
 Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, const Status& status,
                   const std::vector<int>& frames);

@@ -12,12 +12,15 @@ namespace {
 
 // A configuration outside the joint limits is solved as given (the limits
 // matter to the friction solver only at a stop); it is said once per joint.
+// `q` has the base's coordinates first; "q[j]" is the problem's (per joint).
 void warnOutsideLimits(const std::string& file, const Model& model, const Eigen::VectorXd& q) {
+  const int base = model.baseConfigurationSize();
   for (int j = 0; j < model.dof(); ++j) {
     const Joint& joint = model.joint(j);
-    if (std::isnan(q[j]) || (q[j] >= joint.lower && q[j] <= joint.upper)) continue;  // NaN: the solve refuses it
+    const double qj = q[base + j];
+    if (std::isnan(qj) || (qj >= joint.lower && qj <= joint.upper)) continue;  // NaN: the solve refuses it
     std::fprintf(stderr, "zwang: warning: %s: q[%d] = %g puts joint '%s' outside its limits [%g, %g]\n", file.c_str(),
-                 j, q[j], printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
+                 j, qj, printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
   }
 }
 

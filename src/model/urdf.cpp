@@ -30,6 +30,13 @@
 // leader (Joint::mimic; the leader must be loaded too), or is welded at the
 // position its leader at rest implies (MimicJoints::Lock), or refused
 // (MimicJoints::Refuse): never loaded as an independent joint.
+//
+// The base (chooseBase): a floating or planar joint that is the URDF root
+// link's only joint becomes a Free or Planar base under its child link (the
+// links above it are the world); UrdfOptions::base adds one under the root
+// link instead. Either way the root link's own inertia is body 0's
+// (addRootLinkInertia), and every link of a floating base is judged like a
+// moving one.
 #include "zwang/urdf.hpp"
 
 #include <console_bridge/console.h>
@@ -327,7 +334,8 @@ Transform placementOf(const urdf::Joint& joint) {
 // The link's inertia in its own frame; a link without <inertial> is massless.
 // Its mass is checked here, naming the URDF field; whether the rotational
 // inertia is a body's is the ModelBuilder's check, made only for links that
-// move (anything welded to the base is skipped: the base never moves).
+// move (anything welded to a fixed base is skipped: it never moves; `on_base`
+// is false for every link of a floating base).
 RigidInertia linkInertia(const Reporter& report, const urdf::Link& link, bool on_base) {
   if (!link.inertial) return RigidInertia{};
   const urdf::Inertial& in = *link.inertial;
@@ -401,6 +409,13 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
     case urdf::Joint::REVOLUTE: joint.type = JointType::Revolute; break;
     case urdf::Joint::CONTINUOUS: joint.type = JointType::Continuous; break;
     case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
+    case urdf::Joint::FLOATING:
+    case urdf::Joint::PLANAR:
+      report.fail(who + " (parent '" + uj.parent_link_name + "', child '" + uj.child_link_name + "'): type " +
+                  typeName(uj.type) +
+                  " is not supported here: only a root joint can have more than one degree of freedom (the only "
+                  "joint of the URDF's root link, which becomes the robot's floating base); the other joints must "
+                  "be revolute, continuous, prismatic or fixed");
     default:
       report.fail(who + " (parent '" + uj.parent_link_name + "', child '" + uj.child_link_name + "'): type " +
                   typeName(uj.type) + " is not supported (only revolute, continuous, prismatic and fixed joints are)");
@@ -657,6 +672,7 @@ void addMimicLaws(const Reporter& report, const urdf::ModelInterface& urdf_model
 
 // Links placed into the builder, and the ones on the last body (the tip body).
 struct Placement {
+  bool base_floats = false;  // a free or planar base: the links welded to the base move and are judged
   std::set<std::string> placed;
   std::vector<LinkPtr> tip_body;
   std::vector<std::string> locked_mimic;  // mimic joints welded by MimicJoints::Lock
@@ -708,7 +724,7 @@ void addLockedMimic(const Reporter& report, ModelBuilder& builder, Placement& pl
 void addChain(const Reporter& report, ModelBuilder& builder, Placement& placement, const std::vector<LinkPtr>& chain,
               const std::map<std::string, double>& rotor, const UrdfOptions& options) {
   for (const LinkPtr& link : chain) placement.placed.insert(link->name);
-  bool on_base = true;  // until the first moving joint
+  bool on_base = !placement.base_floats;  // until the first moving joint (a floating base moves: never)
   placement.tip_body = {chain.front()};
   addWelded(report, builder, placement, chain.front(), on_base);
   for (std::size_t k = 1; k < chain.size(); ++k) {
@@ -739,7 +755,7 @@ void addChain(const Reporter& report, ModelBuilder& builder, Placement& placemen
 void addTree(const Reporter& report, ModelBuilder& builder, Placement& placement, const LinkPtr& root,
              const std::map<std::string, double>& rotor, const UrdfOptions& options, std::vector<std::string>& moving) {
   placement.placed.insert(root->name);
-  addWelded(report, builder, placement, root, true, false);
+  addWelded(report, builder, placement, root, !placement.base_floats, false);
   struct Pending {
     urdf::JointConstSharedPtr joint;
     LinkPtr child;
@@ -755,7 +771,7 @@ void addTree(const Reporter& report, ModelBuilder& builder, Placement& placement
     for (auto k = order.rbegin(); k != order.rend(); ++k)
       stack.push_back({link.child_joints[*k], link.child_links[*k], on_base});
   };
-  pushChildren(*root, true);
+  pushChildren(*root, !placement.base_floats);
   while (!stack.empty()) {
     const Pending next = stack.back();
     stack.pop_back();
@@ -781,8 +797,10 @@ void addTree(const Reporter& report, ModelBuilder& builder, Placement& placement
 }
 
 // Whether a link moves with the chain: a moving joint lies between it and the
-// chain's root (a branch off the fixed base never affects the dynamics).
-bool movesWithChain(const LinkPtr& link, const std::string& root, const UrdfOptions& options) {
+// chain's root (a branch off the fixed base never affects the dynamics), or
+// the base floats (a branch off a floating base rides on it).
+bool movesWithChain(const LinkPtr& link, const std::string& root, const UrdfOptions& options, bool base_floats) {
+  if (base_floats) return true;
   for (LinkPtr l = link; l && l->name != root; l = l->getParent())
     if (l->parent_joint && isDegreeOfFreedom(*l->parent_joint, options)) return true;
   return false;
@@ -802,7 +820,7 @@ void warnMassOffChain(Placement& placement, const urdf::ModelInterface& model, c
   for (const std::string& name : placement.placed) {
     if (tip_body.count(name)) continue;  // below the tip body: handleBeyondTip's business
     const LinkPtr link = model.getLink(name);
-    if (!movesWithChain(link, root, options)) continue;
+    if (!movesWithChain(link, root, options, placement.base_floats)) continue;
     for (std::size_t k = 0; k < link->child_joints.size(); ++k)
       if (isMoving(*link->child_joints[k]) && !placement.placed.count(link->child_links[k]->name)) {
         joints.push_back(link->child_joints[k]->name);
@@ -905,6 +923,107 @@ void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& p
        what + (links.size() == 1 ? " is" : " are") + " welded to the tip body as a payload, those joints locked"});
 }
 
+// ---------------------------------------------------------------------------
+// The base: a floating or planar root joint in the file, or UrdfOptions::base
+
+bool isMultiDof(const urdf::Joint& joint) {
+  return joint.type == urdf::Joint::FLOATING || joint.type == urdf::Joint::PLANAR;
+}
+
+BaseType baseTypeOf(const urdf::Joint& joint) {
+  return joint.type == urdf::Joint::FLOATING ? BaseType::Free : BaseType::Planar;
+}
+
+// The URDF's root joint: the only joint of the root link, when it is floating
+// or planar (the "world → base_link" pattern). A floating or planar joint
+// anywhere else is refused when it is loaded (makeJoint).
+urdf::JointConstSharedPtr floatingRootJoint(const urdf::ModelInterface& model) {
+  const LinkPtr root = model.getRoot();
+  if (!root || root->child_joints.size() != 1 || !isMultiDof(*root->child_joints[0])) return nullptr;
+  return root->child_joints[0];
+}
+
+// Where the model starts and how its base is attached. A floating root joint
+// is used when the model starts at the URDF's root link or at the joint's
+// child link; its child becomes body 0, the links above it are the world.
+struct BaseChoice {
+  LinkPtr root;                     // the model's root link (body 0)
+  urdf::JointConstSharedPtr joint;  // the file's floating or planar root joint in use, if any
+  BaseType type = BaseType::Fixed;  // the model's base
+  Transform plane;                  // a planar base's plane, ᴾX_world
+};
+
+// The plane of a planar root joint: the joint frame (its <origin> in the root
+// link), whose z axis must be the joint's <axis>, the plane's normal.
+Transform planeOf(const Reporter& report, const urdf::Joint& uj, const TiXmlElement* robot) {
+  Vec3 axis = vectorOf(uj.axis);
+  const bool unit_z = axis.allFinite() && axis.norm() > 1e-9 && [&] {
+    axis.normalize();
+    return std::abs(axis.x()) <= 1e-9 && std::abs(axis.y()) <= 1e-9 && axis.z() > 0.0;
+  }();
+  if (!unit_z) {
+    bool written = false;  // urdfdom gives a missing <axis> its default, 1 0 0
+    for (const TiXmlElement* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint"))
+      if (nameOf(j) == uj.name) written = j->FirstChildElement("axis") != nullptr;
+    const std::string given = written ? "<axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " + fmt(uj.axis.z) +
+                                            "\" is not the z axis of its joint frame"
+                                      : "has no <axis> (the URDF default is \"1 0 0\")";
+    report.fail("planar root joint '" + uj.name + "': " + given +
+                ": zwang moves a planar base in the x-y plane of the joint frame, so the axis (the plane's normal) "
+                "must be \"0 0 1\"; turn the joint's <origin> rpy to put its z axis along the normal you mean "
+                "(a normal along x: rpy=\"0 1.5707963267948966 0\", along y: rpy=\"-1.5707963267948966 0 0\")");
+  }
+  const Transform plane = placementOf(uj);
+  if (!plane.E.allFinite() || !plane.r.allFinite()) report.fail("joint '" + uj.name + "': <origin> is not finite");
+  return plane;
+}
+
+BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model, const TiXmlElement* robot,
+                      const UrdfOptions& options) {
+  BaseChoice choice;
+  const LinkPtr file_root = model.getRoot();
+  choice.root = options.root.empty() ? file_root : model.getLink(options.root);
+  if (!choice.root)
+    report.fail("root link '" + options.root + "' not found (links: " + nameList(allLinkNames(model)) + ")");
+  const urdf::JointConstSharedPtr joint = floatingRootJoint(model);
+  if (joint && (choice.root == file_root || choice.root->name == joint->child_link_name)) {
+    const std::string who = std::string(typeName(joint->type)) + " root joint '" + joint->name + "' (from '" +
+                            joint->parent_link_name + "' to '" + joint->child_link_name + "')";
+    if (options.base != BaseType::Fixed && !options.base_may_match_file)
+      report.fail("the URDF already has a " + who + ", a " + toString(baseTypeOf(*joint)) + " base; drop " +
+                  options.names.base);
+    if (options.base != BaseType::Fixed && options.base != baseTypeOf(*joint))
+      report.fail("the URDF has a " + who + ", a " + toString(baseTypeOf(*joint)) + " base, not the " +
+                  toString(options.base) + " base that " + options.names.base + " asks for");
+    if (joint->dynamics && (joint->dynamics->friction != 0.0 || joint->dynamics->damping != 0.0))
+      report.fail(who + ": <dynamics> friction " + fmt(joint->dynamics->friction) + ", damping " +
+                  fmt(joint->dynamics->damping) + ": a floating base has no friction in zwang (remove them)");
+    choice.root = model.getLink(joint->child_link_name);
+    choice.joint = joint;
+    choice.type = baseTypeOf(*joint);
+    if (choice.type == BaseType::Planar) choice.plane = planeOf(report, *joint, robot);
+    return choice;
+  }
+  choice.type = options.base;
+  return choice;
+}
+
+// Body 0's own inertia: the root link's <inertial>. A floating base moves it;
+// on a fixed base it is only counted (Model::inertia(0), "base mass"): there
+// an inertia that is not a body's is left out rather than refused, as nothing
+// welded to a fixed base is judged.
+void addRootLinkInertia(const Reporter& report, ModelBuilder& builder, const urdf::Link& root, bool base_floats) {
+  const RigidInertia inertia = linkInertia(report, root, !base_floats);
+  if (!base_floats) {
+    try {
+      (void)validate::rigidInertia("link '" + root.name + "'", inertia);
+    } catch (const ModelError&) {
+      return;
+    }
+  }
+  report.builder([&] { builder.addBaseLinkInertia(inertia); });
+}
+
 // Strict mode: every warning about the data is an error. PayloadAttached and
 // MimicLocked only report what the options asked for, so they do not count.
 void refuseWarnings(const Reporter& report, const Model& model) {
@@ -936,7 +1055,7 @@ void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, c
     if (isDegreeOfFreedom(uj, options)) moving.push_back(uj.name);
     if (isLockedMimic(uj, options)) ++locked;
   }
-  if (moving.empty())
+  if (moving.empty() && !placement.base_floats)  // a floating base alone is a rigid body: fine
     report.fail("the chain from root link '" + root->name + "' to tip link '" + tip_name + "' has no moving joint" +
                 (locked ? " (its mimic joints are locked)" : ""));
   checkRotorNames(report, urdf_model, options, moving, "the chain from '" + root->name + "' to '" + tip_name + "'");
@@ -953,7 +1072,7 @@ void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, co
               Placement& placement) {
   std::vector<std::string> moving;
   addTree(report, builder, placement, root, rotor, options, moving);
-  if (moving.empty())
+  if (moving.empty() && !placement.base_floats)
     report.fail("the tree below root link '" + root->name + "' has no moving joint (its mimic joints are locked)");
   checkRotorNames(report, urdf_model, options, moving, "the tree below '" + root->name + "'");
   addMimicLaws(report, urdf_model, options, moving, "the tree below '" + root->name + "'", builder);
@@ -974,16 +1093,18 @@ Model load(const Reporter& report, const std::string& text, const UrdfOptions& o
   Placement placement;
   const urdf::ModelInterfaceSharedPtr urdf_model = parseWithUrdfdom(report, xml, placement.warnings);
   if (!urdf_model->getRoot()) report.fail("the URDF has no root link");
-  requireMovingJoint(report, *urdf_model);
+  if (options.base == BaseType::Fixed) requireMovingJoint(report, *urdf_model);  // a floating body needs none
   const std::map<std::string, double> rotor = rotorInertias(report, robot, *urdf_model, options);
 
-  const LinkPtr root = options.root.empty() ? urdf_model->getRoot() : urdf_model->getLink(options.root);
-  if (!root)
-    report.fail("root link '" + options.root + "' not found (links: " + nameList(allLinkNames(*urdf_model)) + ")");
+  const BaseChoice base = chooseBase(report, *urdf_model, robot, options);
+  const LinkPtr root = base.root;
   if (!options.tip.empty() && !urdf_model->getLink(options.tip))
     report.fail("tip link '" + options.tip + "' not found (links: " + nameList(allLinkNames(*urdf_model)) + ")");
 
   ModelBuilder builder(urdf_model->getName(), root->name);
+  placement.base_floats = base.type != BaseType::Fixed;
+  if (placement.base_floats) report.builder([&] { builder.setBase(base.type, base.plane); });
+  addRootLinkInertia(report, builder, *root, placement.base_floats);
   if (options.tip.empty() && branchesIntoMovingJoints(root))
     loadTree(report, *urdf_model, root, rotor, options, builder, placement);
   else

@@ -15,15 +15,24 @@ std::string pathArg(py::handle path) {
   return fs.cast<std::string>();
 }
 
+BaseType baseArg(const std::string& base) {
+  if (base == "fixed") return BaseType::Fixed;
+  if (base == "free") return BaseType::Free;
+  if (base == "planar") return BaseType::Planar;
+  raise(PyExc_ValueError, "base: unknown value '" + base + "' (expected 'fixed', 'free' or 'planar')");
+}
+
 UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia, bool strict,
-                        bool attach_beyond_tip, bool lock_mimic) {
+                        bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
   UrdfOptions options;
   options.root = root;
   options.tip = tip;
   options.strict = strict;
   options.attach_beyond_tip = attach_beyond_tip;
   options.mimic = lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
+  options.base = baseArg(base);
   options.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
+  options.names.base = "base='" + base + "'";
   if (!rotor_inertia.is_none()) {
     if (!py::isinstance<py::dict>(rotor_inertia))
       raise(PyExc_TypeError, "rotor_inertia: expected a dict {joint name: inertia}");
@@ -134,6 +143,23 @@ void bindModel(py::module_& m) {
       .def_property_readonly("name", &Model::name)
       .def_property_readonly("dof", &Model::dof, "number of moving joints")
       .def_property_readonly(
+          "base_type", [](const Model& model) { return std::string(toString(model.baseType())); },
+          "'fixed', 'free' (a free-flyer) or 'planar' (x, y, yaw in a plane): how body 0 is attached to the world")
+      .def_property_readonly("nq", &Model::nq,
+                             "length of q: the base's coordinates (7 free, 3 planar, 0 fixed), then one per joint")
+      .def_property_readonly("nv", &Model::nv,
+                             "length of qd, tau, qdd: the base's velocity coordinates (6 free, 3 planar), then one "
+                             "per joint")
+      .def_property_readonly(
+          "base_plane",
+          [](const Model& model) -> py::object {
+            if (model.baseType() != BaseType::Planar) return py::none();
+            const Transform& X = model.basePlacement();
+            return transformMatrix(X.rotationOfTarget(), X.originOfTarget());
+          },
+          "a planar base's plane: 4×4 pose of its frame in the world (x, y span the plane, z is the yaw axis); "
+          "None for the other bases")
+      .def_property_readonly(
           "joint_names",
           [](const Model& model) {
     py::list names;
@@ -165,15 +191,16 @@ void bindModel(py::module_& m) {
           [](const Model& model, const py::object& q, const py::object& qd) {
     Eigen::VectorXd q_buf, qd_buf;
     Eigen::VectorXd q_out = vectorArg("q", q, q_buf), qd_out = vectorArg("qd", qd, qd_buf);
-    if (q_out.size() != model.dof() || qd_out.size() != model.dof())
-      throw py::value_error("follow_leaders: q and qd need " + std::to_string(model.dof()) + " entries each");
+    if (q_out.size() != model.nq() || qd_out.size() != model.nv())
+      throw py::value_error("follow_leaders: q needs nq = " + std::to_string(model.nq()) +
+                            " entries and qd nv = " + std::to_string(model.nv()) + " (a floating base's first)");
     model.followLeaders(q_out, qd_out);
     return py::make_tuple(vectorCopy(q_out), vectorCopy(qd_out));
           },
           py::arg("q"), py::arg("qd"),
-          "copies of q and qd with each mimic joint's entries set from its leader's (q = a*q_leader + b, "
-          "qd = a*qd_leader)")
-      .def_property_readonly("body_count", &Model::bodyCount, "dof + 1: the fixed base (body 0) and one body per joint")
+          "copies of q (nq entries) and qd (nv) with each mimic joint's entries set from its leader's "
+          "(q = a*q_leader + b, qd = a*qd_leader)")
+      .def_property_readonly("body_count", &Model::bodyCount, "dof + 1: the base (body 0) and one body per joint")
       .def_property_readonly("is_chain", &Model::isChain, "True when every body's parent is the body before it")
       .def_property_readonly(
           "parents",
@@ -229,7 +256,8 @@ void bindModel(py::module_& m) {
           "list of (code, message): what was doubtful in the data ('point_mass', 'placeholder_inertia', ...)")
       .def_property_readonly(
           "base_mass", [](const Model& model) { return model.inertia(0).mass; },
-          "mass welded to the fixed base (not in the dynamics) [kg]")
+          "mass of body 0, the root link and the links welded to it [kg]: in the dynamics when the base floats, "
+          "not on a fixed base")
       .def_property_readonly(
           "mass",
           [](const Model& model) {
@@ -263,19 +291,24 @@ void bindModel(py::module_& m) {
           "a copy with these friction parameters, one per joint (kinetic defaults to breakaway, viscous to the\n"
           "model's)")
       .def("__repr__", [](const Model& model) {
-        return "<zwang.Model '" + model.name() + "': " + std::to_string(model.dof()) + " joints (" + jointNames(model) +
-               "), " + std::to_string(model.frames().size()) + " frames>";
+        const std::string base = model.hasFloatingBase() ? std::string(toString(model.baseType())) +
+                                                               " base, nq=" + std::to_string(model.nq()) +
+                                                               ", nv=" + std::to_string(model.nv()) + ", "
+                                                         : std::string();
+        return "<zwang.Model '" + model.name() + "': " + base + std::to_string(model.dof()) + " joints (" +
+               jointNames(model) + "), " + std::to_string(model.frames().size()) + " frames>";
       });
 
   m.def(
       "load_urdf",
       [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
-         bool attach_beyond_tip, bool lock_mimic) {
+         bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
     return issueWarnings(std::make_shared<Model>(
-        loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic))));
+        loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic, base))));
       },
       py::arg("path"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
       py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,
+      py::arg("base") = "fixed",
       "Load the whole tree below link `root` (default: the URDF's root link; joints depth first, each link's\n"
       "children by joint name), or with `tip` the chain from `root` to `tip`.\n"
       "rotor_inertia: optional {joint name: reflected inertia} overriding the URDF.\n"
@@ -284,17 +317,20 @@ void bindModel(py::module_& m) {
       "below the tip to the tip body (joints locked at 0). A <mimic> joint follows its leader (its q, qd\n"
       "must obey the law: Model.follow_leaders; its torque is carried by the leader); lock_mimic=True\n"
       "welds it instead, at its position when its leader is at 0.\n"
+      "base='free' gives the root link a free-flyer, base='planar' x, y, yaw in the world's x-y plane (then q\n"
+      "has model.nq entries, qd and tau model.nv, the base's first); 'fixed' (the default) adds none: a URDF\n"
+      "whose root link's only joint is floating or planar floats without it (base='free' on it is a ModelError).\n"
       "Raises ModelError.");
   m.def(
       "load_urdf_string",
       [](const std::string& xml, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
-         bool attach_beyond_tip, bool lock_mimic) {
+         bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
     return issueWarnings(std::make_shared<Model>(
-        loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic))));
+        loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic, base))));
       },
       py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
       py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,
-      "load_urdf from a string holding the URDF XML.");
+      py::arg("base") = "fixed", "load_urdf from a string holding the URDF XML.");
 }
 
 }  // namespace zwang::python

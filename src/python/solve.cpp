@@ -208,15 +208,18 @@ py::object overrideArray(const Eigen::VectorXd& v) { return v.size() ? py::objec
 // A configuration outside the joint limits is solved as given; say so (a
 // zwang.ModelWarning; Python's filters show each distinct message once). Kept
 // out of the C++ solve, which must not allocate.
+// q[k] names the entry of the full q (a floating base's coordinates first).
 void warnOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q) {
+  const int base = model.baseConfigurationSize();
   for (int j = 0; j < model.dof(); ++j) {
     const Joint& joint = model.joint(j);
-    if (q[j] >= joint.lower && q[j] <= joint.upper) continue;
+    const double qj = q[base + j];
+    if (qj >= joint.lower && qj <= joint.upper) continue;
     char figures[120];
-    std::snprintf(figures, sizeof figures, "%g puts joint '", q[j]);
+    std::snprintf(figures, sizeof figures, "%g puts joint '", qj);
     char limits[80];
     std::snprintf(limits, sizeof limits, "' outside its limits [%g, %g]", joint.lower, joint.upper);
-    const std::string text = "q[" + std::to_string(j) + "] = " + figures + joint.name + limits;
+    const std::string text = "q[" + std::to_string(base + j) + "] = " + figures + joint.name + limits;
     if (PyErr_WarnEx(exceptions().model_warning.ptr(), text.c_str(), 1) != 0) throw py::error_already_set();
   }
 }
@@ -243,7 +246,9 @@ py::array bodyAccelerations(const Result& r, Expressed e) {
 
 std::string resultRepr(const Result& r) {
   const Solution& s = r.solution();
-  std::string text = "<zwang.Result dof=" + std::to_string(s.qdd.size()) + " rows=" + std::to_string(s.balance.rows);
+  std::string text = "<zwang.Result dof=" + std::to_string(r.model->dof()) +
+                     (r.model->hasFloatingBase() ? " nv=" + std::to_string(s.qdd.size()) : std::string()) +
+                     " rows=" + std::to_string(s.balance.rows);
   if (r.with_friction) text += " friction" + std::string(r.friction().indeterminate ? " (indeterminate)" : "");
   if (s.balance.singular) text += " singular";
   if (r.infeasible) text += " infeasible";
@@ -256,12 +261,11 @@ PyWorkspace::PyWorkspace(std::shared_ptr<Model> model_in, int max_constraint_row
   if (!model) raise(PyExc_TypeError, "model: expected a zwang.Model, got None");
   if (max_constraint_rows < 0) raise(PyExc_ValueError, "max_constraint_rows must be >= 0");
   ws = std::make_unique<Workspace>(*model, max_constraint_rows);
-  const int n = model->dof();
-  q_buf.setZero(n);
-  qd_buf.setZero(n);
-  tau_buf.setZero(n);
-  qdd_buf.setZero(n);
-  zeros.setZero(n);
+  q_buf.setZero(model->nq());
+  qd_buf.setZero(model->nv());
+  tau_buf.setZero(model->nv());
+  qdd_buf.setZero(model->nv());
+  zeros.setZero(model->nv());  // qd, tau or qdd left out
 }
 
 void PyWorkspace::ensureCapacity(int rows) {
@@ -495,7 +499,12 @@ void bindSolve(py::module_& m) {
                      "until the next call on that workspace; reading a Result after that raises\n"
                      "StaleResultError, and arrays taken earlier then show the new values. Result.copy() keeps it.")
       .def_property_readonly(
-          "qdd", [](const Result& r) { return vectorView(r.solution().qdd, r.base()); }, "q̈")
+          "qdd", [](const Result& r) { return vectorView(r.solution().qdd, r.base()); },
+          "q̈ (nv entries: a floating base's first, the derivative of its velocity coordinates as given)")
+      .def_property_readonly(
+          "base_acceleration_world",
+          [](const Result& r) { return vectorView(r.solution().base_acceleration_world.data(), 6, r.base()); },
+          "a floating base's classical acceleration [p̈; ω̇] of its origin in world axes (zeros for a fixed base)")
       .def_property_readonly(
           "tau_constraint", [](const Result& r) { return vectorView(r.solution().tau_constraint, r.base()); },
           "τ_c = Σ Jᵀ A ν, the joint torques of the constraint forces")
@@ -644,7 +653,8 @@ void bindSolve(py::module_& m) {
       py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
       py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("balance") = py::none(),
       "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
-      "q, qd, tau: one entry per joint (qd, tau default to zeros); float64 arrays are read in place.\n"
+      "q: model.nq entries, qd, tau: model.nv (one per joint on a fixed base; a floating base's coordinates\n"
+      "first: docs/python.md); qd, tau default to zeros; float64 arrays are read in place.\n"
       "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
       "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
       "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
@@ -732,13 +742,13 @@ void bindSolve(py::module_& m) {
     const int f = frameArg(*model, frame);
     const Expressed e = expressedArg("expressed", expressed, true);
     const auto qv = vectorArg("q", q, pw.q_buf);
-    Eigen::MatrixXd J(6, model->dof());
+    Eigen::MatrixXd J(6, model->nv());
     ++pw.generation;
     if (const Status s = frameJacobian(*model, *pw.ws, qv, f, e, J); !s) raiseStatus(s, "frame_jacobian");
     return matrixCopy(J);
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), py::arg("expressed") = "local",
-      "6×dof J with frame_velocity = J qd");
+      "6×nv J with frame_velocity = J qd (nv = dof on a fixed base)");
   m.def(
       "inverse_dynamics",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle qdd,

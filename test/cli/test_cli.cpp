@@ -319,6 +319,114 @@ TEST_CASE("A relative constraint (\"relative_to\"): the tool and Task::addRelati
   for (std::size_t k = 3; k < 6; ++k) CHECK(left[k] == Approx(right[k]).margin(1e-12));
 }
 
+// ---------------------------------------------------------------------------
+// Floating bases: "base" (docs/cli.md, "Floating base").
+
+namespace {
+
+// The library's answer to a problem file with a floating base: q, qd and tau
+// with the base's coordinates first, as the C++ API takes them.
+struct Floating {
+  zwang::Model model;
+  Eigen::VectorXd q, qd, tau;
+};
+
+Floating floatingProblem(const Json& p, const zwang::Model& model) {
+  Floating f{model, {}, {}, {}};
+  const Json& b = p["base"];
+  const int n = model.dof();
+  const Eigen::VectorXd joints_q = p.contains("q") ? vectorOf(p["q"]) : Eigen::VectorXd::Zero(n);
+  if (model.baseType() == zwang::BaseType::Free) {
+    f.q.resize(7 + n);
+    f.q << vectorOf(b["position"]), vectorOf(b.value("orientation", Json::array({1, 0, 0, 0}))), joints_q;
+    f.qd.resize(6 + n);
+    f.qd << vectorOf(b.value("linear_velocity", Json::array({0, 0, 0}))),
+        vectorOf(b.value("angular_velocity", Json::array({0, 0, 0}))), Eigen::VectorXd::Zero(n);
+  } else {
+    f.q.resize(3 + n);
+    f.q << vectorOf(b["position"]), b.value("yaw", 0.0), joints_q;
+    f.qd.resize(3 + n);
+    f.qd << vectorOf(b.value("velocity", Json::array({0, 0, 0}))), Eigen::VectorXd::Zero(n);
+  }
+  f.tau = Eigen::VectorXd::Zero(model.nv());
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("A free base (solo12, \"base\" type free): it falls at g; the feet held: the tool and the library agree",
+          "[golden]") {
+  const Json fall = solve(problem("solo_fall.json"));
+  CHECK(fall["joints"].size() == 12);
+  CHECK(fall["qdd"].size() == 12);  // per joint: the base's entries are under "base"
+  CHECK(fall["base"]["type"] == "free");
+  const std::vector<double> g{0, 0, -9.81, 0, 0, 0};
+  for (std::size_t k = 0; k < 6; ++k) {
+    CHECK(fall["base"]["acceleration_world"][k].get<double>() == Approx(g[k]).margin(1e-12));
+    CHECK(fall["base"]["acceleration"][k].get<double>() == Approx(g[k]).margin(1e-12));  // level, at rest
+  }
+  for (const Json& x : fall["qdd"]) CHECK(std::abs(x.get<double>()) < 1e-12);
+
+  const Json s = solve(problem("solo_feet.json"));
+  CHECK(s["status"]["rank"] == 12);
+  CHECK(s["status"]["consistent"] == true);
+  for (const char* foot : {"FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"})
+    for (std::size_t k = 0; k < 3; ++k)
+      CHECK(std::abs(s["frames"][foot]["acceleration_world"][k].get<double>()) < 1e-12);
+  const Json p = problemFile("solo_feet.json");
+  zwang::UrdfOptions options;
+  options.base = zwang::BaseType::Free;
+  const Floating f = floatingProblem(p, zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/solo12.urdf", options));
+  zwang::Task task(f.model);
+  for (const Json& c : p["constraints"])
+    task.addConstraint(c["frame"].get<std::string>(), directionsOf(c), zwang::Expressed::World);
+  zwang::Workspace ws(f.model, task);
+  REQUIRE(zwang::solveHybridDynamics(f.model, task, f.q, f.qd, f.tau, ws));
+  sameAs(s["qdd"], ws.solution.qdd.tail(12));  // bit for bit
+  sameAs(s["base"]["acceleration"], ws.solution.qdd.head(6));
+  sameAs(s["base"]["acceleration_world"], ws.solution.base_acceleration_world);
+  sameAs(s["base"]["tau_constraint"], ws.solution.tau_constraint.head(6));
+  sameAs(s["tau_control"], ws.solution.tau_control.tail(12));
+  sameAs(s["nu"], ws.solution.nu);
+}
+
+TEST_CASE("A planar root joint (planar_cart.urdf, \"base\" type planar): the tool and the library agree", "[golden]") {
+  const Json s = solve(problem("planar_cart.json"));
+  CHECK(s["base"]["type"] == "planar");
+  CHECK(s["base"]["acceleration"].size() == 3);
+  CHECK(s["base"]["acceleration_world"].size() == 6);
+  CHECK(s["friction"]["state"][0] == "stick");
+  CHECK(std::abs(s["frames"]["cart"]["acceleration_world"][2].get<double>()) < 1e-12);  // held at its height
+  const Json p = problemFile("planar_cart.json");
+  const zwang::Model model = zwang::loadUrdfFile(problem("planar_cart.urdf"));
+  REQUIRE(model.baseType() == zwang::BaseType::Planar);
+  const Floating f = floatingProblem(p, model);
+  zwang::Task task(model);
+  task.addConstraint("cart", directionsOf(p["constraints"][0]), zwang::Expressed::World);
+  zwang::Workspace ws(model, task);
+  REQUIRE(zwang::solveWithFriction(model, task, f.q, f.qd, f.tau, ws));
+  sameAs(s["qdd"], ws.solution.qdd.tail(1));
+  sameAs(s["base"]["acceleration"], ws.solution.qdd.head(3));
+  sameAs(s["base"]["acceleration_world"], ws.solution.base_acceleration_world);
+  sameAs(s["friction"]["mu"], ws.friction.mu);
+  // The plane is the joint frame: x along the world's x, y up, the normal along −y. The world acceleration
+  // is the plane's [ẍ, ÿ] along those axes, the yaw acceleration about −y.
+  const std::vector<double> plane = numbers(s["base"]["acceleration"]),
+                            world = numbers(s["base"]["acceleration_world"]);
+  CHECK(world[0] == Approx(plane[0]).margin(1e-12));
+  CHECK(world[2] == Approx(plane[1]).margin(1e-12));
+  CHECK(world[4] == Approx(-plane[2]).margin(1e-12));
+  // A base force pushes the cart along the rail (+x): τ_base in the plane's axes.
+  Json pushed = p;
+  pushed["model"] = problem("planar_cart.urdf");
+  pushed["base"]["force"] = Json::array({5, 0, 0});
+  const std::string file = cli_test::scratchDir() + "/planar_cart_pushed.json";
+  cli_test::writeText(file, pushed.dump());
+  const Json s2 = solve(file);
+  CHECK(s2["base"]["tau_control"][0].get<double>() == 5.0);
+  CHECK(s2["base"]["acceleration"][0].get<double>() > s["base"]["acceleration"][0].get<double>());
+}
+
 TEST_CASE("--pretty and -o give the same numbers", "[golden]") {
   const Json compact = solve(problem("panda_hold.json"));
   const Json pretty = solve(problem("panda_hold.json"), {"--pretty"});
@@ -407,6 +515,20 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_reference_absolute.json",
        {": constraints[0].expressed_in: unknown value \"reference\"", "for a constraint with \"relative_to\""}},
       {"err_unknown_root.json", {": model: ", "root link 'shoulders' not found (links: 'chest',", "'world'"}},
+      {"err_base_missing.json",
+       {": base: missing: the URDF's root joint gives the robot a planar base", "\"base\": {\"type\": \"planar\""}},
+      {"err_base_mismatch.json",
+       {": model: ",
+        "planar_cart.urdf: the URDF has a planar root joint 'rail' (from 'world' to 'cart'), a planar base, "
+        "not the free base that base.type asks for"}},
+      {"err_base_type.json", {": base.type: unknown value \"fixed\"", "a fixed base needs no \"base\" section"}},
+      {"err_base_key.json", {": base.yaw: unknown key (allowed here: type, position, orientation,"}},
+      {"err_base_quaternion.json",
+       {": base.orientation: has norm 0.9999904099540154, not 1 within 1e-06",
+        "[0.7071067811865476, 0, 0, 0.7071067811865476]"}},
+      {"err_base_length.json", {": base.velocity: has 6 entries, expected 3"}},
+      {"err_base_q_length.json",
+       {": q: has 4 entries, expected 1 (one per moving joint: hinge); the base's state goes in \"base\""}},
   };
   for (const Case& c : cases) {
     SECTION(c.file) {
@@ -708,6 +830,43 @@ TEST_CASE("info: table and JSON", "[info]") {
     const Json sub = parse(run({"info", tree, "--root", "chest", "--json"}).out);
     CHECK(sub["dof"] == 4);
     CHECK(sub["joints"][2]["parent"].is_null());  // right_shoulder hangs from the base (chest)
+  }
+  SECTION("the base: fixed, --base free, a planar root joint") {
+    const Run fixed = run({"info", arm});
+    CHECK(contains(fixed.out, "\nbase: fixed (nq = nv = 1)\n"));
+    const std::string solo = std::string(ZWANG_MODELS_DIR) + "/solo12.urdf";
+    const Run free = run({"info", solo, "--base", "free"});
+    REQUIRE(free.exit_code == 0);
+    CHECK(contains(free.out,
+                   "base: free, link base_link (q: 7 base coordinates + 12 joints = nq 19; v: 6 + 12 = nv 18)"));
+    CHECK(contains(free.out, "base mass 1.16115 kg (body 0: the root link and the links welded to it; it floats"));
+    const Json j = parse(run({"info", solo, "--base=free", "--json"}).out);
+    CHECK(j["base_type"] == "free");
+    CHECK(j["nq"] == 19);
+    CHECK(j["nv"] == 18);
+    CHECK(j["base_mass"].get<double>() == 1.16115091);  // the root link's own inertial
+    CHECK_FALSE(j.contains("base_plane"));
+    const Json jf = parse(run({"info", solo, "--json"}).out);
+    CHECK(jf["base_type"] == "fixed");
+    CHECK(jf["nq"] == 12);
+    CHECK(jf["base_mass"].get<double>() == 1.16115091);  // counted on a fixed base too
+    const Run planar = run({"info", problem("planar_cart.urdf")});
+    REQUIRE(planar.exit_code == 0);
+    CHECK(contains(planar.out, "base: planar, link cart (q: 3 base coordinates + 1 joint = nq 4; v: 3 + 1 = nv 4)"));
+    CHECK(contains(planar.out, "moving in the plane through (0, 0, 1) with normal (0, -1, 0) (x axis (1, 0, 0))"));
+    const Json jp = parse(run({"info", problem("planar_cart.urdf"), "--json"}).out);
+    CHECK(jp["base_type"] == "planar");
+    CHECK(numbers(jp["base_plane"]["origin"]) == std::vector<double>{0, 0, 1});
+    CHECK(jp["base_plane"]["normal"][1].get<double>() == -1.0);
+    // A base option on a file that floats already; a value that is no base.
+    const Run again = run({"info", problem("planar_cart.urdf"), "--base", "planar"});
+    checkOneLineError(again, 1);
+    CHECK(contains(again.err,
+                   "already has a planar root joint 'rail' (from 'world' to 'cart'), a planar base; drop "
+                   "--base"));
+    const Run bad = run({"info", solo, "--base", "flying"});
+    CHECK(bad.exit_code == 2);
+    CHECK(contains(bad.err, "--base: unknown value 'flying' (expected free, planar or fixed)"));
   }
   SECTION("--root/--tip") {
     const Run r = run({"info", std::string(ZWANG_MODELS_DIR) + "/panda.urdf", "--tip", "panda_link4", "--json"});

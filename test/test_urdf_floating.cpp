@@ -1,0 +1,328 @@
+// Floating bases from URDF (issue #15): UrdfOptions::base on files without a
+// root joint (models/solo12.urdf, models/simple_humanoid.urdf), a floating or
+// planar root joint in the file ("world → base_link"), the root link's own
+// inertia in body 0, and the errors: a floating joint below the root, a base
+// option on a file that floats already, a planar axis that is not the joint
+// frame's z.
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "zwang/zwang.hpp"
+
+using namespace zwang;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const std::string kModels = ZWANG_MODELS_DIR;
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+UrdfOptions withBase(BaseType base) {
+  UrdfOptions o;
+  o.base = base;
+  return o;
+}
+
+// The URDF text with `xml` inserted right after the <robot …> tag.
+std::string insertAfterRobot(const std::string& urdf, const std::string& xml) {
+  const std::size_t at = urdf.find('>', urdf.find("<robot"));
+  REQUIRE(at != std::string::npos);
+  return urdf.substr(0, at + 1) + "\n" + xml + urdf.substr(at + 1);
+}
+
+// A root joint from link "world" to `child`.
+std::string rootJoint(const std::string& type, const std::string& child, const std::string& origin = "",
+                      const std::string& axis = "") {
+  return "<link name=\"world\"/><joint name=\"root_joint\" type=\"" + type +
+         "\"><parent link=\"world\"/><child link=\"" + child + "\"/>" + origin + axis + "</joint>";
+}
+
+double totalMass(const Model& m) {
+  double mass = 0.0;
+  for (int b = 0; b < m.bodyCount(); ++b) mass += m.inertia(b).mass;
+  return mass;
+}
+
+// A random state: configuration from randomConfiguration, velocities and torques uniform in [−1, 1].
+struct State {
+  Eigen::VectorXd q, v, tau;
+};
+State randomState(const Model& m, std::uint64_t seed) {
+  State s;
+  s.q.resize(m.nq());
+  REQUIRE(randomConfiguration(m, seed, s.q));
+  s.v.resize(m.nv());
+  s.tau.resize(m.nv());
+  for (Eigen::Index k = 0; k < m.nv(); ++k) {
+    s.v[k] = 2.0 * static_cast<double>(splitMix64(seed) >> 11) * 0x1.0p-53 - 1.0;
+    s.tau[k] = 2.0 * static_cast<double>(splitMix64(seed) >> 11) * 0x1.0p-53 - 1.0;
+  }
+  return s;
+}
+
+Eigen::VectorXd qdd(const Model& m, const State& s, const Vec3& gravity = Vec3(0, 0, -9.81)) {
+  Task task(m);
+  task.gravity = gravity;
+  Workspace ws(m, task);
+  const Status status = solveHybridDynamics(m, task, s.q, s.v, s.tau, ws);
+  INFO(status.message);
+  REQUIRE(status);
+  return ws.solution.qdd;
+}
+
+}  // namespace
+
+TEST_CASE("solo12 and the humanoid load with each base type", "[urdf][floating]") {
+  const struct {
+    const char* file;
+    int dof;
+    double base_link_mass;  // the root link's own <inertial> (body 0 also carries the links welded to it)
+  } robots[] = {{"solo12.urdf", 12, 1.16115091}, {"simple_humanoid.urdf", 29, 0.0}};
+  for (const auto& robot : robots) {
+    const std::string path = kModels + "/" + robot.file;
+    const Model fixed = loadUrdfFile(path);
+    const Model free = loadUrdfFile(path, withBase(BaseType::Free));
+    const Model planar = loadUrdfFile(path, withBase(BaseType::Planar));
+    INFO(robot.file);
+    CHECK(fixed.baseType() == BaseType::Fixed);
+    CHECK(free.baseType() == BaseType::Free);
+    CHECK(planar.baseType() == BaseType::Planar);
+    for (const Model* m : {&fixed, &free, &planar}) {
+      CHECK(m->dof() == robot.dof);
+      CHECK(m->frames().size() == fixed.frames().size());
+      CHECK(m->inertia(0).mass >= robot.base_link_mass);
+      CHECK(totalMass(*m) == Approx(totalMass(fixed)).epsilon(1e-15));
+    }
+    CHECK(fixed.nq() == robot.dof);
+    CHECK(fixed.nv() == robot.dof);
+    CHECK(free.nq() == robot.dof + 7);
+    CHECK(free.nv() == robot.dof + 6);
+    CHECK(planar.nq() == robot.dof + 3);
+    CHECK(planar.nv() == robot.dof + 3);
+    CHECK(planar.basePlacement().E.isIdentity(0.0));
+    CHECK(planar.basePlacement().r.isZero(0.0));
+    std::printf("%s: %d joints; nq/nv fixed %d/%d, free %d/%d, planar %d/%d; base mass %.9g kg of %.9g kg\n",
+                robot.file, fixed.dof(), fixed.nq(), fixed.nv(), free.nq(), free.nv(), planar.nq(), planar.nv(),
+                free.inertia(0).mass, totalMass(free));
+  }
+  // solo12's base_link has its own inertial, and nothing is welded to it: body 0 is exactly that link.
+  const Model solo = loadUrdfFile(kModels + "/solo12.urdf", withBase(BaseType::Free));
+  CHECK(solo.inertia(0).mass == 1.16115091);
+  CHECK(solo.inertia(0).inertiaAboutCom().diagonal().isApprox(Vec3(0.00578574, 0.01938108, 0.02476124), 1e-14));
+  // The humanoid's base_link is massless; BODY (27 kg) is welded to it.
+  const Model humanoid = loadUrdfFile(kModels + "/simple_humanoid.urdf", withBase(BaseType::Free));
+  CHECK(humanoid.inertia(0).mass == 27.0);
+  CHECK(humanoid.frame(humanoid.frameIndex("BODY")).body == 0);
+}
+
+TEST_CASE("the root link's own inertia is body 0's, fixed base too", "[urdf][floating]") {
+  const std::string solo = readText(kModels + "/solo12.urdf");
+  const Model fixed = loadUrdfString(solo);
+  CHECK(fixed.inertia(0).mass == 1.16115091);  // counted (the "base mass"), not in the dynamics
+  // A chain off the floating base: the other legs ride on the base, so their mass is warned about.
+  UrdfOptions o = withBase(BaseType::Free);
+  o.tip = "FL_FOOT";
+  const Model leg = loadUrdfString(solo, o);
+  CHECK(leg.dof() == 3);
+  bool off_chain = false;
+  for (const ModelWarning& w : leg.warnings()) off_chain = off_chain || w.code == WarningCode::MassOffChain;
+  CHECK(off_chain);
+  o.base = BaseType::Fixed;
+  const Model fixed_leg = loadUrdfString(solo, o);
+  for (const ModelWarning& w : fixed_leg.warnings()) CHECK(w.code != WarningCode::MassOffChain);
+}
+
+TEST_CASE("a floating root joint in the file equals the base option", "[urdf][floating]") {
+  for (const char* file : {"solo12.urdf", "simple_humanoid.urdf"}) {
+    INFO(file);
+    const std::string urdf = readText(kModels + "/" + file);
+    const Model option = loadUrdfString(urdf, withBase(BaseType::Free));
+    // The joint's origin is folded into the base pose: it changes nothing in the model.
+    for (const std::string& origin :
+         {std::string(), std::string(R"(<origin xyz="0.1 -0.2 0.3" rpy="0.4 0.5 0.6"/>)")}) {
+      const Model root = loadUrdfString(insertAfterRobot(urdf, rootJoint("floating", "base_link", origin)));
+      CHECK(root.baseType() == BaseType::Free);
+      CHECK(root.nq() == option.nq());
+      CHECK(root.frames().size() == option.frames().size());  // "world" is the world, not a frame
+      CHECK_FALSE(root.hasFrame("world"));
+      CHECK(root.frame(0).name == "base_link");
+      double worst = 0.0;
+      for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+        const State s = randomState(option, seed);
+        const Eigen::VectorXd a = qdd(option, s), b = qdd(root, s);
+        worst = std::max(worst, (a - b).cwiseAbs().maxCoeff());
+      }
+      std::printf("%s: floating root joint%s vs base option, 20 random states: max |qdd difference| %.3g\n", file,
+                  origin.empty() ? "" : " (with an origin)", worst);
+      CHECK(worst == 0.0);  // the same model, built the same way
+    }
+    // The same for a planar root joint in the world's x-y plane.
+    const Model planar_option = loadUrdfString(urdf, withBase(BaseType::Planar));
+    const Model planar_root =
+        loadUrdfString(insertAfterRobot(urdf, rootJoint("planar", "base_link", "", R"(<axis xyz="0 0 1"/>)")));
+    CHECK(planar_root.baseType() == BaseType::Planar);
+    const State s = randomState(planar_option, 7);
+    CHECK((qdd(planar_option, s) - qdd(planar_root, s)).cwiseAbs().maxCoeff() == 0.0);
+  }
+}
+
+TEST_CASE("the model may start at the floating joint's child link, or below it", "[urdf][floating]") {
+  const std::string urdf = insertAfterRobot(readText(kModels + "/solo12.urdf"), rootJoint("floating", "base_link"));
+  UrdfOptions o;
+  o.root = "world";
+  CHECK(loadUrdfString(urdf, o).baseType() == BaseType::Free);
+  o.root = "base_link";
+  CHECK(loadUrdfString(urdf, o).baseType() == BaseType::Free);
+  o.root = "FL_UPPER_LEG";  // below the joint: a fixed base there, or one asked for
+  CHECK(loadUrdfString(urdf, o).baseType() == BaseType::Fixed);
+  o.base = BaseType::Planar;
+  CHECK(loadUrdfString(urdf, o).baseType() == BaseType::Planar);
+  // A floating root joint to a single rigid body: no joint at all.
+  const std::string box = R"(<robot name="box"><link name="world"/>
+    <joint name="free" type="floating"><parent link="world"/><child link="box"/></joint>
+    <link name="box"><inertial><mass value="2"/><inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="3"/></inertial></link></robot>)";
+  const Model body = loadUrdfString(box);
+  CHECK(body.dof() == 0);
+  CHECK(body.nq() == 7);
+  CHECK(body.nv() == 6);
+  CHECK(body.inertia(0).mass == 2.0);
+  // The same body without the joint, given a base by the option.
+  const std::string bare = R"(<robot name="box"><link name="box"><inertial><mass value="2"/>
+    <inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="3"/></inertial></link></robot>)";
+  CHECK(loadUrdfString(bare, withBase(BaseType::Free)).nv() == 6);
+  REQUIRE_THROWS_WITH(loadUrdfString(bare), Contains("no moving joint"));
+}
+
+TEST_CASE("a planar root joint: the joint frame is the plane", "[urdf][floating]") {
+  // A box with its centre of mass at its origin on a plane tilted by 0.3 rad
+  // about x, 0.5 m up: at rest it slides down the plane at g's component in
+  // the plane, without turning.
+  const double tilt = 0.3;
+  const std::string box = R"(<robot name="sled"><link name="world"/>
+    <joint name="slide" type="planar"><parent link="world"/><child link="sled"/>
+      <origin xyz="0 0 0.5" rpy="0.3 0 0"/><axis xyz="0 0 1"/></joint>
+    <link name="sled"><inertial><mass value="2"/><inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="3"/></inertial></link></robot>)";
+  const Model m = loadUrdfString(box);
+  REQUIRE(m.baseType() == BaseType::Planar);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(tilt, Vec3::UnitX()).toRotationMatrix();  // plane axes in the world
+  CHECK(m.basePlacement().rotationOfTarget().isApprox(R, 1e-15));
+  CHECK(m.basePlacement().originOfTarget().isApprox(Vec3(0, 0, 0.5), 1e-15));
+  const Vec3 g(0, 0, -9.81), n = R.col(2);
+  State s{Eigen::Vector3d(0.2, -0.1, 0.7), Eigen::VectorXd::Zero(3), Eigen::VectorXd::Zero(3)};
+  Task task(m);
+  Workspace ws(m, task);
+  REQUIRE(solveHybridDynamics(m, task, s.q, s.v, s.tau, ws));
+  const Vec3 expected = g - g.dot(n) * n;
+  const double e_world = (ws.solution.base_acceleration_world.head<3>() - expected).norm() +
+                         ws.solution.base_acceleration_world.tail<3>().norm();
+  const double e_plane =
+      (ws.solution.qdd - Eigen::Vector3d((R.transpose() * expected).x(), (R.transpose() * expected).y(), 0.0)).norm();
+  std::printf(
+      "planar root joint (plane tilted 0.3 rad): base acceleration vs g projected on the plane %.2g (world), "
+      "%.2g (plane coordinates)\n",
+      e_world, e_plane);
+  CHECK(e_world < 1e-14);
+  CHECK(e_plane < 1e-14);
+}
+
+TEST_CASE("a free robot at rest under gravity falls at g", "[urdf][floating]") {
+  for (const char* file : {"solo12.urdf", "simple_humanoid.urdf"}) {
+    const Model m = loadUrdfFile(kModels + "/" + file, withBase(BaseType::Free));
+    Task task(m);
+    task.gravity = Vec3(0.3, -1.0, -9.81);
+    Workspace ws(m, task);
+    double worst = 0.0, worst_qdd = 0.0;
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+      State s = randomState(m, seed);
+      s.v.setZero();
+      s.tau.setZero();
+      REQUIRE(solveHybridDynamics(m, task, s.q, s.v, s.tau, ws));
+      worst_qdd = std::max(worst_qdd, ws.solution.qdd.tail(m.dof()).cwiseAbs().maxCoeff());
+      for (int f = 0; f < static_cast<int>(m.frames().size()); ++f) {
+        Vec6 a;
+        REQUIRE(frameAcceleration(m, ws, f, Expressed::World, a));
+        worst = std::max(worst, (a.head<3>() - task.gravity).norm() / task.gravity.norm() + a.tail<3>().norm());
+      }
+    }
+    std::printf("%s, free base at rest, 20 random configurations: every frame falls at g to %.2g, joint |qdd| %.2g\n",
+                file, worst, worst_qdd);
+    CHECK(worst < 1e-11);
+    CHECK(worst_qdd < 1e-11);
+  }
+}
+
+TEST_CASE("errors: floating joints off the root, a base on a floating file, a planar axis", "[urdf][floating]") {
+  const std::string solo = readText(kModels + "/solo12.urdf");
+  // A floating joint below the root.
+  std::string below = solo;
+  const std::string knee = R"(<joint name="FL_KFE" type="revolute">)";
+  REQUIRE(below.find(knee) != std::string::npos);
+  below.replace(below.find(knee), knee.size(), R"(<joint name="FL_KFE" type="floating">)");
+  REQUIRE_THROWS_WITH(loadUrdfString(below), Contains("joint 'FL_KFE'") && Contains("type floating is not supported") &&
+                                                 Contains("only a root joint"));
+  REQUIRE_THROWS_WITH(loadUrdfString(below, withBase(BaseType::Free)), Contains("joint 'FL_KFE'"));
+  // A root link with a floating joint and another joint: not a root joint, refused where it is loaded.
+  const std::string two = insertAfterRobot(
+      solo,
+      rootJoint("floating", "base_link") +
+          R"(<joint name="table_joint" type="fixed"><parent link="world"/><child link="table"/></joint><link name="table"/>)");
+  REQUIRE_THROWS_WITH(loadUrdfString(two), Contains("joint 'root_joint'") && Contains("not supported"));
+  // A base option on a file that floats already.
+  const std::string floating = insertAfterRobot(solo, rootJoint("floating", "base_link"));
+  REQUIRE_THROWS_WITH(loadUrdfString(floating, withBase(BaseType::Free)),
+                      Contains("<string>: the URDF already has a floating root joint 'root_joint' (from 'world' to "
+                               "'base_link'), a free base; drop UrdfOptions::base"));
+  REQUIRE_THROWS_WITH(loadUrdfString(floating, withBase(BaseType::Planar)),
+                      Contains("already has a floating root joint 'root_joint'"));
+  // … unless the caller accepts the file's own base of the same type.
+  UrdfOptions match = withBase(BaseType::Free);
+  match.base_may_match_file = true;
+  CHECK(loadUrdfString(floating, match).baseType() == BaseType::Free);
+  match.base = BaseType::Planar;
+  match.names.base = "\"base\"";
+  REQUIRE_THROWS_WITH(loadUrdfString(floating, match),
+                      Contains("the URDF has a floating root joint 'root_joint' (from 'world' to 'base_link'), a "
+                               "free base, not the planar base that \"base\" asks for"));
+  // Planar axes other than the joint frame's z.
+  for (const char* axis : {"1 0 0", "0 0 -1", "0 1 1"}) {
+    INFO(axis);
+    REQUIRE_THROWS_WITH(loadUrdfString(insertAfterRobot(
+                            solo, rootJoint("planar", "base_link", "", std::string("<axis xyz=\"") + axis + "\"/>"))),
+                        Contains("planar root joint 'root_joint': <axis> xyz") &&
+                            Contains("is not the z axis of its joint frame") && Contains("must be \"0 0 1\"") &&
+                            Contains("rpy="));
+  }
+  REQUIRE_THROWS_WITH(loadUrdfString(insertAfterRobot(solo, rootJoint("planar", "base_link"))),
+                      Contains("planar root joint 'root_joint': has no <axis> (the URDF default is \"1 0 0\")"));
+  // A normal along z written as a scaled vector is fine.
+  CHECK(loadUrdfString(insertAfterRobot(solo, rootJoint("planar", "base_link", "", R"(<axis xyz="0 0 2"/>)")))
+            .baseType() == BaseType::Planar);
+  // Friction on the base joint would be dropped: refused.
+  REQUIRE_THROWS_WITH(
+      loadUrdfString(insertAfterRobot(solo, rootJoint("floating", "base_link", R"(<dynamics damping="0.5"/>)"))),
+      Contains("root joint 'root_joint'") && Contains("a floating base has no friction"));
+}
+
+TEST_CASE("a floating base's links are judged like moving ones", "[urdf][floating]") {
+  // A point mass welded to the base: unjudged on a fixed base, a warning (an error in strict mode) when it floats.
+  const std::string urdf = R"(<robot name="r"><link name="base"><inertial><mass value="1"/>
+      <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+    <joint name="w" type="fixed"><parent link="base"/><child link="bad"/></joint>
+    <link name="bad"><inertial><mass value="-1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+    <joint name="j1" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+    <link name="l1"><inertial><origin xyz="0.5 0 0"/><mass value="1"/>
+      <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link></robot>)";
+  CHECK(loadUrdfString(urdf).dof() == 1);
+  REQUIRE_THROWS_WITH(loadUrdfString(urdf, withBase(BaseType::Free)),
+                      Contains("link 'bad'") && Contains("<mass>") && Contains("negative"));
+}

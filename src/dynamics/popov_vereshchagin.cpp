@@ -90,8 +90,9 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
                          ws.constraintCapacity());
   if (Status s = checkBalanceOptions(task.balance); !s) return s;
   if (Status s = checkConfiguration(model, q); !s) return s;  // size, finite, a free base's unit quaternion
-  if (Status s = checkVector("qd", qd, model.nv()); !s) return s;
-  if (Status s = checkVector("tau", tau, model.nv()); !s) return s;
+  if (!workspaceFitsBase(model, ws)) return workspaceBaseMismatch(model, ws);
+  if (Status s = checkVelocityVector(model, "qd", qd); !s) return s;
+  if (Status s = checkVelocityVector(model, "tau", tau); !s) return s;
   if (task.balanceRows() > ws.balanceCapacity())  // a workspace made for a model with fewer mimic joints
     return Status::error(StatusCode::WorkspaceTooSmall,
                          "task has %d balance rows (%d constraint, %d mimic), the workspace was made for at most %d",
@@ -337,9 +338,15 @@ void balance(const Task& task, Workspace& ws) {
   // or a direction through every joint axis) has 𝓛_rr = Σ (Sᵀa)²/D = 0 up to
   // the rounding of the Sᵀa products, ~ε²·L_scale. Make it exactly zero, so
   // the balance sees the singularity and gives the row ν = 0 (docs/solver.md).
-  constexpr double kRounding = 1e4 * std::numeric_limits<double>::epsilon() * std::numeric_limits<double>::epsilon();
+  // A condensed row (the sum of a relative row's two sides, or of a joint
+  // row's) is a difference of large terms: what nothing can move cancels only
+  // to ~ε·L_scale there (a relative row between two links whose relative
+  // motion no joint gives, on a free base: test_floating_algorithms). Real
+  // rows sit far above 1e3·ε of their terms.
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  const double rounding = condensed ? 1e3 * kEps : 1e4 * kEps * kEps;
   for (int r = 0; r < m; ++r)
-    if (L(r, r) <= kRounding * L_scale[r]) {
+    if (L(r, r) <= rounding * L_scale[r]) {
       for (int col = 0; col <= r; ++col) L(r, col) = 0.0;
       for (int row = r; row < m; ++row) L(row, r) = 0.0;
     }

@@ -20,27 +20,6 @@ using namespace zwang::testing;
 
 namespace {
 
-// The spec's model with its base let float as `base` says.
-Model floatingModel(const ChainSpec& spec, const FloatingBase& base) {
-  ModelBuilder builder(modelFromSpecByBuilder(spec));
-  const LinkSpec& root = spec.links[0];  // the fixed-base builder leaves the root link's own inertia out
-  const Eigen::Matrix3d R = rpyToMatrix(root.inertial_rpy);
-  builder.addBaseLinkInertia(RigidInertia::fromMassComInertia(root.mass, root.com, R * root.inertia * R.transpose()));
-  if (base.kind == BaseKind::Free) builder.setBase(BaseType::Free);
-  if (base.kind == BaseKind::Planar)
-    builder.setBase(BaseType::Planar, Transform::fromPose(base.plane.linear(), base.plane.translation()));
-  return builder.build();
-}
-
-// The same problem as a zwang Task (rows in the same order).
-Task floatingTask(const Model& model, const FloatingInput& input) {
-  DynamicsInput as_fixed;
-  as_fixed.gravity = input.gravity;
-  as_fixed.wrenches = input.wrenches;
-  as_fixed.constraints = input.constraints;
-  return taskFromInput(model, as_fixed);
-}
-
 // Kept draws: the KKT system well conditioned and every row reachable (the
 // smallest singular value of G at least 1e-6, as for the fixed base).
 bool wellPosed(const FloatingResult& dense) {
@@ -65,8 +44,8 @@ TEST_CASE("floating trees: solveHybridDynamics against the dense floating-base r
     const FloatingProblem p = randomFloatingProblem(rng, options);
     const FloatingResult dense = floatingDynamics(p.spec, p.base, p.input);
     if (!wellPosed(dense)) continue;
-    const Model model = floatingModel(p.spec, p.base);
-    const Task task = floatingTask(model, p.input);
+    const Model model = floatingModelFromSpec(p.spec, p.base);
+    const Task task = floatingTaskFromInput(model, p.input);
     Workspace ws(model, task);
     const Status s = solveHybridDynamics(model, task, p.input.q, p.input.v, p.input.tau, ws);
     INFO("draw " << draws << ": " << s.message);
@@ -117,7 +96,7 @@ TEST_CASE("floating trees: physics without a reference model", "[floating]") {
   for (int draw = 0; draw < 100; ++draw) {
     FloatingProblem p = randomFloatingProblem(rng, options);
     p.input.tau.head(6).setZero();
-    const Model model = floatingModel(p.spec, p.base);
+    const Model model = floatingModelFromSpec(p.spec, p.base);
     Task task(model);
     Workspace ws(model, task);
     // No gravity, no wrench, no constraint, no torque: the spatial momentum
@@ -178,7 +157,7 @@ TEST_CASE("floating trees: friction through the same sweeps, checked by the dens
     for (int a = 0; a < k; ++a) p.input.v[nvb + order[static_cast<std::size_t>(a)]] = 0.0;
     const FloatingResult check = floatingDynamics(p.spec, p.base, p.input);
     if (!wellPosed(check)) continue;
-    const Model plain = floatingModel(p.spec, p.base);
+    const Model plain = floatingModelFromSpec(p.spec, p.base);
     FrictionOptions fo;
     fo.breakaway.resize(plain.dof());
     fo.kinetic.resize(plain.dof());
@@ -186,7 +165,7 @@ TEST_CASE("floating trees: friction through the same sweeps, checked by the dens
     for (int j = 0; j < plain.dof(); ++j)
       fo.breakaway[j] = fo.kinetic[j] = 20.0 * std::uniform_real_distribution<>(0, 1)(rng);
     fo.joint_limits = false;
-    const Task task = floatingTask(plain, p.input);
+    const Task task = floatingTaskFromInput(plain, p.input);
     Workspace ws(plain, task);
     const Status s = solveWithFriction(plain, task, p.input.q, p.input.v, p.input.tau, ws, fo);
     INFO("draw " << draws << ": " << s.message);
@@ -247,7 +226,7 @@ TEST_CASE("floating trees: standing on contacts, every joint held by its motor (
     ++draws;
     FloatingProblem p = randomFloatingProblem(rng, options);
     if (p.spec.dof() < 4) continue;
-    const Model model = floatingModel(p.spec, p.base);
+    const Model model = floatingModelFromSpec(p.spec, p.base);
     // Feet: the last link and one other link off the base.
     const std::string foot_a = p.spec.links.back().name;
     const std::string foot_b = p.spec.links[1 + rng() % (p.spec.links.size() - 2)].name;

@@ -27,26 +27,6 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-// The spec's model with its base let float as `base` says (as test_floating).
-Model floatingModel(const ChainSpec& spec, const FloatingBase& base) {
-  ModelBuilder builder(modelFromSpecByBuilder(spec));
-  const LinkSpec& root = spec.links[0];  // the fixed-base builder leaves the root link's own inertia out
-  const Eigen::Matrix3d R = rpyToMatrix(root.inertial_rpy);
-  builder.addBaseLinkInertia(RigidInertia::fromMassComInertia(root.mass, root.com, R * root.inertia * R.transpose()));
-  if (base.kind == BaseKind::Free) builder.setBase(BaseType::Free);
-  if (base.kind == BaseKind::Planar)
-    builder.setBase(BaseType::Planar, Transform::fromPose(base.plane.linear(), base.plane.translation()));
-  return builder.build();
-}
-
-Task floatingTask(const Model& model, const FloatingInput& input) {
-  DynamicsInput as_fixed;
-  as_fixed.gravity = input.gravity;
-  as_fixed.wrenches = input.wrenches;
-  as_fixed.constraints = input.constraints;
-  return taskFromInput(model, as_fixed);
-}
-
 // Frames at random places: massless links welded (fixed joints at random
 // poses) to random links, the base link included. Both the reference and the
 // model see them as links; the dynamics do not change.
@@ -123,8 +103,8 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
   while (trees < 300) {
     const Draw d = draw(rng);
     const FloatingProblem& p = d.p;
-    const Model model = floatingModel(p.spec, p.base);
-    const Task task = floatingTask(model, p.input);
+    const Model model = floatingModelFromSpec(p.spec, p.base);
+    const Task task = floatingTaskFromInput(model, p.input);
     Workspace ws(model, task);
     const int nv = model.nv(), nvb = model.baseVelocitySize();
     ++trees;
@@ -257,7 +237,7 @@ TEST_CASE("floating trees: sizes are named by nq and nv; a workspace of the same
   tree.min_moving_joints = tree.max_moving_joints = 4;
   const ChainSpec spec = randomTree(rng, tree);
   FloatingBase free_base;
-  const Model model = floatingModel(spec, free_base);  // nq = 11, nv = 10
+  const Model model = floatingModelFromSpec(spec, free_base);  // nq = 11, nv = 10
   const Model fixed = modelFromSpecByBuilder(spec);
   const Task task(model);
   Workspace ws(model, task), fixed_ws(fixed);
@@ -321,8 +301,8 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians allocate nothing
     RandomFloatingOptions options;
     options.max_constraint_rows = 0;
     const FloatingInput in = randomFloatingInput(rng, spec, base, options);
-    const Model model = floatingModel(spec, base);
-    const Task task = floatingTask(model, in);
+    const Model model = floatingModelFromSpec(spec, base);
+    const Task task = floatingTaskFromInput(model, in);
     Workspace ws(model, task);
     Eigen::MatrixXd J(6, model.nv());
     const int frame = model.frameIndex(spec.links.back().name);
@@ -362,8 +342,8 @@ TEST_CASE("floating trees: an unreachable relative row is singular on a free bas
   REQUIRE(p.base.kind == BaseKind::Free);
   REQUIRE(p.input.constraints.size() == 1);
   REQUIRE(p.input.constraints[0].relative_to == "link8");
-  const Model model = floatingModel(p.spec, p.base);
-  const Task task = floatingTask(model, p.input);
+  const Model model = floatingModelFromSpec(p.spec, p.base);
+  const Task task = floatingTaskFromInput(model, p.input);
   Workspace ws(model, task);
   REQUIRE(solveHybridDynamics(model, task, p.input.q, p.input.v, p.input.tau, ws));
   FloatingInput free_motion = p.input;  // the row can do nothing: the robot moves as without it

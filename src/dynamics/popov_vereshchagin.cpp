@@ -386,6 +386,20 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
     ws.a[at(i)] = ws.a[at(model.parent(i))] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];  // line 29
 }
 
+namespace {
+// The base joint's step of unitTorqueColumns' inward pass: δu₀ = −S₀ᵀ δF^a₀
+// (no torque at the base) and its share of δU (line 20), per column.
+void baseUnitTorques(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Matrix6X>& dF,
+                     Eigen::Ref<Eigen::MatrixXd> du_base, Eigen::Ref<Eigen::MatrixXd> dU) {
+  const int kb = model.baseVelocitySize();
+  for (Eigen::Index c = 0; c < dF.cols(); ++c) {
+    du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));
+    const VectorXmax6 du_D = ws.D_base.solve(du_base.col(c).head(kb));
+    for (int r = 0; r < m; ++r) dU(r, c) += ws.SA_base.col(r).head(kb).dot(du_D);
+  }
+}
+}  // namespace
+
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
                        Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> du_base,
                        Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
@@ -425,13 +439,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
       dF.col(c) += IAS * du_D;                                          // lines 17–18
     }
   }
-  if (floating) {  // the base joint: every column's δF^a has reached body 0
-    for (Eigen::Index c = 0; c < k; ++c) {
-      du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));  // δu₀ (no torque at the base)
-      const VectorXmax6 du_D = ws.D_base.solve(du_base.col(c).head(kb));
-      for (int r = 0; r < m; ++r) dU(r, c) += ws.SA_base.col(r).head(kb).dot(du_D);  // line 20
-    }
-  }
+  if (floating) baseUnitTorques(model, ws, m, dF, du_base, dU);  // every column's δF^a has reached body 0
   dU.topRows(m) *= -1.0;     // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();

@@ -132,6 +132,25 @@ Task taskFromInput(const Model& model, const DynamicsInput& input) {
   return task;
 }
 
+Model floatingModelFromSpec(const ChainSpec& spec, const FloatingBase& base) {
+  ModelBuilder builder(modelFromSpecByBuilder(spec));
+  const LinkSpec& root = spec.links[0];  // the fixed-base builder leaves the root link's own inertia out
+  const Eigen::Matrix3d R = rpyToMatrix(root.inertial_rpy);
+  builder.addBaseLinkInertia(RigidInertia::fromMassComInertia(root.mass, root.com, R * root.inertia * R.transpose()));
+  if (base.kind == BaseKind::Free) builder.setBase(BaseType::Free);
+  if (base.kind == BaseKind::Planar)
+    builder.setBase(BaseType::Planar, Transform::fromPose(base.plane.linear(), base.plane.translation()));
+  return builder.build();
+}
+
+Task floatingTaskFromInput(const Model& model, const FloatingInput& input) {
+  DynamicsInput as_fixed;
+  as_fixed.gravity = input.gravity;
+  as_fixed.wrenches = input.wrenches;
+  as_fixed.constraints = input.constraints;
+  return taskFromInput(model, as_fixed);
+}
+
 double relativeError(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
   if (x.size() != y.size()) return std::numeric_limits<double>::infinity();
   if (x.size() == 0) return 0.0;

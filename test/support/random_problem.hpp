@@ -5,6 +5,7 @@
 #include <random>
 
 #include "support/dense_reference.hpp"
+#include "support/floating_reference.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::testing {
@@ -33,6 +34,12 @@ Model modelFromSpecByBuilder(const ChainSpec& spec);
 
 // The same problem as a zwang Task (rows in the same order).
 Task taskFromInput(const Model& model, const DynamicsInput& input);
+
+// The spec's model (modelFromSpecByBuilder, with the root link's own inertia
+// in body 0) with its base let float as `base` says, and a floating problem
+// as a zwang Task (rows in the same order).
+Model floatingModelFromSpec(const ChainSpec& spec, const FloatingBase& base);
+Task floatingTaskFromInput(const Model& model, const FloatingInput& input);
 
 // A draw the solver comparisons keep (test_dense, test_kdl): the dense KKT
 // system well conditioned (condition at most 1e6) and every constraint row

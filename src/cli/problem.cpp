@@ -42,11 +42,26 @@ WrenchSpec parseWrench(const JsonReader& in, const Json& value, const std::strin
   return w;
 }
 
-ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const std::string& path) {
-  in.object(value, path, {"frame", "relative_to", "expressed_in", "directions", "acceleration"});
+// {"joint": NAME, "acceleration": [b]}: one row q̈_joint = b (Task::addJointConstraint).
+ConstraintSpec parseJointRow(const JsonReader& in, const Json& value, const std::string& path) {
+  in.object(value, path, {"joint", "acceleration"});
   ConstraintSpec c;
   c.path = path;
-  if (!value.contains("frame")) in.fail(path, "missing key \"frame\" (the link whose acceleration is constrained)");
+  c.joint = in.string(value["joint"], childPath(path, "joint"));
+  if (c.joint.empty()) in.fail(childPath(path, "joint"), "is empty (name the joint whose acceleration is held)");
+  c.acceleration = value.contains("acceleration")
+                       ? in.numbers(value["acceleration"], childPath(path, "acceleration"), 1, "the joint's q̈")
+                       : Eigen::VectorXd::Zero(1);
+  return c;
+}
+
+ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const std::string& path) {
+  if (value.is_object() && value.contains("joint") && !value.contains("frame")) return parseJointRow(in, value, path);
+  in.object(value, path, {"frame", "relative_to", "expressed_in", "directions", "acceleration", "contact"});
+  ConstraintSpec c;
+  c.path = path;
+  if (!value.contains("frame"))
+    in.fail(path, "missing key \"frame\" (the link whose acceleration is constrained) or \"joint\" (a joint row)");
   c.frame = in.string(value["frame"], childPath(path, "frame"));
   if (value.contains("relative_to")) {
     const std::string rpath = childPath(path, "relative_to");
@@ -56,6 +71,14 @@ ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const st
       in.fail(rpath, "is the constrained frame itself (\"" + printable(c.frame, 60) +
                          "\"): a relative constraint needs another frame to refer to");
     c.expressed = Expressed::Reference;  // the default axes of a relative constraint
+  }
+  if (value.contains("contact")) {
+    const std::string cpath = childPath(path, "contact");
+    c.contact = in.boolean(value["contact"], cpath);
+    if (c.contact && !c.relative_to.empty())
+      in.fail(cpath,
+              "is true with \"relative_to\": a relative constraint holds two links of the robot together "
+              "and the motors give its force; a contact is a link against the environment");
   }
   if (value.contains("expressed_in"))
     c.expressed =
@@ -195,6 +218,17 @@ std::string frameList(const Model& model) {
   return list;
 }
 
+// The joint of a joint row, named in the error with the model's joints when unknown.
+int jointRowIndex(const JsonReader& in, const Model& model, const ConstraintSpec& c) {
+  const std::string path = childPath(c.path, "joint");
+  int j = -1;
+  for (int k = 0; k < model.dof(); ++k)
+    if (model.joint(k).name == c.joint) j = k;
+  if (j < 0)
+    in.fail(path, "unknown joint \"" + printable(c.joint, 60) + "\" (the model's joints: " + jointList(model) + ")");
+  return j;
+}
+
 }  // namespace
 
 Problem readProblem(const std::string& file) {
@@ -329,11 +363,16 @@ BoundProblem bindProblem(const Problem& p) {
   };
   try {
     for (const ConstraintSpec& c : p.constraints) {
-      const int f = frameIndex(c.frame, c.path);
-      const int first =
-          c.relative_to.empty()
-              ? task.addConstraint(f, c.A, c.expressed)
-              : task.addRelativeConstraint(f, frameIndex(c.relative_to, c.path, "relative_to"), c.A, c.expressed);
+      int first;
+      if (!c.joint.empty()) {
+        first = task.addJointConstraint(jointRowIndex(in, m, c));
+      } else {
+        const int f = frameIndex(c.frame, c.path);
+        first = c.contact ? task.addContact(f, c.A, c.expressed)
+                : c.relative_to.empty()
+                    ? task.addConstraint(f, c.A, c.expressed)
+                    : task.addRelativeConstraint(f, frameIndex(c.relative_to, c.path, "relative_to"), c.A, c.expressed);
+      }
       task.targets().segment(first, c.acceleration.size()) = c.acceleration;
     }
     for (const WrenchSpec& w : p.wrenches) {

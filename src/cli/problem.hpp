@@ -25,6 +25,8 @@ struct ConstraintSpec {
   Expressed expressed = Expressed::Local;  // default Reference for a relative constraint
   ConstraintMatrix A;                      // 6 × directions
   Eigen::VectorXd acceleration;            // one per direction (default 0)
+  bool contact = false;                    // "contact": the environment gives the force (Task::addContact)
+  std::string joint;                       // "joint": a joint row q̈ = acceleration[0] (frame, A unused)
 };
 
 struct FrictionSpec {

@@ -64,7 +64,9 @@ struct Constraint {
   std::string relative_to;  // the reference frame of a relative constraint (empty: the world)
   Expressed expressed;
   ConstraintMatrix A;
-  Eigen::VectorXd b;  // set points, mutable
+  Eigen::VectorXd b;     // set points, mutable
+  bool contact = false;  // the environment supplies its force (Task::addContact)
+  std::string joint;     // a joint row (Constraint.on_joint, Task::addJointConstraint): frame and A unused
 };
 
 struct Wrench {
@@ -138,5 +140,6 @@ struct Result {
 
 void bindModel(py::module_& m);
 void bindSolve(py::module_& m);
+void bindConfiguration(py::module_& m);  // configuration.cpp
 
 }  // namespace zwang::python

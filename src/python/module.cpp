@@ -98,4 +98,5 @@ PYBIND11_MODULE(zwang, m) {
 
   bindModel(m);
   bindSolve(m);
+  bindConfiguration(m);
 }

@@ -120,6 +120,14 @@ void writeWrenchesAndGravity(Task& task, py::handle gravity) {
   task.gravity = gravity.is_none() ? kDefaultGravity : vec3Arg("gravity", gravity);
 }
 
+// One Constraint's rows into a task being built; its first row (ModelError for an unknown joint).
+int addConstraintRows(Task& task, const Constraint& c) {
+  if (!c.joint.empty()) return task.addJointConstraint(c.joint);
+  if (c.contact) return task.addContact(c.frame, c.A, c.expressed);
+  if (!c.relative_to.empty()) return task.addRelativeConstraint(c.frame, c.relative_to, c.A, c.expressed);
+  return task.addConstraint(c.frame, c.A, c.expressed);
+}
+
 // The workspace's task for these constraints and wrenches: rebuilt (allocating)
 // only when the objects differ from the last call; then only b, the wrench
 // values and gravity are written.
@@ -132,13 +140,11 @@ Task& solveTask(PyWorkspace& pw, py::handle constraints, py::handle wrenches, py
     std::vector<int> first_rows;
     for (std::size_t k = 0; k < g_constraints.size(); ++k) {
       const Constraint& c = *g_constraints[k];
-      checkFrame(*pw.model, "constraints[" + std::to_string(k) + "]", c.frame);
+      if (c.joint.empty()) checkFrame(*pw.model, "constraints[" + std::to_string(k) + "]", c.frame);
       if (!c.relative_to.empty())
         checkFrame(*pw.model, "constraints[" + std::to_string(k) + "].relative_to", c.relative_to);
       try {
-        first_rows.push_back(c.relative_to.empty()
-                                 ? task->addConstraint(c.frame, c.A, c.expressed)
-                                 : task->addRelativeConstraint(c.frame, c.relative_to, c.A, c.expressed));
+        first_rows.push_back(addConstraintRows(*task, c));
       } catch (const ModelError& e) {
         raiseModelError("constraints[" + std::to_string(k) + "]", e);
       }
@@ -322,9 +328,11 @@ void bindSolve(py::module_& m) {
                          "one an observer riding on that frame sees (Task::addRelativeConstraint), and expressed\n"
                          "defaults to 'reference' (that frame's axes). frame, relative_to, A and expressed are\n"
                          "fixed; b may be changed between solves (c.b[:] = ... or c.b = ...) without rebuilding\n"
-                         "the task.")
+                         "the task. contact=True: the environment gives the force (a foot on the ground,\n"
+                         "Task::addContact): nu is the contact force, left out of tau_constraint and tau_control.\n"
+                         "Constraint.on_joint(joint, b): one row qdd_joint = b (Task::addJointConstraint).")
       .def(py::init([](const std::string& frame, py::handle A, py::handle b, py::handle expressed,
-                       py::handle relative_to) {
+                       py::handle relative_to, bool contact) {
              std::string reference;
              if (!relative_to.is_none()) {
                if (!py::isinstance<py::str>(relative_to))
@@ -334,6 +342,11 @@ void bindSolve(py::module_& m) {
                if (reference == frame)
                  raise(exceptions().model_error, "relative_to: is the constrained frame itself ('" + frame +
                                                      "'): a relative constraint needs another frame to refer to");
+               if (contact)
+                 raise(PyExc_ValueError,
+                       "contact=True with relative_to: a relative constraint holds two links of "
+                       "the robot together, the motors give its force; a contact is a link "
+                       "against the environment");
              }
              std::string axes = reference.empty() ? "local" : "reference";
              if (!expressed.is_none()) {
@@ -347,6 +360,8 @@ void bindSolve(py::module_& m) {
                           reference,
                           expressedArg("expressed", axes, true, !reference.empty()),
                           constraintMatrixArg("A", A),
+                          {},
+                          contact,
                           {}};
              c.b.setZero(c.A.cols());
              if (!b.is_none()) {
@@ -360,7 +375,24 @@ void bindSolve(py::module_& m) {
              return c;
            }),
            py::arg("frame"), py::arg("A"), py::arg("b") = py::none(), py::arg("expressed") = py::none(),
-           py::arg("relative_to") = py::none())
+           py::arg("relative_to") = py::none(), py::kw_only(), py::arg("contact") = false)
+      .def_static(
+          "on_joint",
+          [](const std::string& joint, double b) {
+    Constraint c{g_next_serial++, {}, {}, Expressed::Local, ConstraintMatrix::Zero(6, 1), {}, false, joint};
+    c.b = Eigen::VectorXd::Constant(1, b);
+    return c;
+          },
+          py::arg("joint"), py::arg("b") = 0.0,
+          "A joint row: qdd of this joint = b (Task::addJointConstraint); its nu is the motor torque that holds\n"
+          "it, part of tau_control. ModelError at solve for an unknown joint.")
+      .def_property_readonly(
+          "joint", [](const Constraint& c) { return c.joint.empty() ? py::object(py::none()) : py::str(c.joint); },
+          "the joint of a joint row (Constraint.on_joint), else None")
+      .def_property_readonly(
+          "contact", [](const Constraint& c) { return c.contact; },
+          "True when the environment supplies the force (a foot on the ground): it moves the robot like any\n"
+          "constraint, its nu is the contact force, and it is left out of tau_constraint and tau_control")
       .def_property_readonly("frame", [](const Constraint& c) { return c.frame; })
       .def_property_readonly(
           "relative_to",
@@ -368,7 +400,9 @@ void bindSolve(py::module_& m) {
           "the frame a relative constraint refers to (None: the world)")
       .def_property_readonly("expressed", [](const Constraint& c) { return std::string(expressedName(c.expressed)); })
       .def_property_readonly(
-          "A", [](const Constraint& c) { return matrixCopy(c.A); }, "6×m (a copy)")
+          "A",
+          [](const Constraint& c) { return c.joint.empty() ? py::object(matrixCopy(c.A)) : py::object(py::none()); },
+          "6×m (a copy); None for a joint row")
       .def_property_readonly("rows", [](const Constraint& c) { return c.A.cols(); })
       .def_property(
           "b", [](py::object self) { return vectorView(self.cast<Constraint&>().b, self, true); },
@@ -382,7 +416,8 @@ void bindSolve(py::module_& m) {
           },
           "set points, one per column of A (a writable view)")
       .def("__repr__", [](const Constraint& c) {
-        return "<zwang.Constraint on '" + c.frame + "'" +
+        if (!c.joint.empty()) return "<zwang.Constraint on joint '" + c.joint + "', 1 row>";
+        return "<zwang.Constraint on '" + c.frame + "'" + (c.contact ? std::string(" (contact)") : std::string()) +
                (c.relative_to.empty() ? std::string() : " relative to '" + c.relative_to + "'") + ", " +
                std::to_string(c.A.cols()) + " rows, " + expressedName(c.expressed) + ">";
       });

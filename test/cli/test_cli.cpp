@@ -390,6 +390,38 @@ TEST_CASE("A free base (solo12, \"base\" type free): it falls at g; the feet hel
   sameAs(s["nu"], ws.solution.nu);
 }
 
+TEST_CASE(
+    "Solo 12 standing on four contacts, every joint held by a joint row, with friction: the tool and the "
+    "library agree; the base needs no force",
+    "[golden]") {
+  const Json s = solve(problem("solo_stand.json"));
+  CHECK(s["status"]["rank"] == 18);  // 24 rows on nv = 18, dependent and consistent
+  CHECK(s["status"]["consistent"] == true);
+  CHECK(s["nu"].size() == 24);
+  for (const Json& x : s["base"]["tau_control"]) CHECK(std::abs(x.get<double>()) < 1e-9);  // the ground holds it
+  const Json p = problemFile("solo_stand.json");
+  zwang::UrdfOptions options;
+  options.base = zwang::BaseType::Free;
+  const Floating f = floatingProblem(p, zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/solo12.urdf", options));
+  zwang::Task task(f.model);
+  for (const Json& c : p["constraints"]) {
+    if (c.contains("joint"))
+      task.addJointConstraint(c["joint"].get<std::string>());
+    else
+      task.addContact(c["frame"].get<std::string>(), directionsOf(c), zwang::Expressed::World);
+  }
+  zwang::Workspace ws(f.model, task);
+  zwang::FrictionOptions friction;
+  friction.breakaway = vectorOf(p["breakaway"]);
+  REQUIRE(zwang::solveWithFriction(f.model, task, f.q, f.qd, f.tau, ws, friction));
+  sameAs(s["qdd"], ws.solution.qdd.tail(12));  // bit for bit
+  sameAs(s["base"]["acceleration"], ws.solution.qdd.head(6));
+  sameAs(s["tau_control"], ws.solution.tau_control.tail(12));
+  sameAs(s["base"]["tau_control"], ws.solution.tau_control.head(6));
+  sameAs(s["nu"], ws.solution.nu);
+  sameAs(s["friction"]["mu"], ws.friction.mu);
+}
+
 TEST_CASE("A planar root joint (planar_cart.urdf, \"base\" type planar): the tool and the library agree", "[golden]") {
   const Json s = solve(problem("planar_cart.json"));
   CHECK(s["base"]["type"] == "planar");
@@ -529,6 +561,10 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_base_length.json", {": base.velocity: has 6 entries, expected 3"}},
       {"err_base_q_length.json",
        {": q: has 4 entries, expected 1 (one per moving joint: hinge); the base's state goes in \"base\""}},
+      {"err_joint_unknown.json", {": constraints[0].joint: unknown joint \"elbow\" (the model's joints: joint1)"}},
+      {"err_joint_row_key.json", {": constraints[0].directions: unknown key (allowed here: joint, acceleration)"}},
+      {"err_contact_relative.json",
+       {": constraints[0].contact: is true with \"relative_to\"", "a contact is a link against the environment"}},
   };
   for (const Case& c : cases) {
     SECTION(c.file) {

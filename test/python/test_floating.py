@@ -157,3 +157,122 @@ def test_same_doubles_as_the_cli(name):
     assert res.base_acceleration_world.tolist() == out["base"]["acceleration_world"]
     assert res.tau_constraint[:k].tolist() == out["base"]["tau_constraint"]
     assert res.nu.tolist() == out["nu"]
+
+
+# ---- configuration helpers (docs/python.md, "Configuration helpers") ------------------------------------------
+
+
+def quat_about_z(angle):
+    return np.array([np.cos(angle / 2), 0.0, 0.0, np.sin(angle / 2)])
+
+
+def test_integrate_closed_forms():
+    model = zwang.load_urdf(SOLO, base="free")
+    q0 = zwang.neutral_configuration(model)
+    # neutral: the base at the origin, identity quaternion, joints at 0 inside solo12's limits (none are given)
+    np.testing.assert_array_equal(q0, np.r_[0, 0, 0, 1, 0, 0, 0, np.zeros(12)])
+    # a turn about z at 0.7 rad/s for 2 s: the quaternion of 1.4 rad about z, the joints moved by qd·dt
+    v = np.r_[0, 0, 0, 0, 0, 0.7, np.linspace(-1, 1, 12)]
+    q1 = zwang.integrate(model, q0, v, 2.0)
+    np.testing.assert_allclose(q1[3:7], quat_about_z(1.4), atol=1e-15)  # a few roundings of sin, cos
+    np.testing.assert_allclose(q1[7:], 2.0 * v[6:], atol=1e-15)
+    np.testing.assert_allclose(q1[:3], 0.0, atol=1e-15)
+    # a straight line in base axes from a base turned by 0.5 rad about z: p = R v dt
+    start = np.r_[1, 2, 3, quat_about_z(0.5), np.zeros(12)]
+    q2 = zwang.integrate(model, start, np.r_[1.0, 0, 0, np.zeros(15)], 0.25)
+    np.testing.assert_allclose(q2[:3], [1 + 0.25 * np.cos(0.5), 2 + 0.25 * np.sin(0.5), 3], atol=1e-15)
+    # the default dt is 1, and difference undoes integrate
+    rng = np.random.default_rng(3)
+    for seed in range(20):
+        qa, _ = zwang.random_configuration(model, seed)
+        v = rng.normal(size=model.nv)
+        qb = zwang.integrate(model, qa, v)
+        assert abs(np.linalg.norm(qb[3:7]) - 1) < 1e-15  # renormalised: within an ulp or two of unit
+        # the log of a rotation of |ω| < π: unique, so the round trip is exact up to rounding (angles ~3 rad)
+        if np.linalg.norm(v[3:6]) < 3.0:
+            np.testing.assert_allclose(zwang.difference(model, qa, qb), v, atol=1e-12)
+
+
+def test_random_configuration_is_reproducible_and_chains():
+    model = zwang.load_urdf(HUMANOID, base="free")
+    qa, state = zwang.random_configuration(model, 12345)
+    qb, _ = zwang.random_configuration(model, 12345)
+    np.testing.assert_array_equal(qa, qb)
+    qc, _ = zwang.random_configuration(model, state)
+    assert np.abs(qc - qa).max() > 0.1  # the next draw from the advanced state is another configuration
+    assert abs(np.linalg.norm(qa[3:7]) - 1) < 1e-15
+    lower, upper = model.lower, model.upper
+    assert np.all(qa[7:] >= lower) and np.all(qa[7:] <= upper)
+    planar = zwang.load_urdf(SOLO, base="planar")
+    qp, _ = zwang.random_configuration(planar, 1)
+    assert qp.shape == (15,) and np.all(np.abs(qp[:2]) <= 1) and abs(qp[2]) <= np.pi
+
+
+def test_configuration_errors():
+    model = zwang.load_urdf(SOLO, base="free")
+    q = zwang.neutral_configuration(model)
+    with pytest.raises(zwang.SolveError) as e:
+        zwang.check_configuration(model, q[7:])
+    assert e.value.code == "SizeMismatch"
+    bad = q.copy()
+    bad[4] = np.nan
+    with pytest.raises(zwang.SolveError) as e:
+        zwang.integrate(model, bad, np.zeros(18))
+    assert e.value.code == "NonFinite"
+    bad = q.copy()
+    bad[3] = 1.1
+    with pytest.raises(zwang.SolveError, match="norm 1.1") as e:
+        zwang.check_configuration(model, bad)
+    assert e.value.code == "BadConfiguration"
+    np.testing.assert_allclose(zwang.normalize_configuration(model, bad), q, atol=0)  # (1.1, 0, 0, 0) → (1, 0, 0, 0)
+    bad[3] = 0.0
+    with pytest.raises(zwang.SolveError) as e:
+        zwang.normalize_configuration(model, bad)
+    assert e.value.code == "BadConfiguration"
+    with pytest.raises(zwang.SolveError) as e:
+        zwang.difference(model, q, np.zeros(18))
+    assert e.value.code == "SizeMismatch"
+    assert zwang.check_configuration(model, q) is None
+    assert zwang.QUATERNION_NORM_TOLERANCE == 1e-6
+
+
+# ---- contacts and joint rows --------------------------------------------------------------------------------
+
+FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+
+
+def test_standing_on_contacts_with_joint_rows():
+    """Solo 12 on four point contacts, every joint held by a joint row: nothing moves, the motors' torques are
+    the joint torques of RNEA with the contact forces applied (an independent route), the base needs none."""
+    model = zwang.load_urdf(SOLO, base="free")
+    q = solo_q(position=(0.1, -0.2, 0.3), orientation=(np.cos(0.15), 0, 0, np.sin(0.15)))
+    feet = [zwang.Constraint(f, np.eye(6)[:, :3], expressed="world", contact=True) for f in FEET]
+    hold = [zwang.Constraint.on_joint(name) for name in model.joint_names]
+    assert (feet[0].contact, feet[0].joint, hold[0].joint, hold[0].A, hold[0].rows) == (True, None, "FL_HAA", None, 1)
+    assert repr(hold[0]) == "<zwang.Constraint on joint 'FL_HAA', 1 row>"
+    ws = model.workspace(24)
+    res = zwang.solve(model, ws, q, constraints=feet + hold)
+    # 24 rows on nv = 18: dependent but consistent (each fixes q̈ = 0); the balance keeps 18 and meets all
+    assert (res.rank, res.singular, res.consistent) == (18, True, True)
+    np.testing.assert_allclose(res.qdd, 0.0, atol=1e-10)  # 24 rows of size ~10 m/s², solved to ~1e-12
+    ground = res.nu[:12].reshape(4, 3)  # world-axis forces on the feet
+    assert abs(ground[:, 2].sum() - model.mass * 9.81 - model.base_mass * 9.81) < 1e-9  # they carry the weight
+    push = [zwang.Wrench(f, force=ground[k], expressed="world") for k, f in enumerate(FEET)]
+    rnea = zwang.inverse_dynamics(model, model.workspace(), q, wrenches=push)
+    np.testing.assert_allclose(res.tau_control, rnea, atol=1e-9)  # RNEA's base entries are ~0 too
+    np.testing.assert_allclose(res.tau_control[:6], 0.0, atol=1e-9)
+    np.testing.assert_allclose(res.tau_control[6:], res.nu[12:], atol=1e-12)  # the joint rows' ν: motor torques
+    np.testing.assert_allclose(res.tau_constraint, np.r_[np.zeros(6), res.nu[12:]], atol=1e-12)
+    # the same feet as ordinary constraints: their force is then the motors', so τ_control includes it
+    plain_feet = [zwang.Constraint(f, np.eye(6)[:, :3], expressed="world") for f in FEET]
+    mixed = zwang.solve(model, model.workspace(24), q, constraints=plain_feet + hold)
+    np.testing.assert_allclose(mixed.nu, res.nu, atol=1e-9)
+    assert np.abs(mixed.tau_control[:6]).max() > 1.0  # the ground force now counts as the base's "motor"
+
+
+def test_contact_and_joint_row_errors():
+    model = zwang.load_urdf(SOLO, base="free")
+    with pytest.raises(zwang.ModelError, match=r"constraints\[0\].*'nope'"):
+        zwang.solve(model, model.workspace(), solo_q(), constraints=[zwang.Constraint.on_joint("nope")])
+    with pytest.raises(ValueError, match="contact=True with relative_to"):
+        zwang.Constraint("FL_FOOT", np.eye(6), relative_to="FR_FOOT", contact=True)

@@ -5,8 +5,9 @@
 //
 // The "model" key names a file; the harness never lets the fuzzer open one: it
 // binds every problem to models/one_dof_arm.urdf, to models/dual_panda.urdf (a
-// tree) when the model string mentions "dual", or to models/panda.urdf when it
-// mentions "panda".
+// tree) when the model string mentions "dual", to models/panda.urdf when it
+// mentions "panda", or to models/solo12.urdf (floating with a "base" section:
+// contacts, joint rows) when it mentions "solo".
 #include <unistd.h>
 
 #include <cstddef>
@@ -49,8 +50,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   const bool dual = problem.model_path.find("dual") != std::string::npos;
   const bool panda = problem.model_path.find("panda") != std::string::npos;
+  const bool solo = problem.model_path.find("solo") != std::string::npos;
   problem.model_path = std::string(ZWANG_MODELS_DIR) + (dual    ? "/dual_panda.urdf"
                                                         : panda ? "/panda.urdf"
+                                                        : solo  ? "/solo12.urdf"
                                                                 : "/one_dof_arm.urdf");
   BoundProblem bound;
   try {

@@ -22,7 +22,8 @@
 // zwang adds d_j), no damping, stiffness, friction loss or limits, contacts,
 // the constraint solver and passive forces disabled. The root link floats on a
 // <freejoint/> or on slide x, slide y, hinge z at the plane pose. Joints are
-// mapped by name.
+// mapped by name. Every compiled model is checked for these settings
+// (checkMujocoConventions).
 //
 // The conversion (derived in support/mujoco_bridge.hpp, whose helpers do it).
 // Free base, R = ⁰R_base, ω the angular velocity in base axes, T =
@@ -174,6 +175,27 @@ void mujocoLinkMotions(const ChainSpec& spec, const Eigen::Vector3d& gravity, co
   }
 }
 
+// What the file comment says of the MJCF, as MuJoCo compiled it: only the smooth dynamics (no contacts, constraint
+// solver, equality constraints or passive forces), no equality constraint at all (no mimic joints), and on every dof
+// no damping, stiffness or friction loss and the armature zwang has (0 on the base, d_j = the reflected rotor
+// inertia on joint j: both add it to the diagonal of the inertia matrix).
+void checkMujocoConventions(const ChainSpec& spec, const FloatingBase& base, const mjModel* m,
+                            const MujocoCoordinates& map) {
+  const int smooth_only = mjDSBL_CONTACT | mjDSBL_CONSTRAINT | mjDSBL_EQUALITY | mjDSBL_PASSIVE;
+  CHECK((m->opt.disableflags & smooth_only) == smooth_only);
+  CHECK(m->neq == 0);
+  const auto nb = static_cast<std::size_t>(base.nvBase());
+  const std::vector<int> moving = spec.movingJoints();
+  for (std::size_t k = 0; k < map.dof.size(); ++k) {
+    const int dof = map.dof[k];
+    const double armature = k < nb ? 0.0 : spec.joints[static_cast<std::size_t>(moving[k - nb])].reflectedInertia();
+    CHECK(m->dof_armature[dof] == Approx(armature).epsilon(1e-15).margin(0.0));  // the written %.17g, read back
+    CHECK(m->dof_damping[dof] == 0.0);
+    CHECK(m->dof_frictionloss[dof] == 0.0);
+    CHECK(m->jnt_stiffness[m->dof_jntid[dof]] == 0.0);
+  }
+}
+
 // M (MuJoCo's dense mass matrix) in our coordinate order.
 Eigen::MatrixXd mujocoMassMatrix(const mjModel* m, const mjData* d, const std::vector<int>& dof) {
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> full(m->nv, m->nv);
@@ -193,6 +215,7 @@ Answers solveWithMujoco(const FloatingProblem& p, const Eigen::VectorXd& qdd_inv
   const mjModel* m = mj.m();
   mjData* d = mj.d();
   const MujocoCoordinates map = mapCoordinates(p.spec, p.base, m);
+  checkMujocoConventions(p.spec, p.base, m, map);
   const VelocityChange change = velocityChange(p.base, in, m->nv, conversion);
   Answers a;
 

@@ -3,30 +3,16 @@
 // poses and velocities) on random floating trees, and against physics in
 // closed form (momentum, free fall, a single rigid body's Newton–Euler).
 //
-// Conventions and conversions, checked here rather than assumed:
-//  * MuJoCo's world is ours; the root body floats on a <freejoint/> (Free) or on
-//    slide x, slide y, hinge z at the plane pose (Planar; mjcf_writer.hpp);
-//  * joints are mapped by name (mj_name2id), never by position;
-//  * Planar: MuJoCo's qpos, qvel, qacc, qfrc of the three base joints are ours;
-//  * Free: qpos = [p; w x y z] is ours, but MuJoCo's free joint has
-//      qvel = u = [ṗ in WORLD axes; ω in BODY axes],  qacc = u̇ = [p̈ world; ω̇ body],
-//    where ours is v = [Rᵀṗ; ω] (both in base axes, Pinocchio's free-flyer). With
-//    T = blockdiag(R, 1₃, 1 (joints)):  u = T v,  u̇ = T v̇ + Ṫ v, Ṫ v = [R (ω × v_lin); 0], so
-//      v = [Rᵀ u_lin; u_ang],   v̇ = [Rᵀ p̈ − ω × Rᵀ ṗ; ω̇]  (= [Rᵀ u̇_lin − ω × v_lin; u̇_ang]);
-//    generalized forces are dual (same power τᵀv = fᵀu): f_mj = T⁻ᵀ τ = [R τ_lin; τ_ang] (a force at the base
-//    origin in world axes, a moment about the base origin in base axes), τ = Tᵀ f_mj; and the mass
-//    matrices H = Tᵀ M_mj T (same kinetic energy);
-//  * an external wrench [f; n] at a link origin p (world axes) reaches MuJoCo's
-//    forward dynamics as xfrc_applied = [f; n + (p − c) × f] at the body's COM c,
-//    and is taken out of mj_inverse's qfrc_inverse (which does not include
-//    applied forces) with mj_applyFT at p.
+// The conventions and the conversions between our coordinates and MuJoCo's
+// (a free joint's qvel is [ṗ in world axes; ω in body axes]; ours is
+// [Rᵀṗ; ω]) are written once in test/support/mujoco_bridge.hpp, which this
+// test and test_mujoco_floating share; this test checks them rather than
+// assuming them (poses, velocities, the base's classical acceleration straight
+// from qacc, and the mistakes that must be seen).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <memory>
 #include <random>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,6 +25,7 @@
 #include "support/dense_reference.hpp"
 #include "support/floating_reference.hpp"
 #include "support/mjcf_writer.hpp"
+#include "support/mujoco_bridge.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"
 
@@ -51,109 +38,6 @@ double relErr(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
   if (x.rows() != y.rows() || x.cols() != y.cols()) return std::numeric_limits<double>::infinity();
   if (x.size() == 0) return 0.0;
   return (x - y).cwiseAbs().maxCoeff() / std::max(1.0, y.cwiseAbs().maxCoeff());
-}
-
-// An mjModel and its mjData from MJCF text through MuJoCo's virtual file system (as test_mujoco.cpp).
-class Mujoco {
- public:
-  explicit Mujoco(const std::string& xml) {
-    static const char kFile[] = "zwang_floating.xml";
-    const auto vfs = std::make_unique<mjVFS>();
-    mj_defaultVFS(vfs.get());
-    const int size = static_cast<int>(xml.size()) + 1;
-    if (mj_makeEmptyFileVFS(vfs.get(), kFile, size) != 0) throw std::runtime_error("mj_makeEmptyFileVFS failed");
-    const int file = mj_findFileVFS(vfs.get(), kFile);
-    std::memcpy(vfs->filedata[file], xml.c_str(), static_cast<std::size_t>(size));
-    char error[1000] = "";
-    model_ = mj_loadXML(kFile, vfs.get(), error, sizeof error);
-    mj_deleteVFS(vfs.get());
-    if (model_ == nullptr) throw std::runtime_error(std::string("mj_loadXML: ") + error + "\n" + xml);
-    data_ = mj_makeData(model_);
-  }
-  ~Mujoco() {
-    mj_deleteData(data_);
-    mj_deleteModel(model_);
-  }
-  Mujoco(const Mujoco&) = delete;
-  Mujoco& operator=(const Mujoco&) = delete;
-  const mjModel* m() const { return model_; }
-  mjData* d() const { return data_; }
-
- private:
-  mjModel* model_ = nullptr;
-  mjData* data_ = nullptr;
-};
-
-// MuJoCo's qpos address of each of our q entries and dof address of each of our v entries.
-struct Map {
-  std::vector<int> qpos, dof;
-};
-
-int jointId(const mjModel* m, const std::string& name, int type) {
-  const int id = mj_name2id(m, mjOBJ_JOINT, name.c_str());
-  INFO("joint " << name);
-  REQUIRE(id >= 0);
-  REQUIRE(m->jnt_type[id] == type);
-  return id;
-}
-
-Map mapCoordinates(const ChainSpec& spec, const FloatingBase& base, const mjModel* m) {
-  REQUIRE(m->nq == base.nq(spec));
-  REQUIRE(m->nv == base.nv(spec));
-  Map map;
-  if (base.kind == BaseKind::Free) {
-    const int id = jointId(m, kMjcfFreeJoint, mjJNT_FREE);
-    for (int k = 0; k < 7; ++k) map.qpos.push_back(m->jnt_qposadr[id] + k);
-    for (int k = 0; k < 6; ++k) map.dof.push_back(m->jnt_dofadr[id] + k);
-  } else if (base.kind == BaseKind::Planar) {
-    const int types[] = {mjJNT_SLIDE, mjJNT_SLIDE, mjJNT_HINGE};
-    const char* names[] = {kMjcfPlanarX, kMjcfPlanarY, kMjcfPlanarYaw};
-    for (int k = 0; k < 3; ++k) {
-      const int id = jointId(m, names[k], types[k]);
-      map.qpos.push_back(m->jnt_qposadr[id]);
-      map.dof.push_back(m->jnt_dofadr[id]);
-    }
-  }
-  for (const int k : spec.movingJoints()) {
-    const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
-    const int id = jointId(m, joint.name, joint.isPrismatic() ? mjJNT_SLIDE : mjJNT_HINGE);
-    map.qpos.push_back(m->jnt_qposadr[id]);
-    map.dof.push_back(m->jnt_dofadr[id]);
-  }
-  return map;
-}
-
-void scatter(const Eigen::VectorXd& x, const std::vector<int>& address, mjtNum* to) {
-  for (std::size_t i = 0; i < address.size(); ++i) to[address[i]] = x(static_cast<Eigen::Index>(i));
-}
-Eigen::VectorXd gather(const mjtNum* from, const std::vector<int>& address) {
-  Eigen::VectorXd x(static_cast<Eigen::Index>(address.size()));
-  for (std::size_t i = 0; i < address.size(); ++i) x(static_cast<Eigen::Index>(i)) = from[address[i]];
-  return x;
-}
-
-// T with u_mujoco = T v (our order): the identity but for R on a free base's linear velocity.
-Eigen::MatrixXd velocityMap(const FloatingBase& base, const Eigen::VectorXd& q, int nv) {
-  Eigen::MatrixXd T = Eigen::MatrixXd::Identity(nv, nv);
-  if (base.kind == BaseKind::Free) T.topLeftCorner<3, 3>() = basePose(base, q).linear();
-  return T;
-}
-
-// Ṫ v = [R (ω × v_lin); 0] for a free base, 0 otherwise.
-Eigen::VectorXd velocityMapRate(const FloatingBase& base, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
-  Eigen::VectorXd r = Eigen::VectorXd::Zero(v.size());
-  if (base.kind == BaseKind::Free)
-    r.head<3>() = basePose(base, q).linear() * Eigen::Vector3d(v.segment<3>(3)).cross(Eigen::Vector3d(v.head<3>()));
-  return r;
-}
-
-// A wrench input as [f; n] at the link origin in world axes.
-Vector6d worldWrench(const WrenchInput& w, const Eigen::Isometry3d& pose) {
-  const Eigen::Matrix3d R =
-      w.axes == Axes::World ? Eigen::Matrix3d(Eigen::Matrix3d::Identity()) : Eigen::Matrix3d(pose.linear());
-  Vector6d out;
-  out << R * w.wrench.head<3>(), R * w.wrench.tail<3>();
-  return out;
 }
 
 struct Figures {
@@ -187,29 +71,18 @@ Figures compareWithMujoco(const ChainSpec& spec, const FloatingBase& base, const
   const Mujoco mj(toMjcf(mistake.spec ? *mistake.spec : spec, in.gravity, mistake.base ? *mistake.base : base));
   const mjModel* m = mj.m();
   mjData* d = mj.d();
-  const Map map = mapCoordinates(spec, base, m);
-  const Eigen::MatrixXd T = mistake.no_conversion ? Eigen::MatrixXd::Identity(nv, nv) : velocityMap(base, in.q, nv);
-  const Eigen::VectorXd Tdot_v = mistake.no_conversion ? Eigen::VectorXd::Zero(nv) : velocityMapRate(base, in.q, in.v);
+  const MujocoCoordinates map = mapCoordinates(spec, base, m);
+  const Eigen::MatrixXd T =
+      mistake.no_conversion ? Eigen::MatrixXd::Identity(nv, nv) : mujocoVelocityMap(base, in.q, nv);
+  const Eigen::VectorXd Tdot_v =
+      mistake.no_conversion ? Eigen::VectorXd::Zero(nv) : mujocoVelocityMapRate(base, in.q, in.v);
 
   Figures f;
   // Forward: τ as generalized forces f_mj = T⁻ᵀ τ, wrenches as xfrc_applied at each body's COM.
   scatter(in.q, map.qpos, d->qpos);
   scatter(T * in.v, map.dof, d->qvel);
   scatter(T.transpose().lu().solve(in.tau), map.dof, d->qfrc_applied);
-  for (const WrenchInput& w : in.wrenches) {
-    const int link = spec.linkIndex(w.link);
-    const Eigen::Isometry3d& pose = kin.poses[static_cast<std::size_t>(link)];
-    const Vector6d fw = worldWrench(w, pose);
-    const Eigen::Vector3d c = pose * spec.links[static_cast<std::size_t>(link)].com;
-    const Eigen::Vector3d force = fw.head<3>();
-    const Eigen::Vector3d torque = fw.tail<3>() + (pose.translation() - c).cross(force);
-    const int body = mj_name2id(m, mjOBJ_BODY, w.link.c_str());
-    REQUIRE(body >= 1);
-    for (int k = 0; k < 3; ++k) {
-      d->xfrc_applied[6 * body + k] += force(k);
-      d->xfrc_applied[6 * body + 3 + k] += torque(k);
-    }
-  }
+  addWrenchesToXfrc(spec, kin.poses, in.wrenches, m, d);
   mj_forward(m, d);
   const Eigen::VectorXd qacc_mj = gather(d->qacc, map.dof);
   const Eigen::VectorXd qdd_mj = T.lu().solve(qacc_mj - Tdot_v);  // v̇ = T⁻¹ (u̇ − Ṫ v)
@@ -256,16 +129,7 @@ Figures compareWithMujoco(const ChainSpec& spec, const FloatingBase& base, const
   std::fill(d->xfrc_applied, d->xfrc_applied + 6 * m->nbody, 0.0);
   scatter(T * qdd_inverse + Tdot_v, map.dof, d->qacc);
   mj_inverse(m, d);
-  std::vector<mjtNum> qfrc_wrench(static_cast<std::size_t>(m->nv), 0.0);
-  for (const WrenchInput& w : in.wrenches) {
-    const int link = spec.linkIndex(w.link);
-    const Eigen::Isometry3d& pose = kin.poses[static_cast<std::size_t>(link)];
-    const Vector6d fw = worldWrench(w, pose);
-    const mjtNum force[3] = {fw(0), fw(1), fw(2)}, torque[3] = {fw(3), fw(4), fw(5)};
-    const Eigen::Vector3d p = pose.translation();
-    const mjtNum point[3] = {p.x(), p.y(), p.z()};
-    mj_applyFT(m, d, force, torque, point, mj_name2id(m, mjOBJ_BODY, w.link.c_str()), qfrc_wrench.data());
-  }
+  const std::vector<mjtNum> qfrc_wrench = wrenchGeneralizedForces(spec, kin.poses, in.wrenches, m, d);
   const Eigen::VectorXd qfrc = gather(d->qfrc_inverse, map.dof) - gather(qfrc_wrench.data(), map.dof);
   f.inverse = relErr(floatingInverseDynamics(spec, base, in.q, in.v, qdd_inverse, in.gravity, in.wrenches),
                      T.transpose() * qfrc);

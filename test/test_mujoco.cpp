@@ -19,10 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <memory>
 #include <random>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -31,6 +28,7 @@
 #include <catch2/catch.hpp>
 
 #include "support/mjcf_writer.hpp"
+#include "support/mujoco_bridge.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"
 
@@ -38,42 +36,6 @@ using namespace zwang;
 using namespace zwang::testing;
 
 namespace {
-
-// An mjModel and its mjData, compiled from MJCF text handed over in memory
-// through MuJoCo's virtual file system (mj_defaultVFS, mj_makeEmptyFileVFS,
-// mj_findFileVFS, mj_loadXML, mj_deleteVFS: mujoco.h of 2.2.2; the VFS holds
-// the file's bytes in a buffer it allocates and frees itself).
-class Mujoco {
- public:
-  explicit Mujoco(const std::string& xml) {
-    static const char kFile[] = "zwang_tree.xml";
-    const auto vfs = std::make_unique<mjVFS>();  // ~2 MB of fixed-size name table: not on the stack
-    mj_defaultVFS(vfs.get());
-    // One byte more than the text: the buffer ends in '\0' whether or not the parser relies on a terminator.
-    const int size = static_cast<int>(xml.size()) + 1;
-    if (mj_makeEmptyFileVFS(vfs.get(), kFile, size) != 0) throw std::runtime_error("mj_makeEmptyFileVFS failed");
-    const int file = mj_findFileVFS(vfs.get(), kFile);
-    std::memcpy(vfs->filedata[file], xml.c_str(), static_cast<std::size_t>(size));
-    char error[1000] = "";
-    model_ = mj_loadXML(kFile, vfs.get(), error, sizeof error);
-    mj_deleteVFS(vfs.get());
-    if (model_ == nullptr) throw std::runtime_error(std::string("mj_loadXML: ") + error + "\n" + xml);
-    data_ = mj_makeData(model_);
-  }
-  ~Mujoco() {
-    mj_deleteData(data_);
-    mj_deleteModel(model_);
-  }
-  Mujoco(const Mujoco&) = delete;
-  Mujoco& operator=(const Mujoco&) = delete;
-
-  const mjModel* m() const { return model_; }
-  mjData* d() const { return data_; }
-
- private:
-  mjModel* model_ = nullptr;
-  mjData* data_ = nullptr;
-};
 
 // For zwang's joint i: MuJoCo's qpos and dof addresses of the joint of the same name.
 struct JointMap {
@@ -94,16 +56,6 @@ JointMap mapJoints(const Model& model, const mjModel* m) {
     map.dof.push_back(m->jnt_dofadr[id]);
   }
   return map;
-}
-
-// x (zwang's joint order) into MuJoCo's array at the mapped addresses, and back.
-void scatter(const Eigen::VectorXd& x, const std::vector<int>& address, mjtNum* to) {
-  for (std::size_t i = 0; i < address.size(); ++i) to[address[i]] = x(static_cast<Eigen::Index>(i));
-}
-Eigen::VectorXd gather(const mjtNum* from, const std::vector<int>& address) {
-  Eigen::VectorXd x(static_cast<Eigen::Index>(address.size()));
-  for (std::size_t i = 0; i < address.size(); ++i) x(static_cast<Eigen::Index>(i)) = from[address[i]];
-  return x;
 }
 
 // One state on one tree, both ways: forward (q̈ from τ) and inverse (τ from q̈).

@@ -49,7 +49,7 @@ std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity);
 //  - Free: a <freejoint name=kMjcfFreeJoint/> (qpos = [p; quat w x y z] as
 //    ours, but qvel = [ṗ in world axes; ω in body axes] and qacc its rate,
 //    qfrc_* = [force in world axes; moment about the body origin in body
-//    axes]; test_floating_reference.cpp converts), the body at the identity;
+//    axes]; support/mujoco_bridge.hpp converts), the body at the identity;
 //  - Planar: the body at the plane pose (pos, quat), then three joints at the
 //    body origin in this order: slide "1 0 0" (kMjcfPlanarX), slide "0 1 0"
 //    (kMjcfPlanarY), hinge "0 0 1" (kMjcfPlanarYaw), so the pose is

@@ -193,6 +193,8 @@ int commandEnergy(int argc, char** argv) {
   }
   // The dual arm holding a box (energy_dual.cpp): solved and checked here, before anything is written.
   const std::function<bool(bool)> dual_arm = prepareDualArmEnergy(*report);
+  // The humanoid and Solo 12 standing (energy_standing.cpp): likewise.
+  const std::function<bool(bool)> standing = prepareStandingEnergy(*report);
 
   std::printf("zwang energy: %s holding still against gravity (0, 0, -9.81), at rest\n", report->shownUrdf().c_str());
   std::printf("task: tool0 fixed (6 rows, world axes) + panda_link1 angular z (= qdd1) fixed: qdd = 0 exactly\n");
@@ -244,6 +246,7 @@ int commandEnergy(int argc, char** argv) {
   const bool plotted =
       writePlots(*report, "energy.gp", plotScript(model, results), "panda_energy.png, panda_energy_joints.png");
   all_ok = dual_arm(plotted) && all_ok;
+  all_ok = standing(plotted) && all_ok;
   return reportExitCode(*report, all_ok, "the closed form");
 }
 

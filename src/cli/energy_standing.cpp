@@ -179,6 +179,12 @@ struct VariantResult {
   double kkt = 0;       // friction variants: how far μ is from minimising ‖τ_control‖² there (kktViolation)
 };
 
+// Plain, with the split of the ground's force that needs the least motor effort (bestSplit).
+struct BestSplit {
+  double sq = 0;          // ‖τ_control‖²
+  double tangential = 0;  // the largest |horizontal force| / vertical force on a foot
+};
+
 struct PostureResult {
   Eigen::VectorXd q;
   double placement_error = 0, limit_distance = 0;
@@ -188,7 +194,7 @@ struct PostureResult {
   int rank = 0;
   double worst_qdd = 0, worst_rnea = 0, worst_split = 0, worst_bound = 0, split_shift = 0;
   double worst_reference_kkt = 0;  // of the least-effort reference (leastEffort)
-  double best_split_sq = 0;        // plain: the least ‖τ_control‖² over every split of the ground's force
+  BestSplit best_split;            // plain: the least ‖τ_control‖² over every split of the ground's force
   bool ok = false;
 };
 
@@ -361,12 +367,17 @@ DenseBalance denseBalance(const Model& model, Workspace& ws, const StandingRobot
 // The least ‖τ_control‖² over every split of the ground's force, without
 // friction: ν = ν₀ + N z solves the balance for any z (N spans null(Gᵀ), the
 // internal forces), and z is chosen for the least motor torques.
-double bestSplitEffort(const DenseBalance& d) {
+BestSplit bestSplit(const DenseBalance& d, int contact_rows) {
   const Eigen::Index n = d.tau0.size();
   const Eigen::MatrixXd internal = Eigen::FullPivLU<Eigen::MatrixXd>(d.Gt_matrix).kernel();
   const Eigen::MatrixXd on_joints = internal.bottomRows(n);
   const Eigen::VectorXd z = -on_joints.completeOrthogonalDecomposition().solve(d.tau0);
-  return (d.tau0 + on_joints * z).squaredNorm();
+  const Eigen::VectorXd nu = d.Gt.solve(d.gravity) + internal * z;
+  BestSplit best;
+  best.sq = nu.tail(n).squaredNorm();
+  for (Eigen::Index foot = 0; foot + contact_rows <= nu.size() - n; foot += contact_rows)
+    best.tangential = std::max(best.tangential, nu.segment<2>(foot).norm() / nu[foot + 2]);
+  return best;
 }
 
 // The worst violation of the optimality conditions of min ½‖τ₀ + M μ‖² over
@@ -431,7 +442,7 @@ PostureResult runPosture(const Model& model, const StandingRobot& robot, const E
   r.q = postureConfiguration(model, check_ws, robot, posture, r);
   const std::string context = where(robot, posture);
   const DenseBalance dense = denseBalance(model, check_ws, robot, r.q, context);
-  r.best_split_sq = bestSplitEffort(dense);
+  r.best_split = bestSplit(dense, robot.contact_rows);
   const Task task = standingTask(model, robot);
   Workspace ws(model, task);
   const int n = model.dof(), contacts = robot.contact_rows * static_cast<int>(robot.feet.size());
@@ -524,7 +535,7 @@ void csvRobot(std::ostringstream& out, const RobotResult& robot) {
       csvRow(out, key + ",effort", "tau_sq", e.effort.sq);
       csvRow(out, key + ",effort", "tau_abs_sum", e.effort.abs_sum);
       if (energy::kVariants[v].margin >= 0) csvRow(out, key + ",effort", "tau_sq_least", e.least_sq);
-      if (energy::kVariants[v].margin < 0) csvRow(out, key + ",effort", "tau_sq_best_split", r.best_split_sq);
+      if (energy::kVariants[v].margin < 0) csvRow(out, key + ",effort", "tau_sq_best_split", r.best_split.sq);
     }
   }
 }
@@ -647,6 +658,20 @@ void printTorques(const RobotResult& robot) {
   printColumns(rows);
 }
 
+// The joints whose plain holding torque is above the URDF's <limit effort>.
+void printEffortLimits(const RobotResult& robot) {
+  std::string over;
+  for (std::size_t p = 0; p < robot.postures.size(); ++p)
+    for (int j = 0; j < robot.model.dof(); ++j) {
+      const double tau = robot.postures[p].variant[0].tau[j], limit = robot.model.joint(j).effort_limit;
+      if (std::abs(tau) > limit)
+        over += std::string(over.empty() ? "" : ", ") + (*robot.robot->postures)[p].name + " " +
+                robot.model.joint(j).name + " " + fmt(std::abs(tau), "%.3g") + " > " + fmt(limit);
+    }
+  std::printf("above the URDF's effort limit (|tau| plain > <limit effort>) [N·m]: %s\n",
+              over.empty() ? "none" : over.c_str());
+}
+
 void printGround(const RobotResult& robot) {
   const bool flat = robot.robot->contact_rows == 6;
   std::printf("\nthe ground's force on each foot: nu of the contact rows, world axes at the foot origin [N%s]%s\n",
@@ -672,14 +697,17 @@ void printGround(const RobotResult& robot) {
 void printLeastEffort(const RobotResult& robot) {
   std::printf(
       "\nleast effort [N²m²]: plain |tau|^2 with the solver's least-norm split, and with the split of the ground's\n"
-      "force that needs the least motor effort (best split: over the internal forces, no friction); friction-aware\n"
-      "|tau|^2 against the least possible over the same margin box (a dense box QP on tau_control(mu), the\n"
-      "least-norm split moving with mu); kkt = how far the solve's mu is from that QP's optimality conditions [N·m]\n");
-  std::vector<std::vector<std::string>> rows{{"posture", "|tau|^2 plain", "best split", "|tau|^2 m=0.5", "least m=0.5",
-                                              "above", "kkt m=0.5", "|tau|^2 m=1", "least m=1", "above", "kkt m=1"}};
+      "force that needs the least motor effort (best split, over the internal forces, no friction; ft/fn = the\n"
+      "largest horizontal over vertical force it puts on a foot); friction-aware |tau|^2 against the least possible\n"
+      "over the same margin box (a dense box QP on tau_control(mu), the least-norm split moving with mu); kkt = how\n"
+      "far the solve's mu is from that QP's optimality conditions [N·m]\n");
+  std::vector<std::vector<std::string>> rows{{"posture", "|tau|^2 plain", "best split", "its ft/fn", "|tau|^2 m=0.5",
+                                              "least m=0.5", "above", "kkt m=0.5", "|tau|^2 m=1", "least m=1", "above",
+                                              "kkt m=1"}};
   for (std::size_t p = 0; p < robot.postures.size(); ++p) {
     const PostureResult& r = robot.postures[p];
-    std::vector<std::string> row{(*robot.robot->postures)[p].name, fmt(r.variant[0].effort.sq), fmt(r.best_split_sq)};
+    std::vector<std::string> row{(*robot.robot->postures)[p].name, fmt(r.variant[0].effort.sq), fmt(r.best_split.sq),
+                                 fmt(r.best_split.tangential, "%.3f")};
     for (int v = 1; v < energy::kVariantCount; ++v) {
       const VariantResult& e = r.variant[v];
       row.push_back(fmt(e.effort.sq));
@@ -729,6 +757,7 @@ bool printRobot(const RobotResult& robot) {
   std::printf("\n");
   printPostures(robot);
   printTorques(robot);
+  printEffortLimits(robot);
   printGround(robot);
   std::vector<bool> ok;
   for (const PostureResult& p : robot.postures) ok.push_back(p.ok);

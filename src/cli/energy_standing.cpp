@@ -206,6 +206,9 @@ struct RobotResult {
   std::vector<PostureResult> postures;
 };
 
+// Feet with six contact rows carry a moment: they stand flat, level on the ground.
+bool flatFeet(const StandingRobot& robot) { return robot.contact_rows == 6; }
+
 std::string where(const StandingRobot& robot, const Posture& posture) {
   return std::string("energy: ") + robot.label + ", posture " + posture.name + ": ";
 }
@@ -232,7 +235,7 @@ double placeBase(const Model& model, Workspace& ws, const StandingRobot& robot, 
   q.head<7>() << 0, 0, 0, 1, 0, 0, 0;
   std::vector<Eigen::Isometry3d> feet = footPoses(model, ws, robot, q, context);
   const Eigen::Matrix3d R =
-      robot.contact_rows == 6 ? Eigen::Matrix3d(feet[0].linear().transpose()) : Eigen::Matrix3d::Identity();
+      flatFeet(robot) ? Eigen::Matrix3d(feet[0].linear().transpose()) : Eigen::Matrix3d::Identity();
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Eigen::Isometry3d& foot : feet) mean += R * foot.translation() / static_cast<double>(feet.size());
   const Eigen::Quaterniond orientation(R);
@@ -243,8 +246,7 @@ double placeBase(const Model& model, Workspace& ws, const StandingRobot& robot, 
   Eigen::Vector3d midpoint = Eigen::Vector3d::Zero();
   for (const Eigen::Isometry3d& foot : feet) {
     error = std::max(error, std::abs(foot.translation().z()));
-    if (robot.contact_rows == 6)
-      error = std::max(error, (foot.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
+    if (flatFeet(robot)) error = std::max(error, (foot.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
     midpoint += foot.translation() / static_cast<double>(feet.size());
   }
   return std::max(error, midpoint.head<2>().cwiseAbs().maxCoeff());
@@ -624,7 +626,7 @@ void printPostures(const RobotResult& robot) {
   std::printf(
       "\npostures: the base pose (placed so the feet are on z = 0%s, their midpoint at the origin), how far the\n"
       "feet are off it, the centre of mass across gravity [m], the mass from RNEA [kg], the closest joint limit [rad]\n",
-      robot.robot->contact_rows == 6 ? " and level" : "");
+      flatFeet(*robot.robot) ? " and level" : "");
   std::vector<std::vector<std::string>> rows{{"posture", "what", "base z", "base pitch",
                                               robot.robot->waist ? "waist" : "", "feet off", "com x", "com y", "mass",
                                               "closest limit"}};
@@ -673,7 +675,7 @@ void printEffortLimits(const RobotResult& robot) {
 }
 
 void printGround(const RobotResult& robot) {
-  const bool flat = robot.robot->contact_rows == 6;
+  const bool flat = flatFeet(*robot.robot);
   std::printf("\nthe ground's force on each foot: nu of the contact rows, world axes at the foot origin [N%s]%s\n",
               flat ? ", N·m" : "", flat ? "; cop = centre of pressure relative to the foot origin [m]" : "");
   std::vector<std::vector<std::string>> rows{{"posture", "variant", "foot", "fx", "fy", "fz"}};

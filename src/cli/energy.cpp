@@ -1,7 +1,9 @@
 // `zwang energy [--out DIR] [--models DIR] [--no-plots]`: the energy result of
 // docs/evaluation.md. The Franka Panda (models/panda.urdf) at rest in several
 // poses, holding still against gravity; the actuator effort with and without
-// friction awareness.
+// friction awareness. The same command then runs the dual arm holding a box
+// (energy_dual.cpp) and the humanoid and Solo 12 standing
+// (energy_standing.cpp); energy_report.hpp holds what the three share.
 //
 // The task holds everything still: six world-axis rows on tool0 (the tool's
 // classical acceleration is zero) and one row that locks the redundant

@@ -401,8 +401,10 @@ double kktViolation(const DenseBalance& d, const Eigen::VectorXd& mu, const Eige
 
 // The least ‖τ_control(μ)‖² over the margin box, by projected gradient with
 // the step 1/λ_max(MᵀM) (a convex quadratic: every step lowers it), until
-// the optimality conditions hold to 1e-12 N·m or 10⁵ steps. The reference
-// for the friction-aware solve's pick.
+// the optimality conditions hold to 1e-12 N·m (the gradient sums torques of
+// at most a few hundred N·m, rounding at ~1e-13; the result is judged at
+// kCheckTolerance) or 10⁵ steps. The reference for the friction-aware
+// solve's pick.
 Eigen::VectorXd leastEffort(const DenseBalance& d, const Eigen::VectorXd& bound) {
   const Eigen::MatrixXd MtM = d.M.transpose() * d.M;
   const double step = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(MtM).eigenvalues().maxCoeff();
@@ -466,7 +468,8 @@ PostureResult runPosture(const Model& model, const StandingRobot& robot, const E
   }
   // How far the split moved with friction: the joints' τ_control − μ at margin 1 against plain (0 for a fixed split).
   r.split_shift = ((r.variant[2].tau - r.variant[2].mu) - r.variant[0].tau).cwiseAbs().maxCoeff();
-  // The pick's ‖τ_control‖² lies between the least possible and plain's (μ = 0 is in the box).
+  // The pick's ‖τ_control‖² lies between the least possible and plain's (μ = 0 is in the box);
+  // 1e-12 relative: the sweeps and the dense QP round the same optimum differently (~1e-15).
   bool ordered = true;
   for (int v = 1; v < energy::kVariantCount; ++v)
     ordered = ordered && r.variant[v].least_sq <= r.variant[v].effort.sq * (1 + 1e-12) &&

@@ -177,14 +177,15 @@ TEST_CASE("energy: the humanoid and Solo 12 standing regenerate the committed CS
         REQUIRE(ground.size() == contacts);
         // The ground holds the robot up, the joints feel τ_control − μ.
         const Eigen::VectorXd needed = torquesWithGround(model, ws, robot, q, ground);
-        CHECK(needed.head(kb).cwiseAbs().maxCoeff() < 1e-9);  // [N, N·m]: rounding of sums of ~1e3 N
-        CHECK((needed.tail(n) - (tau - mu)).cwiseAbs().maxCoeff() < 1e-9);
+        CHECK(needed.head(kb).cwiseAbs().maxCoeff() < 1e-9);                // [N, N·m]: rounding of sums of ~1e3 N
+        CHECK((needed.tail(n) - (tau - mu)).cwiseAbs().maxCoeff() < 1e-9);  // [N·m], the same sums
         Eigen::VectorXd nu(contacts + n);
         nu << ground, tau;
         CHECK((basis.transpose() * nu).cwiseAbs().maxCoeff() < 1e-9);  // the same rounding
+        // 1e-12 N·m: a μ on its bound is the bound, up to the maximiser's rounding
         for (int j = 0; j < n; ++j) CHECK(std::abs(mu[j]) <= margins[v] * breakaway.values[j] + 1e-12);
         const Series& effort = fresh.at(key + "effort");
-        sq[v] = tau.squaredNorm();
+        sq[v] = tau.squaredNorm();  // the tool sums the same 17-digit numbers: 1e-12 relative is rounding
         CHECK(effort.values[0] == Approx(std::sqrt(sq[v])).epsilon(1e-12));
         CHECK(effort.values[1] == Approx(sq[v]).epsilon(1e-12));
         CHECK(effort.values[2] == Approx(tau.cwiseAbs().sum()).epsilon(1e-12));

@@ -131,5 +131,11 @@ int commandEnergy(int argc, char** argv);
 // report.out (running gnuplot on it when its argument is true), and returns
 // false when a check failed.
 std::function<bool(bool)> prepareDualArmEnergy(const ReportCommand& report);
+// The third part (energy_standing.cpp): simple_humanoid.urdf and solo12.urdf
+// on a free base standing still on the ground. The same contract: solves and
+// checks first (CliError when something cannot be solved), writing nothing;
+// the function it returns prints and writes standing_energy.csv and
+// standing_energy.gp (with gnuplot: its PNGs) and returns false when a check failed.
+std::function<bool(bool)> prepareStandingEnergy(const ReportCommand& report);
 
 }  // namespace zwang::cli

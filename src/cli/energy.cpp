@@ -1,7 +1,9 @@
 // `zwang energy [--out DIR] [--models DIR] [--no-plots]`: the energy result of
 // docs/evaluation.md. The Franka Panda (models/panda.urdf) at rest in several
 // poses, holding still against gravity; the actuator effort with and without
-// friction awareness.
+// friction awareness. The same command then runs the dual arm holding a box
+// (energy_dual.cpp) and the humanoid and Solo 12 standing
+// (energy_standing.cpp); energy_report.hpp holds what the three share.
 //
 // The task holds everything still: six world-axis rows on tool0 (the tool's
 // classical acceleration is zero) and one row that locks the redundant
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "energy_report.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli {
@@ -46,35 +49,21 @@ const Pose kPoses[] = {
     {"folded", "folded in close to the base", {0.0, -1.3, 0.0, -2.9, 0.0, 1.7, 0.785}},
 };
 
-// The variants compared, in table order. margin < 0: the plain solver.
-struct Variant {
-  const char* name;
-  double margin;
-};
-const Variant kVariants[] = {{"plain", -1.0}, {"friction_margin_0.5", 0.5}, {"friction_margin_1", 1.0}};
-constexpr int kVariantCount = 3;
-
-struct Effort {
+struct VariantResult {
   Eigen::VectorXd tau, mu;
   std::vector<std::string> state;
   bool indeterminate = false;
-  double norm = 0, sq = 0, abs_sum = 0;
+  energy::Effort effort;
 };
 
 struct PoseResult {
   Eigen::VectorXd q, gravity;  // G(q) from RNEA
   Eigen::Vector3d tool;        // tool0's position [m], world
-  Effort variant[kVariantCount];
+  VariantResult variant[energy::kVariantCount];
   int rank = 0;
   double worst_qdd = 0, worst_check = 0;
   bool ok = false;
 };
-
-std::string fmt(double x, const char* format = "%.4g") {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, format, std::abs(x) < 1e-12 ? 0.0 : x);
-  return buffer;
-}
 
 PoseResult run(const Model& model, const Pose& pose) {
   const int n = model.dof();
@@ -100,25 +89,16 @@ PoseResult run(const Model& model, const Pose& pose) {
   if (!s) throw CliError(kExitError, where + s.message);
   r.tool = tool.translation();
 
-  for (int v = 0; v < kVariantCount; ++v) {
-    const Variant& variant = kVariants[v];
-    Status status;
-    if (variant.margin < 0) {
-      status = solveHybridDynamics(model, task, r.q, zero, zero, ws);
-    } else {
-      FrictionOptions options;
-      options.margin = variant.margin;
-      status = solveWithFriction(model, task, r.q, zero, zero, ws, options);
-    }
-    if (!status) throw CliError(kExitError, where + variant.name + ": " + status.message);
-    Effort& e = r.variant[v];
+  for (int v = 0; v < energy::kVariantCount; ++v) {
+    const energy::Variant& variant = energy::kVariants[v];
+    if (const Status status = energy::solveAtRest(model, task, r.q, ws, variant); !status)
+      throw CliError(kExitError, where + variant.name + ": " + status.message);
+    VariantResult& e = r.variant[v];
     e.tau = ws.solution.tau_control;
     e.mu = variant.margin < 0 ? zero : Eigen::VectorXd(ws.friction.mu);
     for (int j = 0; j < n; ++j) e.state.push_back(variant.margin < 0 ? "-" : toString(ws.friction.state[j]));
     e.indeterminate = variant.margin >= 0 && ws.friction.indeterminate;
-    e.sq = e.tau.squaredNorm();
-    e.norm = std::sqrt(e.sq);
-    e.abs_sum = e.tau.cwiseAbs().sum();
+    e.effort = energy::effortOf(e.tau);
     r.rank = ws.solution.balance.rank;
     r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
     if (ws.solution.balance.singular) throw CliError(kExitError, where + "the hold-still task is singular here");
@@ -139,23 +119,16 @@ std::string csvText(const std::vector<PoseResult>& results) {
   for (const char* column : {"q", "tau", "mu"})
     for (int j = 1; j <= kJoints; ++j) out << "," << column << j;
   out << ",tau_norm,tau_sq,tau_abs_sum\n";
-  char cell[40];
-  auto number = [&](double x) {
-    std::snprintf(cell, sizeof cell, ",%.17g", x);
-    out << cell;
-  };
   for (std::size_t p = 0; p < results.size(); ++p) {
     const PoseResult& r = results[p];
-    for (int v = 0; v < kVariantCount; ++v) {
-      const Effort& e = r.variant[v];
-      out << kPoses[p].name << "," << kVariants[v].name;
-      for (int j = 0; j < kJoints; ++j) number(r.q[j]);
-      for (int j = 0; j < kJoints; ++j) number(e.tau[j]);
-      for (int j = 0; j < kJoints; ++j) number(e.mu[j]);
-      number(e.norm);
-      number(e.sq);
-      number(e.abs_sum);
-      out << "\n";
+    for (int v = 0; v < energy::kVariantCount; ++v) {
+      const VariantResult& e = r.variant[v];
+      out << kPoses[p].name << "," << energy::kVariants[v].name;
+      for (int j = 0; j < kJoints; ++j) out << energy::csvCell(r.q[j]);
+      for (int j = 0; j < kJoints; ++j) out << energy::csvCell(e.tau[j]);
+      for (int j = 0; j < kJoints; ++j) out << energy::csvCell(e.mu[j]);
+      out << energy::csvCell(e.effort.norm) << energy::csvCell(e.effort.sq) << energy::csvCell(e.effort.abs_sum)
+          << "\n";
     }
   }
   return out.str();
@@ -165,72 +138,41 @@ std::string csvText(const std::vector<PoseResult>& results) {
 // and pose with the breakaway torques. The data are inline (17 digits), the
 // same numbers as the CSV.
 std::string plotScript(const Model& model, const std::vector<PoseResult>& results) {
+  std::vector<std::string> names, labels;
+  std::vector<energy::VariantEfforts> efforts;
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    names.push_back(kPoses[p].name);
+    efforts.push_back({results[p].variant[0].effort, results[p].variant[1].effort, results[p].variant[2].effort});
+  }
+  Eigen::VectorXd breakaway(kJoints);
+  for (int j = 0; j < kJoints; ++j) {
+    labels.push_back(std::to_string(j + 1));
+    breakaway[j] = model.joint(j).breakaway_friction;
+  }
   std::ostringstream s;
-  char cell[40];
-  auto number = [&](double x) {
-    std::snprintf(cell, sizeof cell, " %.17g", std::abs(x) < 1e-12 ? 0.0 : x);
-    return std::string(cell);
-  };
   s << "# Generated by `zwang energy`; run it in this directory: gnuplot energy.gp\n"
        "set encoding utf8\n"
        "set datafile separator whitespace\n"
-       "# columns: pose, |tau_control| plain, margin 0.5, margin 1 [N·m]\n"
-       "$norms << EOD\n";
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    s << kPoses[p].name;
-    for (int v = 0; v < kVariantCount; ++v) s << number(results[p].variant[v].norm);
-    s << "\n";
-  }
-  s << "EOD\n";
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    s << "# columns: joint, |tau_control,j| plain, margin 0.5, margin 1, breakaway f_j [N·m]\n"
-      << "$joints_" << kPoses[p].name << " << EOD\n";
-    for (int j = 0; j < kJoints; ++j) {
-      s << j + 1;
-      for (int v = 0; v < kVariantCount; ++v) s << number(std::abs(results[p].variant[v].tau[j]));
-      s << number(model.joint(j).breakaway_friction) << "\n";
-    }
-    s << "EOD\n";
-  }
-  s << "set style data histograms\n"
-       "set style histogram clustered gap 1\n"
-       "set style fill solid 0.85 border -1\n"
-       "set boxwidth 0.9\n"
-       "set grid ytics\n"
-       "set key outside bottom center horizontal box maxrows 1 width -2\n"
-       "set yrange [0:*]\n"
-       "set xrange [-0.6:"
-    << results.size() - 0.4
-    << "]\n"
-       "\n"
+    << energy::normsData("$norms", "pose", names, efforts);
+  for (std::size_t p = 0; p < results.size(); ++p)
+    s << energy::jointsData(std::string("$joints_") + kPoses[p].name, labels,
+                            {results[p].variant[0].tau, results[p].variant[1].tau, results[p].variant[2].tau},
+                            breakaway);
+  s << energy::histogramStyle(results.size())
+    << "\n"
        "set terminal pngcairo size 900,520 font \"DejaVu Sans,11\"\n"
        "set output \"panda_energy.png\"\n"
        "set title \"Panda holding still against gravity: motor effort ‖τ_{control}‖\"\n"
        "set ylabel \"‖τ_{control}‖ [N·m]\"\n"
        "set xtics noenhanced\n"
-       "plot $norms using 2:xtic(1) title \"plain (friction-unaware)\" linecolor rgb \"#a0a0a0\", \\\n"
-       "  '' using 3 title \"friction-aware, margin 0.5\" linecolor rgb \"#70a0e0\", \\\n"
-       "  '' using 4 title \"friction-aware, margin 1\" linecolor rgb \"#0050b0\"\n"
-       "\n"
+    << energy::normsPlot("$norms")
+    << "\n"
        "set terminal pngcairo size 1200,760 font \"DejaVu Sans,10\"\n"
        "set output \"panda_energy_joints.png\"\n"
        "set multiplot layout 2,3 title \"Panda holding still: |τ_{control,j}| per joint (bars) and breakaway friction f_j (red)\"\n"
-       "set key inside top right vertical maxrows auto width 0 box opaque font \",8\"\n"
-       "set offsets 0, 0, graph 0.05, 0\n"
-       "set xrange [-0.6:"
-    << kJoints - 0.4
-    << "]\n"
-       "set xlabel \"joint\"\n"
-       "set ylabel \"|τ| [N·m]\"\n"
-       "set yrange [0:*]\n";
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    const std::string data = std::string("$joints_") + kPoses[p].name;
-    s << "set title \"" << kPoses[p].name << "\" noenhanced\n"
-      << (p == 0 ? "" : "unset key\n") << "plot " << data
-      << " using 2:xtic(1) title \"plain\" linecolor rgb \"#a0a0a0\", \\\n  '' using 3 title \"margin 0.5\" "
-         "linecolor rgb \"#70a0e0\", \\\n  '' using 4 title \"margin 1\" linecolor rgb \"#0050b0\", \\\n  '' using "
-         "($0):5 with points pointtype 5 pointsize 1.1 linecolor rgb \"#c00000\" title \"f_j\"\n";
-  }
+    << energy::jointsPanelStyle(kJoints);
+  for (std::size_t p = 0; p < results.size(); ++p)
+    s << energy::jointsPanel(std::string("$joints_") + kPoses[p].name, kPoses[p].name, p == 0);
   s << "unset multiplot\nunset output\n";
   return s.str();
 }
@@ -253,11 +195,13 @@ int commandEnergy(int argc, char** argv) {
   }
   // The dual arm holding a box (energy_dual.cpp): solved and checked here, before anything is written.
   const std::function<bool(bool)> dual_arm = prepareDualArmEnergy(*report);
+  // The humanoid and Solo 12 standing (energy_standing.cpp): likewise.
+  const std::function<bool(bool)> standing = prepareStandingEnergy(*report);
 
   std::printf("zwang energy: %s holding still against gravity (0, 0, -9.81), at rest\n", report->shownUrdf().c_str());
   std::printf("task: tool0 fixed (6 rows, world axes) + panda_link1 angular z (= qdd1) fixed: qdd = 0 exactly\n");
   std::printf("breakaway friction f [N·m] (URDF <dynamics friction>):");
-  for (int j = 0; j < kJoints; ++j) std::printf(" %s", fmt(model.joint(j).breakaway_friction).c_str());
+  for (int j = 0; j < kJoints; ++j) std::printf(" %s", energy::fmt(model.joint(j).breakaway_friction).c_str());
   std::printf(
       "\nplain: solveHybridDynamics (tau_control = gravity torques G(q)); friction-aware: solveWithFriction,\n"
       "all joints stick, mu* indeterminate, the maximiser with the least |tau_control|^2 using at most\n"
@@ -268,9 +212,9 @@ int commandEnergy(int argc, char** argv) {
       {"pose", "what", "q1", "q2", "q3", "q4", "q5", "q6", "q7", "tool x", "y", "z"}};
   for (std::size_t p = 0; p < results.size(); ++p) {
     std::vector<std::string> row{kPoses[p].name, kPoses[p].what};
-    for (const double x : kPoses[p].q) row.push_back(fmt(x));
+    for (const double x : kPoses[p].q) row.push_back(energy::fmt(x));
     for (int k = 0; k < 3; ++k)
-      row.push_back(fmt(std::abs(results[p].tool[k]) < 5e-4 ? 0.0 : results[p].tool[k], "%.3f"));
+      row.push_back(energy::fmt(std::abs(results[p].tool[k]) < 5e-4 ? 0.0 : results[p].tool[k], "%.3f"));
     poses.push_back(row);
   }
   printColumns(poses, 2);
@@ -279,36 +223,22 @@ int commandEnergy(int argc, char** argv) {
   std::vector<std::vector<std::string>> joints{
       {"pose", "variant", "tau1", "tau2", "tau3", "tau4", "tau5", "tau6", "tau7"}};
   for (std::size_t p = 0; p < results.size(); ++p)
-    for (int v = 0; v < kVariantCount; ++v) {
-      std::vector<std::string> row{v == 0 ? kPoses[p].name : "", kVariants[v].name};
-      for (int j = 0; j < kJoints; ++j) row.push_back(fmt(results[p].variant[v].tau[j]));
+    for (int v = 0; v < energy::kVariantCount; ++v) {
+      std::vector<std::string> row{v == 0 ? kPoses[p].name : "", energy::kVariants[v].name};
+      for (int j = 0; j < kJoints; ++j) row.push_back(energy::fmt(results[p].variant[v].tau[j]));
       joints.push_back(row);
     }
   printColumns(joints, 2);
 
-  std::printf(
-      "\nactuator effort: |tau| = 2-norm of tau_control [N·m], sum|tau| [N·m], |tau|^2 [N²m²];\n"
-      "m = margin of the friction-aware solve; saved = how much less |tau|^2 with m=1 than plain\n");
-  std::vector<std::vector<std::string>> table{{"pose", "|tau| plain", "|tau| m=0.5", "|tau| m=1", "sum|tau| plain",
-                                               "sum|tau| m=0.5", "sum|tau| m=1", "|tau|^2 plain", "|tau|^2 m=0.5",
-                                               "|tau|^2 m=1", "saved m=1", "check"}};
-  double total[kVariantCount] = {0, 0, 0};
+  std::vector<std::string> names;
+  std::vector<energy::VariantEfforts> efforts;
+  std::vector<bool> ok;
   for (std::size_t p = 0; p < results.size(); ++p) {
-    const PoseResult& r = results[p];
-    std::vector<std::string> row{kPoses[p].name};
-    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].norm));
-    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].abs_sum));
-    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].sq));
-    for (int v = 0; v < kVariantCount; ++v) total[v] += r.variant[v].sq;
-    row.push_back(fmt(100.0 * (1.0 - r.variant[2].sq / r.variant[0].sq), "%.1f") + " %");
-    row.push_back(r.ok ? "ok" : "MISMATCH");
-    table.push_back(row);
+    names.push_back(kPoses[p].name);
+    efforts.push_back({results[p].variant[0].effort, results[p].variant[1].effort, results[p].variant[2].effort});
+    ok.push_back(results[p].ok);
   }
-  printColumns(table);
-  std::printf("\nall poses: |tau|^2 summed %s (plain), %s (margin 0.5), %s (margin 1): %s %% and %s %% less\n",
-              fmt(total[0]).c_str(), fmt(total[1]).c_str(), fmt(total[2]).c_str(),
-              fmt(100.0 * (1.0 - total[1] / total[0]), "%.1f").c_str(),
-              fmt(100.0 * (1.0 - total[2] / total[0]), "%.1f").c_str());
+  energy::printEffortTable("pose", names, efforts, ok);
   std::printf("check: rank 7, |qdd| < 1e-9 and tau_control = the closed form within 1e-9 (G from RNEA)\n");
 
   writeOutput((out / "panda_energy.csv").string(), csvText(results));
@@ -318,6 +248,7 @@ int commandEnergy(int argc, char** argv) {
   const bool plotted =
       writePlots(*report, "energy.gp", plotScript(model, results), "panda_energy.png, panda_energy_joints.png");
   all_ok = dual_arm(plotted) && all_ok;
+  all_ok = standing(plotted) && all_ok;
   return reportExitCode(*report, all_ok, "the closed form");
 }
 

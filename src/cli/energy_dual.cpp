@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "energy_report.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli {
@@ -69,41 +70,24 @@ const Posture kPostures[] = {
 const double kSeed[2][7] = {{-0.0597, 0.9013, 0.2395, -2.0689, -0.7983, 2.8788, -0.6992},
                             {-0.1724, 0.8639, -0.0690, -2.1175, 0.3159, 2.9720, 1.0418}};
 
-struct Variant {
-  const char* name;
-  double margin;  // < 0: the plain solver
-};
-const Variant kVariants[] = {{"plain", -1.0}, {"friction_margin_0.5", 0.5}, {"friction_margin_1", 1.0}};
-constexpr int kVariantCount = 3;
-
-struct Effort {
+struct VariantResult {
   Eigen::VectorXd tau, mu;
   Vec6 loop = Vec6::Zero();  // ν of the relative rows: the wrench on the left hand, right_tool0's axes
-  double norm = 0, sq = 0, abs_sum = 0;
+  energy::Effort effort;
 };
 
 struct PostureResult {
   Eigen::VectorXd q, gravity;  // G'(q): RNEA with the box's wrenches
   Eigen::Vector3d left, right;
   double ik_error = 0, limit_distance = 0;
-  Effort variant[kVariantCount];
+  VariantResult variant[energy::kVariantCount];
   int rank = 0;
   double worst_qdd = 0, worst_closed_form = 0, worst_closure = 0, worst_torso_internal = 0;
   bool ok = false;
 };
 
-std::string fmt(double x, const char* format = "%.4g") {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, format, std::abs(x) < 1e-12 ? 0.0 : x);
-  return buffer;
-}
-
-// A check's residual, as it is (fmt shows |x| < 1e-12 as 0).
-std::string small(double x) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.1e", x);
-  return buffer;
-}
+using energy::fmt;
+using energy::small;
 
 Eigen::Matrix3d rotZ(double angle) { return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
@@ -225,28 +209,19 @@ PostureResult run(const Model& model, const Posture& posture) {
   r.right = pose.translation();
   if (!s) throw CliError(kExitError, where + s.message);
 
-  for (int v = 0; v < kVariantCount; ++v) {
-    const Variant& variant = kVariants[v];
-    Status status;
-    if (variant.margin < 0) {
-      status = solveHybridDynamics(model, task, r.q, zero, zero, ws);
-    } else {
-      FrictionOptions options;
-      options.margin = variant.margin;
-      status = solveWithFriction(model, task, r.q, zero, zero, ws, options);
-    }
-    if (!status) throw CliError(kExitError, where + variant.name + ": " + status.message);
+  for (int v = 0; v < energy::kVariantCount; ++v) {
+    const energy::Variant& variant = energy::kVariants[v];
+    if (const Status status = energy::solveAtRest(model, task, r.q, ws, variant); !status)
+      throw CliError(kExitError, where + variant.name + ": " + status.message);
     if (ws.solution.balance.rank != kDof || ws.solution.balance.singular)
       throw CliError(kExitError, where + variant.name + ": the hold-still task has rank " +
                                      std::to_string(ws.solution.balance.rank) + ", not " + std::to_string(kDof) +
                                      " (q̈ is not fully determined)");
-    Effort& e = r.variant[v];
+    VariantResult& e = r.variant[v];
     e.tau = ws.solution.tau_control;
     e.mu = variant.margin < 0 ? zero : Eigen::VectorXd(ws.friction.mu);
     e.loop = ws.solution.nu.segment<6>(loop_row);
-    e.sq = e.tau.squaredNorm();
-    e.norm = std::sqrt(e.sq);
-    e.abs_sum = e.tau.cwiseAbs().sum();
+    e.effort = energy::effortOf(e.tau);
     r.rank = ws.solution.balance.rank;
     r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
     // The closed form: τ_control = G' + μ with the effort-minimising μ.
@@ -279,23 +254,16 @@ std::string csvText(const std::vector<PostureResult>& results) {
   for (const char* column : {"q", "tau", "mu"})
     for (int j = 1; j <= kDof; ++j) out << "," << column << j;
   out << ",tau_norm,tau_sq,tau_abs_sum,loop_fx,loop_fy,loop_fz,loop_nx,loop_ny,loop_nz\n";
-  char cell[40];
-  auto number = [&](double x) {
-    std::snprintf(cell, sizeof cell, ",%.17g", x);
-    out << cell;
-  };
   for (std::size_t p = 0; p < results.size(); ++p) {
     const PostureResult& r = results[p];
-    for (int v = 0; v < kVariantCount; ++v) {
-      const Effort& e = r.variant[v];
-      out << kPostures[p].name << "," << kVariants[v].name;
-      for (int j = 0; j < kDof; ++j) number(r.q[j]);
-      for (int j = 0; j < kDof; ++j) number(e.tau[j]);
-      for (int j = 0; j < kDof; ++j) number(e.mu[j]);
-      number(e.norm);
-      number(e.sq);
-      number(e.abs_sum);
-      for (int k = 0; k < 6; ++k) number(e.loop[k]);
+    for (int v = 0; v < energy::kVariantCount; ++v) {
+      const VariantResult& e = r.variant[v];
+      out << kPostures[p].name << "," << energy::kVariants[v].name;
+      for (int j = 0; j < kDof; ++j) out << energy::csvCell(r.q[j]);
+      for (int j = 0; j < kDof; ++j) out << energy::csvCell(e.tau[j]);
+      for (int j = 0; j < kDof; ++j) out << energy::csvCell(e.mu[j]);
+      out << energy::csvCell(e.effort.norm) << energy::csvCell(e.effort.sq) << energy::csvCell(e.effort.abs_sum);
+      for (int k = 0; k < 6; ++k) out << energy::csvCell(e.loop[k]);
       out << "\n";
     }
   }
@@ -307,73 +275,42 @@ std::string jointLabel(int j) { return j == 0 ? "t" : (j <= 7 ? "L" : "R") + std
 
 // The same two charts as the Panda's (energy.gp), in the same style.
 std::string plotScript(const Model& model, const std::vector<PostureResult>& results) {
+  std::vector<std::string> names, labels;
+  std::vector<energy::VariantEfforts> efforts;
+  for (std::size_t p = 0; p < results.size(); ++p) {
+    names.push_back(kPostures[p].name);
+    efforts.push_back({results[p].variant[0].effort, results[p].variant[1].effort, results[p].variant[2].effort});
+  }
+  Eigen::VectorXd breakaway(kDof);
+  for (int j = 0; j < kDof; ++j) {
+    labels.push_back(jointLabel(j));
+    breakaway[j] = model.joint(j).breakaway_friction;
+  }
   std::ostringstream s;
-  char cell[40];
-  auto number = [&](double x) {
-    std::snprintf(cell, sizeof cell, " %.17g", std::abs(x) < 1e-12 ? 0.0 : x);
-    return std::string(cell);
-  };
   s << "# Generated by `zwang energy`; run it in this directory: gnuplot dual_energy.gp\n"
        "set encoding utf8\n"
        "set datafile separator whitespace\n"
-       "# columns: posture, |tau_control| plain, margin 0.5, margin 1 [N·m]\n"
-       "$norms << EOD\n";
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    s << kPostures[p].name;
-    for (int v = 0; v < kVariantCount; ++v) s << number(results[p].variant[v].norm);
-    s << "\n";
-  }
-  s << "EOD\n";
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    s << "# columns: joint, |tau_control,j| plain, margin 0.5, margin 1, breakaway f_j [N·m]\n"
-      << "$joints_" << kPostures[p].name << " << EOD\n";
-    for (int j = 0; j < kDof; ++j) {
-      s << jointLabel(j);
-      for (int v = 0; v < kVariantCount; ++v) s << number(std::abs(results[p].variant[v].tau[j]));
-      s << number(model.joint(j).breakaway_friction) << "\n";
-    }
-    s << "EOD\n";
-  }
-  s << "set style data histograms\n"
-       "set style histogram clustered gap 1\n"
-       "set style fill solid 0.85 border -1\n"
-       "set boxwidth 0.9\n"
-       "set grid ytics\n"
-       "set key outside bottom center horizontal box maxrows 1 width -2\n"
-       "set yrange [0:*]\n"
-       "set xrange [-0.6:"
-    << results.size() - 0.4
-    << "]\n"
-       "\n"
+    << energy::normsData("$norms", "posture", names, efforts);
+  for (std::size_t p = 0; p < results.size(); ++p)
+    s << energy::jointsData(std::string("$joints_") + kPostures[p].name, labels,
+                            {results[p].variant[0].tau, results[p].variant[1].tau, results[p].variant[2].tau},
+                            breakaway);
+  s << energy::histogramStyle(results.size())
+    << "\n"
        "set terminal pngcairo size 900,520 font \"DejaVu Sans,11\"\n"
        "set output \"dual_energy.png\"\n"
        "set title \"Dual arm holding a 3 kg box still: motor effort ‖τ_{control}‖\"\n"
        "set ylabel \"‖τ_{control}‖ [N·m]\"\n"
        "set xtics noenhanced\n"
-       "plot $norms using 2:xtic(1) title \"plain (friction-unaware)\" linecolor rgb \"#a0a0a0\", \\\n"
-       "  '' using 3 title \"friction-aware, margin 0.5\" linecolor rgb \"#70a0e0\", \\\n"
-       "  '' using 4 title \"friction-aware, margin 1\" linecolor rgb \"#0050b0\"\n"
-       "\n"
+    << energy::normsPlot("$norms")
+    << "\n"
        "set terminal pngcairo size 1400,800 font \"DejaVu Sans,10\"\n"
        "set output \"dual_energy_joints.png\"\n"
        "set multiplot layout 2,3 title \"Dual arm holding a box: |τ_{control,j}| per joint (bars; t = torso, L/R = left/right "
        "arm) and breakaway friction f_j (red)\"\n"
-       "set key inside top right vertical maxrows auto width 0 box opaque font \",8\"\n"
-       "set offsets 0, 0, graph 0.05, 0\n"
-       "set xrange [-0.6:"
-    << kDof - 0.4
-    << "]\n"
-       "set xlabel \"joint\"\n"
-       "set ylabel \"|τ| [N·m]\"\n"
-       "set yrange [0:*]\n";
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    const std::string data = std::string("$joints_") + kPostures[p].name;
-    s << "set title \"" << kPostures[p].name << "\" noenhanced\n"
-      << (p == 0 ? "" : "unset key\n") << "plot " << data
-      << " using 2:xtic(1) title \"plain\" linecolor rgb \"#a0a0a0\", \\\n  '' using 3 title \"margin 0.5\" "
-         "linecolor rgb \"#70a0e0\", \\\n  '' using 4 title \"margin 1\" linecolor rgb \"#0050b0\", \\\n  '' using "
-         "($0):5 with points pointtype 5 pointsize 1.1 linecolor rgb \"#c00000\" title \"f_j\"\n";
-  }
+    << energy::jointsPanelStyle(kDof);
+  for (std::size_t p = 0; p < results.size(); ++p)
+    s << energy::jointsPanel(std::string("$joints_") + kPostures[p].name, kPostures[p].name, p == 0);
   s << "unset multiplot\nunset output\n";
   return s.str();
 }
@@ -461,8 +398,8 @@ bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urd
   std::vector<std::vector<std::string>> joints{{"posture", "variant"}};
   for (int j = 0; j < kDof; ++j) joints[0].push_back(jointLabel(j));
   for (std::size_t p = 0; p < results.size(); ++p)
-    for (int v = 0; v < kVariantCount; ++v) {
-      std::vector<std::string> row{v == 0 ? kPostures[p].name : "", kVariants[v].name};
+    for (int v = 0; v < energy::kVariantCount; ++v) {
+      std::vector<std::string> row{v == 0 ? kPostures[p].name : "", energy::kVariants[v].name};
       for (int j = 0; j < kDof; ++j) row.push_back(fmt(results[p].variant[v].tau[j], "%.3g"));
       joints.push_back(row);
     }
@@ -482,29 +419,15 @@ bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urd
   }
   printColumns(loop);
 
-  std::printf(
-      "\nactuator effort: |tau| = 2-norm of tau_control [N·m], sum|tau| [N·m], |tau|^2 [N²m²];\n"
-      "m = margin of the friction-aware solve; saved = how much less |tau|^2 with m=1 than plain\n");
-  std::vector<std::vector<std::string>> table{{"posture", "|tau| plain", "|tau| m=0.5", "|tau| m=1", "sum|tau| plain",
-                                               "sum|tau| m=0.5", "sum|tau| m=1", "|tau|^2 plain", "|tau|^2 m=0.5",
-                                               "|tau|^2 m=1", "saved m=1", "check"}};
-  double total[kVariantCount] = {0, 0, 0};
+  std::vector<std::string> names;
+  std::vector<energy::VariantEfforts> efforts;
+  std::vector<bool> ok;
   for (std::size_t p = 0; p < results.size(); ++p) {
-    const PostureResult& r = results[p];
-    std::vector<std::string> row{kPostures[p].name};
-    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].norm));
-    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].abs_sum));
-    for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(r.variant[v].sq));
-    for (int v = 0; v < kVariantCount; ++v) total[v] += r.variant[v].sq;
-    row.push_back(fmt(100.0 * (1.0 - r.variant[2].sq / r.variant[0].sq), "%.1f") + " %");
-    row.push_back(r.ok ? "ok" : "MISMATCH");
-    table.push_back(row);
+    names.push_back(kPostures[p].name);
+    efforts.push_back({results[p].variant[0].effort, results[p].variant[1].effort, results[p].variant[2].effort});
+    ok.push_back(results[p].ok);
   }
-  printColumns(table);
-  std::printf("\nall postures: |tau|^2 summed %s (plain), %s (margin 0.5), %s (margin 1): %s %% and %s %% less\n",
-              fmt(total[0]).c_str(), fmt(total[1]).c_str(), fmt(total[2]).c_str(),
-              fmt(100.0 * (1.0 - total[1] / total[0]), "%.1f").c_str(),
-              fmt(100.0 * (1.0 - total[2] / total[0]), "%.1f").c_str());
+  energy::printEffortTable("posture", names, efforts, ok);
   double worst[4] = {0, 0, 0, 0};
   for (const PostureResult& r : results) {
     worst[0] = std::max(worst[0], r.worst_qdd);

@@ -2,7 +2,8 @@
 // binary and check exit codes, stderr and the JSON/CSV it writes. Numbers are
 // compared numerically, never as strings.
 //
-// Tags (one ctest test each): [golden] [errors] [robustness] [usage] [info] [scenarios] [energy] [docs]
+// Tags (one ctest test each): [golden] [errors] [robustness] [usage] [info] [scenarios] [energy] [docs];
+// test_cli_standing.cpp adds to [energy] (the humanoid and Solo 12 standing)
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -1062,6 +1063,9 @@ TEST_CASE("energy regenerates the committed CSV within 1e-12", "[energy]") {
     CHECK(cli_test::fileExists(out + "/panda_energy_joints.png"));
     CHECK(cli_test::fileExists(out + "/dual_energy.png"));
     CHECK(cli_test::fileExists(out + "/dual_energy_joints.png"));
+    CHECK(cli_test::fileExists(out + "/standing_energy.png"));
+    CHECK(cli_test::fileExists(out + "/standing_humanoid_joints.png"));
+    CHECK(cli_test::fileExists(out + "/standing_solo12_joints.png"));
   }
 
   // Independently of the tool: G(q) by RNEA, and the effort-minimising friction.
@@ -1207,6 +1211,9 @@ TEST_CASE("energy without gnuplot keeps the CSV and says so", "[energy]") {
   CHECK(cli_test::fileExists(out + "/dual_energy.csv"));
   CHECK(cli_test::fileExists(out + "/dual_energy.gp"));
   CHECK_FALSE(cli_test::fileExists(out + "/dual_energy.png"));
+  CHECK(cli_test::fileExists(out + "/standing_energy.csv"));
+  CHECK(cli_test::fileExists(out + "/standing_energy.gp"));
+  CHECK_FALSE(cli_test::fileExists(out + "/standing_energy.png"));
   const Run quiet = run({"energy", "--out", out + "-csv", "--no-plots"}, {{"PATH", empty_bin}});
   CHECK(quiet.exit_code == 0);
   CHECK(quiet.err.empty());

@@ -1,0 +1,796 @@
+// The third scenario of `zwang energy` (docs/evaluation.md, section 4,
+// "Standing"): two robots on a free base standing still on the ground, the
+// humanoid models/simple_humanoid.urdf (29 joints) on both feet and the
+// quadruped models/solo12.urdf (12 joints) on four point feet, with the motor
+// effort of the plain and the friction-aware solver, as for the Panda.
+//
+// The task. Each foot is a contact (Task::addContact, world axes, zero set
+// points: the ground supplies its force, so it is not in τ_control): six rows
+// for the humanoid's flat feet (l_ankle, r_ankle: force and moment), three for
+// Solo's point feet (FL/FR/HL/HR_FOOT: force). The feet alone leave the body
+// free to sag (legs, base and ground form closed chains with 35 − 12 = 23 and
+// 18 − 12 = 6 degrees of freedom left), so every joint also gets a joint row
+// q̈_j = 0 (Task::addJointConstraint: its own motor holds it). The rows then
+// have rank nv and q̈ = 0 is the only motion. Six rows are beyond the rank:
+// the ground's split between the feet is statically indeterminate (internal
+// forces between them), and the balance returns the least-norm ν, the least
+// Σν² over ground forces, moments and motor torques together (docs/solver.md,
+// "Singular tasks"). That choice fixes the split and with it τ_control:
+//   plain (solveHybridDynamics): τ_control = the joint rows' ν;
+//   friction-aware (solveWithFriction, every joint stuck, μ* indeterminate):
+//     the maximiser with the least ‖τ_control‖² within margin·f_j. The split
+//     moves with μ, so this is not max(0, |τ_j| − margin·f_j) joint by joint
+//     as on the Panda.
+// Checked before anything is written, per posture and variant, within 1e-9:
+// rank nv and |q̈|; RNEA with the ground wrenches (ν of the contacts) on the
+// feet gives 0 on the base and τ_control − μ on the joints; ν is the
+// least-norm solution of the dense balance Gᵀν = RNEA(q, 0, 0) + [0; μ]
+// (G from frameJacobian, Eigen's complete orthogonal decomposition); with
+// friction, |μ_j| ≤ margin·f_j, μ meets the optimality (KKT) conditions of
+// min ‖τ_control(μ)‖² over that box with τ_control(μ) from the same dense
+// map, and ‖τ_control‖² is not above the plain one.
+//
+// The postures are chosen (kHumanoidPostures, kSoloPostures). The base is
+// placed from the legs' kinematics (framePose): the feet on z = 0 (the
+// humanoid's flat, identity orientation), their midpoint at the origin. The
+// humanoid's WAIST_P undoes the pelvis's tilt, so its chest stays upright.
+// The contacts are ideal (the URDF has no soles): the ground gives whatever
+// moment the posture needs, and the output shows where the centre of mass
+// and each foot's centre of pressure are. The breakaway friction is chosen
+// too (neither URDF has any) and given per solve (FrictionOptions::breakaway):
+// see humanoidBreakaway and soloBreakaway.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/QR>
+
+#include "cli.hpp"
+#include "energy_report.hpp"
+#include "zwang/zwang.hpp"
+
+namespace zwang::cli {
+
+namespace {
+
+using energy::fmt;
+using energy::small;
+
+constexpr double kCheckTolerance = 1e-9;       // the checks: torques [N·m], forces [N], accelerations [rad/s², m/s²]
+constexpr double kPlacementTolerance = 1e-12;  // feet off z = 0 or off level after placing the base [m, rad]:
+                                               // a few transforms of numbers below 1 round to ~1e-16
+constexpr double kLimitDistance = 0.05;        // every joint at least this far inside its limits [rad]
+constexpr double kBoundTolerance = 1e-9;       // μ within this of ±margin·f counts as on the bound [N·m]
+
+struct JointValue {
+  std::string joint;
+  double q;  // [rad]
+};
+
+struct Posture {
+  const char* name;
+  const char* what;
+  std::vector<JointValue> joints;  // every other joint at 0
+};
+
+// Both legs of the humanoid: hip pitch, knee, ankle pitch (rolls and yaws 0).
+// The URDF's limits allow only knee and ankle pitch ≥ 0 on both legs (its
+// right leg's limits are its left's shifted by one joint), so the shank
+// always leans with the foot ahead of the knee, and the pelvis tilts back by
+// the sum of the three angles when it is not 0.
+std::vector<JointValue> humanoidLegs(double hip, double knee, double ankle, std::vector<JointValue> more) {
+  std::vector<JointValue> joints{{"LLEG_HIP_P", hip},      {"LLEG_KNEE", knee},      {"LLEG_ANKLE_P", ankle},
+                                 {"RLEG_HIP_P", hip},      {"RLEG_KNEE", knee},      {"RLEG_ANKLE_P", ankle},
+                                 {"LARM_SHOULDER_R", 0.1}, {"RARM_SHOULDER_R", 0.1}, {"LARM_ELBOW", -0.1},
+                                 {"RARM_ELBOW", -0.1},     {"LARM_WRIST_Y", -0.1},   {"RARM_WRIST_Y", -0.1}};
+  // The arms' values keep every arm joint kLimitDistance inside the URDF's
+  // limits (shoulder roll ≥ 0.0087, LARM_WRIST_Y and RARM_ELBOW ≤ 0.0035).
+  joints.insert(joints.end(), more.begin(), more.end());
+  return joints;
+}
+
+const std::vector<Posture> kHumanoidPostures = {
+    {"upright", "legs almost straight (knee and ankle 0.06 rad), pelvis level", humanoidLegs(-0.12, 0.06, 0.06, {})},
+    {"crouched", "knees bent 0.6 rad, pelvis back and tilted back 0.45 rad, chest upright",
+     humanoidLegs(-0.25, 0.6, 0.1, {})},
+    {"arm_raised", "upright, left arm raised forward to the horizontal",
+     humanoidLegs(-0.12, 0.06, 0.06, {{"LARM_SHOULDER_P", -1.5}})},
+};
+
+// Solo's legs: hip flexion HFE and knee KFE, front legs (FL, FR) one way and
+// hind legs (HL, HR) mirrored, KFE = −2·HFE so each foot is under its HFE axis.
+std::vector<JointValue> soloLegs(double hfe) {
+  std::vector<JointValue> joints;
+  for (const std::string leg : {"FL", "FR", "HL", "HR"}) {
+    const double front = leg[0] == 'F' ? 1.0 : -1.0;
+    joints.push_back({leg + "_HFE", front * hfe});
+    joints.push_back({leg + "_KFE", -2.0 * front * hfe});
+  }
+  return joints;
+}
+
+const std::vector<Posture> kSoloPostures = {
+    {"stand", "HFE ±0.8, KFE ∓1.6 rad: knees towards the body, feet under the hips", soloLegs(0.8)},
+    {"crouch", "HFE ±1.1, KFE ∓2.2 rad: the same, lower", soloLegs(1.1)},
+};
+
+// Breakaway friction, chosen (simple_humanoid.urdf has none): the Panda's
+// published values (models/panda.urdf) by joint size, as for harmonic-drive
+// joints of the same class: 5 N·m (the Panda's joint 1) for legs, waist and
+// chest, 2 N·m (its joints 2, 3) for shoulders and elbows, 0.5 N·m (its wrist
+// joints 6, 7) for the wrists.
+double humanoidBreakaway(const std::string& joint) {
+  if (joint.find("WRIST") != std::string::npos) return 0.5;
+  if (joint.find("SHOULDER") != std::string::npos || joint.find("ELBOW") != std::string::npos) return 2.0;
+  return 5.0;
+}
+
+// Breakaway friction, chosen (solo12.urdf says 0): 0.05 N·m per joint, 2 % of
+// the 2.5 N·m the ODRI actuator module is rated for (open_robot_actuator_hardware,
+// actuator_module_v1: a 9:1 two-stage belt drive, low friction by design).
+double soloBreakaway(const std::string&) { return 0.05; }
+
+struct StandingRobot {
+  const char* file;
+  const char* label;  // in the CSV and the plots
+  const char* title;  // in the output
+  int dof;
+  std::vector<std::string> feet;
+  int contact_rows;   // 6: a flat foot (force and moment), 3: a point foot (force)
+  const char* waist;  // the joint that turns the chest back upright when the pelvis tilts (nullptr: none)
+  double (*breakaway)(const std::string& joint);
+  const std::vector<Posture>* postures;
+};
+
+const StandingRobot kRobots[] = {
+    {"simple_humanoid.urdf",
+     "humanoid",
+     "simple_humanoid",
+     29,
+     {"l_ankle", "r_ankle"},
+     6,
+     "WAIST_P",
+     humanoidBreakaway,
+     &kHumanoidPostures},
+    {"solo12.urdf",
+     "solo12",
+     "Solo 12",
+     12,
+     {"FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"},
+     3,
+     nullptr,
+     soloBreakaway,
+     &kSoloPostures},
+};
+
+struct VariantResult {
+  Eigen::VectorXd tau, mu;  // τ_control and μ* of the joints (n)
+  Eigen::VectorXd ground;   // ν of the contact rows: per foot [f; n] or [f], world axes at the foot origin
+  energy::Effort effort;
+  double least_sq = 0;  // friction variants: the least ‖τ_control‖² over the margin box (leastEffort)
+  double kkt = 0;       // friction variants: how far μ is from minimising ‖τ_control‖² there (kktViolation)
+};
+
+// Plain, with the split of the ground's force that needs the least motor effort (bestSplit).
+struct BestSplit {
+  double sq = 0;          // ‖τ_control‖²
+  double tangential = 0;  // the largest |horizontal force| / vertical force on a foot
+};
+
+struct PostureResult {
+  Eigen::VectorXd q;
+  double placement_error = 0, limit_distance = 0;
+  Eigen::Vector2d com = Eigen::Vector2d::Zero();  // the centre of mass across gravity [m], world x, y
+  double mass = 0;                                // [kg], from RNEA's base force
+  VariantResult variant[energy::kVariantCount];
+  int rank = 0;
+  double worst_qdd = 0, worst_rnea = 0, worst_split = 0, worst_bound = 0, split_shift = 0;
+  double worst_reference_kkt = 0;  // of the least-effort reference (leastEffort)
+  BestSplit best_split;            // plain: the least ‖τ_control‖² over every split of the ground's force
+  bool ok = false;
+};
+
+struct RobotResult {
+  const StandingRobot* robot = nullptr;
+  std::filesystem::path urdf;
+  Model model;
+  Eigen::VectorXd breakaway;
+  std::vector<PostureResult> postures;
+};
+
+// Feet with six contact rows carry a moment: they stand flat, level on the ground.
+bool flatFeet(const StandingRobot& robot) { return robot.contact_rows == 6; }
+
+std::string where(const StandingRobot& robot, const Posture& posture) {
+  return std::string("energy: ") + robot.label + ", posture " + posture.name + ": ";
+}
+
+void require(const Status& s, const std::string& context) {
+  if (!s) throw CliError(kExitError, context + s.message);
+}
+
+std::vector<Eigen::Isometry3d> footPoses(const Model& model, Workspace& ws, const StandingRobot& robot,
+                                         const Eigen::VectorXd& q, const std::string& context) {
+  require(forwardKinematics(model, ws, q), context);
+  std::vector<Eigen::Isometry3d> poses(robot.feet.size());
+  for (std::size_t k = 0; k < robot.feet.size(); ++k)
+    require(framePose(model, ws, model.frameIndex(robot.feet[k]), poses[k]), context);
+  return poses;
+}
+
+// Put the base where the feet stand on z = 0, their midpoint at the origin.
+// With the base at the origin the feet's poses give the orientation the base
+// needs for flat feet to be level (R_base = R_footᵀ) and their offsets.
+// Returns how far the placed feet are off: height, midpoint, and level.
+double placeBase(const Model& model, Workspace& ws, const StandingRobot& robot, Eigen::VectorXd& q,
+                 const std::string& context) {
+  q.head<7>() << 0, 0, 0, 1, 0, 0, 0;
+  std::vector<Eigen::Isometry3d> feet = footPoses(model, ws, robot, q, context);
+  const Eigen::Matrix3d R =
+      flatFeet(robot) ? Eigen::Matrix3d(feet[0].linear().transpose()) : Eigen::Matrix3d::Identity();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Isometry3d& foot : feet) mean += R * foot.translation() / static_cast<double>(feet.size());
+  const Eigen::Quaterniond orientation(R);
+  q.head<3>() = -mean;
+  q.segment<4>(3) << orientation.w(), orientation.x(), orientation.y(), orientation.z();
+  feet = footPoses(model, ws, robot, q, context);
+  double error = 0;
+  Eigen::Vector3d midpoint = Eigen::Vector3d::Zero();
+  for (const Eigen::Isometry3d& foot : feet) {
+    error = std::max(error, std::abs(foot.translation().z()));
+    if (flatFeet(robot)) error = std::max(error, (foot.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
+    midpoint += foot.translation() / static_cast<double>(feet.size());
+  }
+  return std::max(error, midpoint.head<2>().cwiseAbs().maxCoeff());
+}
+
+// The centre of mass across gravity, world x and y, and the mass: at rest
+// RNEA's base force is the wrench [f; n] (base axes, base origin) that holds
+// the whole robot up, f = −m·g and n = c × f, so c's part across f is
+// f × n / |f|².
+Eigen::Vector2d centreOfMass(const Model& model, Workspace& ws, const Eigen::VectorXd& q, double& mass,
+                             const std::string& context) {
+  const Task gravity_only(model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  require(inverseDynamics(model, gravity_only, q, zero, zero, ws), context + "RNEA: ");
+  const Eigen::Vector3d f = ws.tau.head<3>(), n = ws.tau.segment<3>(3);
+  mass = f.norm() / gravity_only.gravity.norm();
+  const Eigen::Quaterniond orientation(q[3], q[4], q[5], q[6]);
+  return (q.head<3>() + orientation * (f.cross(n) / f.squaredNorm())).head<2>();
+}
+
+// The base's pitch, the angle about the world's y axis, from its quaternion.
+double basePitch(const Eigen::VectorXd& q) {
+  const Eigen::Matrix3d R = Eigen::Quaterniond(q[3], q[4], q[5], q[6]).toRotationMatrix();
+  return std::atan2(R(0, 2), R(2, 2));
+}
+
+double limitDistance(const Model& model, const Eigen::VectorXd& q) {
+  double distance = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < model.dof(); ++j) {
+    const double qj = q[model.baseConfigurationSize() + j];
+    distance = std::min({distance, qj - model.joint(j).lower, model.joint(j).upper - qj});
+  }
+  return distance;
+}
+
+Eigen::VectorXd postureConfiguration(const Model& model, Workspace& ws, const StandingRobot& robot,
+                                     const Posture& posture, PostureResult& r) {
+  const std::string context = where(robot, posture);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq());
+  for (const JointValue& value : posture.joints)
+    q[model.baseConfigurationSize() + model.jointIndex(value.joint)] = value.q;
+  r.placement_error = placeBase(model, ws, robot, q, context);
+  if (robot.waist) q[model.baseConfigurationSize() + model.jointIndex(robot.waist)] = -basePitch(q);
+  r.com = centreOfMass(model, ws, q, r.mass, context);
+  r.limit_distance = limitDistance(model, q);
+  if (!(r.placement_error < kPlacementTolerance) || !(r.limit_distance > kLimitDistance))
+    throw CliError(kExitError, context + "the feet are not level on z = 0 within the joint limits (off by " +
+                                   small(r.placement_error) + ", closest limit " + fmt(r.limit_distance) + " rad)");
+  return q;
+}
+
+Task standingTask(const Model& model, const StandingRobot& robot) {
+  Task task(model);  // gravity (0, 0, −9.81)
+  const ConstraintMatrix rows = ConstraintMatrix::Identity(6, 6).leftCols(robot.contact_rows);
+  for (const std::string& foot : robot.feet) task.addContact(foot, rows, Expressed::World);
+  for (int j = 0; j < model.dof(); ++j) task.addJointConstraint(j);
+  return task;
+}
+
+// Gᵀ of the task's rows, built densely from the feet's world Jacobians and
+// the joint rows' unit torques, independently of the solver's sweeps.
+Eigen::MatrixXd balanceTranspose(const Model& model, Workspace& ws, const StandingRobot& robot,
+                                 const Eigen::VectorXd& q) {
+  const int contacts = robot.contact_rows * static_cast<int>(robot.feet.size()), n = model.dof(), nv = model.nv();
+  Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(nv, contacts + n);
+  Eigen::MatrixXd J(6, nv);
+  for (std::size_t k = 0; k < robot.feet.size(); ++k) {
+    require(frameJacobian(model, ws, q, model.frameIndex(robot.feet[k]), Expressed::World, J), "energy: ");
+    Gt.middleCols(robot.contact_rows * static_cast<int>(k), robot.contact_rows) =
+        J.topRows(robot.contact_rows).transpose();
+  }
+  Gt.bottomRightCorner(n, n).setIdentity();
+  return Gt;
+}
+
+// RNEA with the ground wrenches on the feet: the generalized force the
+// motors and friction must supply for q̈ = 0 (0 on the base when the ground
+// carries the robot).
+Eigen::VectorXd torquesWithGround(const Model& model, Workspace& ws, const StandingRobot& robot,
+                                  const Eigen::VectorXd& q, const Eigen::VectorXd& ground) {
+  Task loaded(model);
+  for (std::size_t k = 0; k < robot.feet.size(); ++k) {
+    Vec6 w = Vec6::Zero();
+    w.head(robot.contact_rows) = ground.segment(robot.contact_rows * static_cast<Eigen::Index>(k), robot.contact_rows);
+    loaded.wrench(loaded.addWrench(robot.feet[k], Expressed::World)) = w;
+  }
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  require(inverseDynamics(model, loaded, q, zero, zero, ws), "energy: RNEA: ");
+  return ws.tau;
+}
+
+// The standing balance written densely, independently of the solver's
+// sweeps: the least-norm ν for a friction torque μ is Gᵀ⁺ (RNEA(q, 0, 0) +
+// [0; μ]), so τ_control(μ) = τ₀ + M μ, its joint rows' part, is affine in μ.
+struct DenseBalance {
+  Eigen::MatrixXd Gt_matrix;  // Gᵀ: nv × rows, the contacts' columns first, then the joint rows'
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Gt;
+  Eigen::VectorXd gravity;  // RNEA(q, 0, 0), nv
+  Eigen::VectorXd tau0;     // τ_control(0)
+  Eigen::MatrixXd M;        // ∂τ_control/∂μ (n × n; the identity if the split did not move)
+};
+
+DenseBalance denseBalance(const Model& model, Workspace& ws, const StandingRobot& robot, const Eigen::VectorXd& q,
+                          const std::string& context) {
+  const int n = model.dof();
+  DenseBalance d;
+  d.Gt_matrix = balanceTranspose(model, ws, robot, q);
+  d.Gt.compute(d.Gt_matrix);
+  const Task gravity_only(model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  require(inverseDynamics(model, gravity_only, q, zero, zero, ws), context + "RNEA: ");
+  d.gravity = ws.tau;
+  d.tau0 = d.Gt.solve(d.gravity).tail(n);
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(model.nv(), n);
+  unit.bottomRows(n).setIdentity();
+  d.M = d.Gt.solve(unit).bottomRows(n);
+  return d;
+}
+
+// The least ‖τ_control‖² over every split of the ground's force, without
+// friction: ν = ν₀ + N z solves the balance for any z (N spans null(Gᵀ), the
+// internal forces), and z is chosen for the least motor torques.
+BestSplit bestSplit(const DenseBalance& d, int contact_rows) {
+  const Eigen::Index n = d.tau0.size();
+  const Eigen::MatrixXd internal = Eigen::FullPivLU<Eigen::MatrixXd>(d.Gt_matrix).kernel();
+  const Eigen::MatrixXd on_joints = internal.bottomRows(n);
+  const Eigen::VectorXd z = -on_joints.completeOrthogonalDecomposition().solve(d.tau0);
+  const Eigen::VectorXd nu = d.Gt.solve(d.gravity) + internal * z;
+  BestSplit best;
+  best.sq = nu.tail(n).squaredNorm();
+  for (Eigen::Index foot = 0; foot + contact_rows <= nu.size() - n; foot += contact_rows)
+    best.tangential = std::max(best.tangential, nu.segment<2>(foot).norm() / nu[foot + 2]);
+  return best;
+}
+
+// The worst violation of the optimality conditions of min ½‖τ₀ + M μ‖² over
+// |μ_j| ≤ bound_j: the gradient Mᵀτ is 0 inside the box and points out of
+// it on a bound [N·m].
+double kktViolation(const DenseBalance& d, const Eigen::VectorXd& mu, const Eigen::VectorXd& bound) {
+  const Eigen::VectorXd gradient = d.M.transpose() * (d.tau0 + d.M * mu);
+  double worst = 0;
+  for (Eigen::Index j = 0; j < mu.size(); ++j) {
+    if (mu[j] >= bound[j] - kBoundTolerance)
+      worst = std::max(worst, gradient[j]);
+    else if (mu[j] <= -bound[j] + kBoundTolerance)
+      worst = std::max(worst, -gradient[j]);
+    else
+      worst = std::max(worst, std::abs(gradient[j]));
+  }
+  return worst;
+}
+
+// The least ‖τ_control(μ)‖² over the margin box, by projected gradient with
+// the step 1/λ_max(MᵀM) (a convex quadratic: every step lowers it), until
+// the optimality conditions hold to 1e-12 N·m (the gradient sums torques of
+// at most a few hundred N·m, rounding at ~1e-13; the result is judged at
+// kCheckTolerance) or 10⁵ steps. The reference for the friction-aware
+// solve's pick.
+Eigen::VectorXd leastEffort(const DenseBalance& d, const Eigen::VectorXd& bound) {
+  const Eigen::MatrixXd MtM = d.M.transpose() * d.M;
+  const double step = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(MtM).eigenvalues().maxCoeff();
+  Eigen::VectorXd mu = Eigen::VectorXd::Zero(bound.size());
+  for (int iteration = 0; iteration < 100000 && kktViolation(d, mu, bound) > 1e-12; ++iteration)
+    mu = (mu - step * (d.M.transpose() * (d.tau0 + d.M * mu))).cwiseMax(-bound).cwiseMin(bound);
+  return mu;
+}
+
+void checkVariant(const Model& model, Workspace& ws, const StandingRobot& robot, const Eigen::VectorXd& q,
+                  const DenseBalance& dense, const Eigen::VectorXd& breakaway, int v, const Solution& solution,
+                  PostureResult& r) {
+  const int n = model.dof(), kb = model.baseVelocitySize();
+  const energy::Variant& variant = energy::kVariants[v];
+  VariantResult& e = r.variant[v];
+  // The ground's wrenches hold the robot; the joints feel τ_control − μ.
+  const Eigen::VectorXd needed = torquesWithGround(model, ws, robot, q, e.ground);
+  r.worst_rnea = std::max({r.worst_rnea, needed.head(kb).cwiseAbs().maxCoeff(),
+                           (needed.tail(n) - (e.tau - e.mu)).cwiseAbs().maxCoeff(),
+                           solution.tau_control.head(kb).cwiseAbs().maxCoeff()});
+  // ν is the least-norm solution of the dense balance.
+  Eigen::VectorXd rhs = dense.gravity;
+  rhs.tail(n) += e.mu;
+  r.worst_split = std::max(r.worst_split, (dense.Gt.solve(rhs) - solution.nu).cwiseAbs().maxCoeff());
+  if (variant.margin < 0) return;
+  // Friction: inside the margin box; how far from the least ‖τ_control‖² there.
+  const Eigen::VectorXd bound = variant.margin * breakaway;
+  r.worst_bound = std::max(r.worst_bound, (e.mu.cwiseAbs() - bound).maxCoeff());
+  e.kkt = kktViolation(dense, e.mu, bound);
+  const Eigen::VectorXd least = leastEffort(dense, bound);
+  r.worst_reference_kkt = std::max(r.worst_reference_kkt, kktViolation(dense, least, bound));
+  e.least_sq = (dense.tau0 + dense.M * least).squaredNorm();
+}
+
+PostureResult runPosture(const Model& model, const StandingRobot& robot, const Eigen::VectorXd& breakaway,
+                         const Posture& posture) {
+  PostureResult r;
+  Workspace check_ws(model, 0);
+  r.q = postureConfiguration(model, check_ws, robot, posture, r);
+  const std::string context = where(robot, posture);
+  const DenseBalance dense = denseBalance(model, check_ws, robot, r.q, context);
+  r.best_split = bestSplit(dense, robot.contact_rows);
+  const Task task = standingTask(model, robot);
+  Workspace ws(model, task);
+  const int n = model.dof(), contacts = robot.contact_rows * static_cast<int>(robot.feet.size());
+  for (int v = 0; v < energy::kVariantCount; ++v) {
+    const energy::Variant& variant = energy::kVariants[v];
+    require(energy::solveAtRest(model, task, r.q, ws, variant, breakaway), context + variant.name + ": ");
+    if (ws.solution.balance.rank != model.nv())
+      throw CliError(kExitError, context + variant.name + ": the standing task has rank " +
+                                     std::to_string(ws.solution.balance.rank) +
+                                     ", not nv = " + std::to_string(model.nv()) + " (q̈ is not fully determined)");
+    VariantResult& e = r.variant[v];
+    e.tau = ws.solution.tau_control.tail(n);
+    e.mu = variant.margin < 0 ? Eigen::VectorXd::Zero(n) : Eigen::VectorXd(ws.friction.mu);
+    e.ground = ws.solution.nu.head(contacts);
+    e.effort = energy::effortOf(e.tau);
+    r.rank = ws.solution.balance.rank;
+    r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
+    checkVariant(model, check_ws, robot, r.q, dense, breakaway, v, ws.solution, r);
+  }
+  // How far the split moved with friction: the joints' τ_control − μ at margin 1 against plain (0 for a fixed split).
+  r.split_shift = ((r.variant[2].tau - r.variant[2].mu) - r.variant[0].tau).cwiseAbs().maxCoeff();
+  // The pick's ‖τ_control‖² lies between the least possible and plain's (μ = 0 is in the box);
+  // 1e-12 relative: the sweeps and the dense QP round the same optimum differently (~1e-15).
+  bool ordered = true;
+  for (int v = 1; v < energy::kVariantCount; ++v)
+    ordered = ordered && r.variant[v].least_sq <= r.variant[v].effort.sq * (1 + 1e-12) &&
+              r.variant[v].effort.sq <= r.variant[0].effort.sq;
+  r.ok = r.rank == model.nv() && r.worst_qdd < kCheckTolerance && r.worst_rnea < kCheckTolerance &&
+         r.worst_split < kCheckTolerance && r.worst_bound < kCheckTolerance &&
+         r.worst_reference_kkt < kCheckTolerance && ordered;
+  return r;
+}
+
+RobotResult runRobot(const ReportCommand& report, const StandingRobot& robot) {
+  RobotResult result;
+  result.robot = &robot;
+  result.urdf = std::filesystem::path(modelsDirectory(report.args, robot.file)) / robot.file;
+  UrdfOptions options;
+  options.base = BaseType::Free;
+  try {
+    result.model = loadUrdfFile(result.urdf.string(), options);
+  } catch (const ModelError& e) {
+    throw CliError(kExitError, report.name + ": " + e.what() + " (use --models DIR)");
+  }
+  bool as_expected = result.model.dof() == robot.dof;
+  for (const std::string& foot : robot.feet) as_expected = as_expected && result.model.hasFrame(foot);
+  for (const Posture& posture : *robot.postures)
+    for (const JointValue& value : posture.joints) as_expected = as_expected && result.model.hasJoint(value.joint);
+  if (!as_expected)
+    throw CliError(kExitError, report.name + ": " + result.urdf.string() + ": expected " + robot.title + " with " +
+                                   std::to_string(robot.dof) + " joints and the feet of docs/evaluation.md, section 4");
+  result.breakaway.resize(robot.dof);
+  for (int j = 0; j < robot.dof; ++j) result.breakaway[j] = robot.breakaway(result.model.joint(j).name);
+  for (const Posture& posture : *robot.postures)
+    result.postures.push_back(runPosture(result.model, robot, result.breakaway, posture));
+  return result;
+}
+
+// --- output -----------------------------------------------------------------
+
+std::string groundName(const StandingRobot& robot, Eigen::Index row) {
+  static const char* const kComponents[] = {"fx", "fy", "fz", "nx", "ny", "nz"};
+  return robot.feet[static_cast<std::size_t>(row / robot.contact_rows)] + "." + kComponents[row % robot.contact_rows];
+}
+
+std::string qName(const Model& model, int k) {
+  static const char* const kBase[] = {"base_x", "base_y", "base_z", "base_qw", "base_qx", "base_qy", "base_qz"};
+  return k < 7 ? kBase[k] : model.joint(k - 7).name;
+}
+
+void csvRow(std::ostringstream& out, const std::string& key, const std::string& name, double value) {
+  out << key << "," << name << energy::csvCell(value) << "\n";
+}
+
+void csvRobot(std::ostringstream& out, const RobotResult& robot) {
+  const Model& model = robot.model;
+  const std::string label = robot.robot->label;
+  for (int j = 0; j < model.dof(); ++j) csvRow(out, label + ",-,-,breakaway", model.joint(j).name, robot.breakaway[j]);
+  for (std::size_t p = 0; p < robot.postures.size(); ++p) {
+    const PostureResult& r = robot.postures[p];
+    const std::string posture = label + "," + (*robot.robot->postures)[p].name;
+    for (int k = 0; k < model.nq(); ++k) csvRow(out, posture + ",-,q", qName(model, k), r.q[k]);
+    for (int v = 0; v < energy::kVariantCount; ++v) {
+      const VariantResult& e = r.variant[v];
+      const std::string key = posture + "," + energy::kVariants[v].name;
+      for (int j = 0; j < model.dof(); ++j) csvRow(out, key + ",tau", model.joint(j).name, e.tau[j]);
+      for (int j = 0; j < model.dof(); ++j) csvRow(out, key + ",mu", model.joint(j).name, e.mu[j]);
+      for (Eigen::Index k = 0; k < e.ground.size(); ++k)
+        csvRow(out, key + ",ground", groundName(*robot.robot, k), e.ground[k]);
+      csvRow(out, key + ",effort", "tau_norm", e.effort.norm);
+      csvRow(out, key + ",effort", "tau_sq", e.effort.sq);
+      csvRow(out, key + ",effort", "tau_abs_sum", e.effort.abs_sum);
+      if (energy::kVariants[v].margin >= 0) csvRow(out, key + ",effort", "tau_sq_least", e.least_sq);
+      if (energy::kVariants[v].margin < 0) csvRow(out, key + ",effort", "tau_sq_best_split", r.best_split.sq);
+    }
+  }
+}
+
+std::string csvText(const std::vector<RobotResult>& robots) {
+  std::ostringstream out;
+  out << "robot,posture,variant,quantity,name,value\n";
+  for (const RobotResult& robot : robots) csvRobot(out, robot);
+  return out.str();
+}
+
+std::vector<std::string> postureNames(const RobotResult& robot) {
+  std::vector<std::string> names;
+  for (const Posture& posture : *robot.robot->postures) names.push_back(posture.name);
+  return names;
+}
+
+std::vector<energy::VariantEfforts> effortsOf(const RobotResult& robot) {
+  std::vector<energy::VariantEfforts> efforts;
+  for (const PostureResult& r : robot.postures)
+    efforts.push_back({r.variant[0].effort, r.variant[1].effort, r.variant[2].effort});
+  return efforts;
+}
+
+std::string jointsBlock(const RobotResult& robot, std::size_t p) {
+  return std::string("$joints_") + robot.robot->label + "_" + (*robot.robot->postures)[p].name;
+}
+
+// Text for a gnuplot title in enhanced mode: "_" would start a subscript.
+std::string enhancedText(const std::string& text) {
+  std::string escaped;
+  for (const char c : text) escaped += c == '_' ? std::string("\\\\_") : std::string(1, c);
+  return escaped;
+}
+
+// The effort chart (one panel per robot) and one per-joint chart per robot.
+std::string plotScript(const std::vector<RobotResult>& robots) {
+  std::ostringstream s;
+  s << "# Generated by `zwang energy`; run it in this directory: gnuplot standing_energy.gp\n"
+       "set encoding utf8\n"
+       "set datafile separator whitespace\n";
+  for (const RobotResult& robot : robots) {
+    s << energy::normsData(std::string("$norms_") + robot.robot->label, "posture", postureNames(robot),
+                           effortsOf(robot));
+    std::vector<std::string> labels;
+    for (const Joint& joint : robot.model.joints()) labels.push_back(joint.name);
+    for (std::size_t p = 0; p < robot.postures.size(); ++p) {
+      const PostureResult& r = robot.postures[p];
+      s << energy::jointsData(jointsBlock(robot, p), labels, {r.variant[0].tau, r.variant[1].tau, r.variant[2].tau},
+                              robot.breakaway);
+    }
+  }
+  s << energy::histogramStyle(robots[0].postures.size())
+    << "\n"
+       "set terminal pngcairo size 1100,520 font \"DejaVu Sans,11\"\n"
+       "set output \"standing_energy.png\"\n"
+       "set multiplot layout 1,2 title \"Standing still on the ground: motor effort ‖τ_{control}‖\"\n"
+       "set ylabel \"‖τ_{control}‖ [N·m]\"\n"
+       "set xtics noenhanced\n";
+  for (const RobotResult& robot : robots)
+    s << "set title \"" << robot.robot->title << "\" noenhanced\n"
+      << "set xrange [-0.6:" << static_cast<double>(robot.postures.size()) - 0.4 << "]\n"
+      << energy::normsPlot(std::string("$norms_") + robot.robot->label);
+  s << "unset multiplot\n";
+  for (const RobotResult& robot : robots) {
+    const bool tall = robot.postures.size() > 2;
+    s << "\nset terminal pngcairo size " << (tall ? "1500,1200" : "1300,520") << " font \"DejaVu Sans,10\"\n"
+      << "set output \"standing_" << robot.robot->label << "_joints.png\"\n"
+      << "set multiplot layout " << (tall ? robot.postures.size() : 1) << "," << (tall ? 1 : robot.postures.size())
+      << " title \"" << enhancedText(robot.robot->title)
+      << " standing: |τ_{control,j}| per joint (bars) and breakaway friction f_j (red)\"\n"
+      << energy::jointsPanelStyle(static_cast<std::size_t>(robot.model.dof()))
+      << "set xlabel \"\"\n"                 // the joints' names say it
+         "set offsets 0, 0, graph 0.3, 0\n"  // room for the key above the bars
+         "set xtics rotate by -45 noenhanced font \",8\"\n"
+      << "set bmargin 6\n";
+    for (std::size_t p = 0; p < robot.postures.size(); ++p)
+      s << energy::jointsPanel(jointsBlock(robot, p), (*robot.robot->postures)[p].name, p == 0);
+    s << "unset multiplot\n";
+  }
+  s << "unset output\n";
+  return s.str();
+}
+
+void printPostures(const RobotResult& robot) {
+  std::printf(
+      "\npostures: the base pose (placed so the feet are on z = 0%s, their midpoint at the origin), how far the\n"
+      "feet are off it, the centre of mass across gravity [m], the mass from RNEA [kg], the closest joint limit [rad]\n",
+      flatFeet(*robot.robot) ? " and level" : "");
+  std::vector<std::vector<std::string>> rows{{"posture", "what", "base z", "base pitch",
+                                              robot.robot->waist ? "waist" : "", "feet off", "com x", "com y", "mass",
+                                              "closest limit"}};
+  for (std::size_t p = 0; p < robot.postures.size(); ++p) {
+    const PostureResult& r = robot.postures[p];
+    const Eigen::Quaterniond orientation(r.q[3], r.q[4], r.q[5], r.q[6]);
+    const double pitch = std::atan2(-orientation.toRotationMatrix()(2, 0), orientation.toRotationMatrix()(2, 2));
+    const std::string waist =
+        robot.robot->waist ? fmt(r.q[7 + robot.model.jointIndex(robot.robot->waist)], "%.4f") : "";
+    rows.push_back({(*robot.robot->postures)[p].name, (*robot.robot->postures)[p].what, fmt(r.q[2], "%.4f"),
+                    fmt(pitch, "%.4f"), waist, small(r.placement_error), fmt(r.com.x(), "%.3f"), fmt(r.com.y(), "%.3f"),
+                    fmt(r.mass, "%.2f"), fmt(r.limit_distance, "%.3f")});
+  }
+  printColumns(rows, 2);
+}
+
+void printTorques(const RobotResult& robot) {
+  std::printf("\ntau_control per joint [N·m] (m = margin of the friction-aware solve)\n");
+  std::vector<std::vector<std::string>> rows{{"joint"}, {""}};
+  for (const Posture& posture : *robot.robot->postures)
+    for (int v = 0; v < energy::kVariantCount; ++v) {
+      rows[0].push_back(v == 0 ? posture.name : "");
+      rows[1].push_back(v == 0 ? "plain" : (v == 1 ? "m=0.5" : "m=1"));
+    }
+  for (int j = 0; j < robot.model.dof(); ++j) {
+    std::vector<std::string> row{robot.model.joint(j).name};
+    for (const PostureResult& r : robot.postures)
+      for (const VariantResult& e : r.variant) row.push_back(fmt(e.tau[j], "%.3g"));
+    rows.push_back(row);
+  }
+  printColumns(rows);
+}
+
+// The joints whose plain holding torque is above the URDF's <limit effort>.
+void printEffortLimits(const RobotResult& robot) {
+  std::string over;
+  for (std::size_t p = 0; p < robot.postures.size(); ++p)
+    for (int j = 0; j < robot.model.dof(); ++j) {
+      const double tau = robot.postures[p].variant[0].tau[j], limit = robot.model.joint(j).effort_limit;
+      if (std::abs(tau) > limit)
+        over += std::string(over.empty() ? "" : ", ") + (*robot.robot->postures)[p].name + " " +
+                robot.model.joint(j).name + " " + fmt(std::abs(tau), "%.3g") + " > " + fmt(limit);
+    }
+  std::printf("above the URDF's effort limit (|tau| plain > <limit effort>) [N·m]: %s\n",
+              over.empty() ? "none" : over.c_str());
+}
+
+void printGround(const RobotResult& robot) {
+  const bool flat = flatFeet(*robot.robot);
+  std::printf("\nthe ground's force on each foot: nu of the contact rows, world axes at the foot origin [N%s]%s\n",
+              flat ? ", N·m" : "", flat ? "; cop = centre of pressure relative to the foot origin [m]" : "");
+  std::vector<std::vector<std::string>> rows{{"posture", "variant", "foot", "fx", "fy", "fz"}};
+  if (flat) rows[0].insert(rows[0].end(), {"nx", "ny", "nz", "cop x", "cop y"});
+  for (std::size_t p = 0; p < robot.postures.size(); ++p)
+    for (int v = 0; v < energy::kVariantCount; v += 2)  // plain and margin 1
+      for (std::size_t k = 0; k < robot.robot->feet.size(); ++k) {
+        const Eigen::VectorXd w = robot.postures[p].variant[v].ground.segment(
+            robot.robot->contact_rows * static_cast<Eigen::Index>(k), robot.robot->contact_rows);
+        std::vector<std::string> row{k == 0 && v == 0 ? (*robot.robot->postures)[p].name : "",
+                                     k == 0 ? energy::kVariants[v].name : "", robot.robot->feet[k]};
+        for (Eigen::Index c = 0; c < w.size(); ++c) row.push_back(fmt(w[c], "%.4g"));
+        if (flat) row.insert(row.end(), {fmt(-w[4] / w[2], "%.4f"), fmt(w[3] / w[2], "%.4f")});
+        rows.push_back(row);
+      }
+  printColumns(rows, 3);
+}
+
+// The friction-aware solve's ‖τ_control‖² against the least possible in the
+// same margin box (leastEffort), and how far its μ is from that optimum.
+void printLeastEffort(const RobotResult& robot) {
+  std::printf(
+      "\nleast effort [N²m²]: plain |tau|^2 with the solver's least-norm split, and with the split of the ground's\n"
+      "force that needs the least motor effort (best split, over the internal forces, no friction; ft/fn = the\n"
+      "largest horizontal over vertical force it puts on a foot); friction-aware |tau|^2 against the least possible\n"
+      "over the same margin box (a dense box QP on tau_control(mu), the least-norm split moving with mu); kkt = how\n"
+      "far the solve's mu is from that QP's optimality conditions [N·m]\n");
+  std::vector<std::vector<std::string>> rows{{"posture", "|tau|^2 plain", "best split", "its ft/fn", "|tau|^2 m=0.5",
+                                              "least m=0.5", "above", "kkt m=0.5", "|tau|^2 m=1", "least m=1", "above",
+                                              "kkt m=1"}};
+  for (std::size_t p = 0; p < robot.postures.size(); ++p) {
+    const PostureResult& r = robot.postures[p];
+    std::vector<std::string> row{(*robot.robot->postures)[p].name, fmt(r.variant[0].effort.sq), fmt(r.best_split.sq),
+                                 fmt(r.best_split.tangential, "%.3f")};
+    for (int v = 1; v < energy::kVariantCount; ++v) {
+      const VariantResult& e = r.variant[v];
+      row.push_back(fmt(e.effort.sq));
+      row.push_back(fmt(e.least_sq));
+      const double above = 100.0 * (e.effort.sq / e.least_sq - 1.0);  // %; below 5e-4 % is rounding of the two QPs
+      row.push_back(fmt(std::abs(above) < 5e-4 ? 0.0 : above, "%.3f") + " %");
+      row.push_back(small(e.kkt));
+    }
+    rows.push_back(row);
+  }
+  printColumns(rows);
+}
+
+void printChecks(const RobotResult& robot) {
+  double worst[6] = {0, 0, 0, 0, 0, 0};
+  for (const PostureResult& p : robot.postures) {
+    const double values[6] = {p.worst_qdd,   p.worst_rnea,          p.worst_split,
+                              p.worst_bound, p.worst_reference_kkt, p.split_shift};
+    for (int k = 0; k < 6; ++k) worst[k] = std::max(worst[k], values[k]);
+  }
+  std::printf(
+      "check: rank %d in every solve; within 1e-9: |qdd| (worst %s), RNEA with the ground's wrenches on the feet\n"
+      "gives 0 on the base and tau_control - mu on the joints (worst %s), nu = the least-norm solution of the\n"
+      "dense balance G^T nu = RNEA + [0; mu] (worst %s), |mu| <= margin*f (worst excess %s), the least-effort\n"
+      "reference meets its optimality conditions (worst %s); |tau|^2 between the least possible and plain's.\n"
+      "The split moves with friction: tau_control - mu at margin 1 differs from plain by up to %s N·m\n",
+      robot.model.nv(), small(worst[0]).c_str(), small(worst[1]).c_str(), small(worst[2]).c_str(),
+      small(worst[3]).c_str(), small(worst[4]).c_str(), fmt(worst[5], "%.3g").c_str());
+}
+
+bool printRobot(const RobotResult& robot) {
+  const StandingRobot& r = *robot.robot;
+  const Model& model = robot.model;
+  std::error_code ec;
+  const std::filesystem::path proximate = std::filesystem::proximate(robot.urdf, ec);
+  std::printf("\nzwang energy: %s on a free base (%d joints, nv %d) standing still, at rest, gravity (0, 0, -9.81)\n",
+              (ec ? robot.urdf : proximate).string().c_str(), model.dof(), model.nv());
+  const int contacts = r.contact_rows * static_cast<int>(r.feet.size());
+  std::printf(
+      "task: %zu feet fixed, %d contact rows each (%s, world axes; the ground's force, not in tau_control) + one\n"
+      "joint row per joint (qdd_j = 0, its motor): %d rows, rank %d = nv, so qdd = 0; the %d rows beyond the rank\n"
+      "are the ground's statically indeterminate split between the feet, which the solver takes least-norm\n",
+      r.feet.size(), r.contact_rows, r.contact_rows == 6 ? "force and moment" : "force", contacts + model.dof(),
+      model.nv(), contacts + model.dof() - model.nv());
+  std::printf("breakaway friction f [N·m] (chosen, not in the URDF):");
+  for (int j = 0; j < model.dof(); ++j) std::printf(" %s", fmt(robot.breakaway[j]).c_str());
+  std::printf("\n");
+  printPostures(robot);
+  printTorques(robot);
+  printEffortLimits(robot);
+  printGround(robot);
+  std::vector<bool> ok;
+  for (const PostureResult& p : robot.postures) ok.push_back(p.ok);
+  energy::printEffortTable("posture", postureNames(robot), effortsOf(robot), ok);
+  printLeastEffort(robot);
+  printChecks(robot);
+  return std::all_of(ok.begin(), ok.end(), [](bool b) { return b; });
+}
+
+bool printAndWrite(const ReportCommand& report, const std::vector<RobotResult>& robots, bool plot) {
+  bool all_ok = true;
+  for (const RobotResult& robot : robots) all_ok = printRobot(robot) && all_ok;
+  writeOutput((report.out / "standing_energy.csv").string(), csvText(robots));
+  std::printf(
+      "wrote %s/standing_energy.csv (robot, posture, variant, quantity, name, value: q, tau = tau_control, mu,\n"
+      "ground = nu of the contacts, effort; breakaway per joint)\n",
+      report.out.string().c_str());
+  writePlots(report, "standing_energy.gp", plotScript(robots),
+             "standing_energy.png, standing_humanoid_joints.png, standing_solo12_joints.png", plot);
+  return all_ok;
+}
+
+}  // namespace
+
+std::function<bool(bool)> prepareStandingEnergy(const ReportCommand& report) {
+  std::vector<RobotResult> robots;
+  for (const StandingRobot& robot : kRobots) robots.push_back(runRobot(report, robot));
+  return [&report, robots = std::move(robots)](bool plot) { return printAndWrite(report, robots, plot); };
+}
+
+}  // namespace zwang::cli

@@ -20,6 +20,15 @@ SLOPE_SIZES = [16, 32, 64, 128]
 TREE_SIZES = [7, 16, 32, 64, 128]
 TREE_BRANCHING = [2, 4]  # next to b = 1, the chain
 TREE_LIMIT = 1.15  # issue 14: a tree's cost per body at most 15 % above the chain's
+# Issue 15: floating bases, and the fixed-base chains of the same size (N = the robot's nv, N = its joints).
+FLOATING_ROBOTS = [("humanoid", "humanoid (`simple_humanoid.urdf`)", 35, 29), ("solo12", "solo12 (`solo12.urdf`)", 18, 12)]
+FLOATING_FRICTION_LIMIT = 4.0  # issue 15: friction with every joint stuck at most 4× the plain solve
+FLOATING_FAMILIES = [  # floating_<family>/<model>, in the tables' column order
+    ("hd_m0", "plain, no rows"),
+    ("hd_m12", "plain, 12 rows"),
+    ("fric_as_m0_kall", "friction, all stuck, no rows"),
+    ("fric_as_m12_kall", "friction, all stuck, 12 rows"),
+]
 
 # Table rows, in order, with a description.
 FAMILIES = [
@@ -221,6 +230,83 @@ def tree_section(w, medians, counters, ctx):
         w("")
 
 
+def floating_name(family, model):
+    return f"floating_{family}/{model}"
+
+
+def floating_models(medians):
+    """The robots and chains that have a floating benchmark, robots first, each robot followed by its chains."""
+    out = []
+    for robot, _, nv, dof in FLOATING_ROBOTS:
+        for model in (robot, f"chain_N={nv}", f"chain_N={dof}"):
+            if model not in out and any(floating_name(f, model) in medians for f, _ in FLOATING_FAMILIES):
+                out.append(model)
+    return out
+
+
+def floating_per_dof(medians, counters, family, model):
+    t = medians.get(floating_name(family, model))
+    nv = counters.get(floating_name(family, model), {}).get("nv")
+    return t / nv if t is not None and nv else None
+
+
+def floating_section(w, medians, counters, ctx):
+    models = floating_models(medians)
+    if not models:
+        return
+    w("## Floating bases (issue 15)")
+    w("")
+    w("Two robots on a free base (`UrdfOptions::base = BaseType::Free`), standing at rest (q̇ = 0, τ = 0: the")
+    w("motors off) with the base upright at the height that puts the feet on the ground:")
+    w("`models/simple_humanoid.urdf` (29 joints, nv = 35) on both feet, each foot a 6-row `Task::addContact` in")
+    w("world axes (its ankle link: the file has no soles), and `models/solo12.urdf` (12 joints, nv = 18) on its")
+    w("four point feet, 3 linear rows each: **12 rows** either way; *no rows*: the same robot in free fall.")
+    w(f"Poses: {ctx.get('zwang_floating_poses', '?')}.")
+    w("*Friction, all stuck*: `solveWithFriction` (active set) with every joint stuck (q̇ = 0) and every breakaway")
+    w(f"friction set to {ctx.get('zwang_floating_breakaway', '?')} N·m (`ModelBuilder::setFriction`), so that all")
+    w("joints stay stuck (the bench checks it before timing): the maximiser works on all of them.")
+    w("*The chain of the same size*: the chain benchmarks' `randomChain` (same seed and pose, q̇ = 0, the same")
+    w("friction) on a fixed base with N = the robot's nv (as many velocity coordinates: q̈ of the same length) or")
+    w("N = its joints (the same joints without the base); its 12 rows hold the last link and the middle link")
+    w("(6 each, contacts in world axes). Cost per DOF: time / nv (a chain's nv is N).")
+    w("")
+    w("**Time per solve** (median CPU time [ns])")
+    w("")
+    w("| model | joints | nv | " + " | ".join(text for _, text in FLOATING_FAMILIES)
+      + " | friction / plain, 12 rows | maximiser iterations (12 rows) |")
+    w("|---|---|---|" + "---|" * len(FLOATING_FAMILIES) + "---|---|")
+    for model in models:
+        c = next((counters[floating_name(f, model)] for f, _ in FLOATING_FAMILIES
+                  if floating_name(f, model) in counters), {})
+        cells = [f"`{model}`", f"{c.get('N', 0):.0f}", f"{c.get('nv', 0):.0f}"]
+        cells += [fmt_ns(medians.get(floating_name(f, model))) for f, _ in FLOATING_FAMILIES]
+        cells.append(fmt_ratio(ratio(medians, floating_name("fric_as_m12_kall", model),
+                                     floating_name("hd_m12", model))))
+        it = counters.get(floating_name("fric_as_m12_kall", model), {})
+        cells.append("—" if "iterations" not in it else f"{it['iterations']:.0f}"
+                     + (" (μ* not unique)" if it.get("indeterminate") else ""))
+        w("| " + " | ".join(cells) + " |")
+    w("")
+    w("**Cost per DOF** (time / nv [ns]), and the robot's against the chain with N = its nv")
+    w("")
+    w("| model | " + " | ".join(text for _, text in FLOATING_FAMILIES) + " |")
+    w("|---|" + "---|" * len(FLOATING_FAMILIES))
+    for model in models:
+        w(f"| `{model}` | " + " | ".join(fmt_ns(floating_per_dof(medians, counters, f, model))
+                                         for f, _ in FLOATING_FAMILIES) + " |")
+    for robot, _, nv, dof in FLOATING_ROBOTS:
+        for n, what in ((nv, "per DOF, the same nv"), (dof, "per DOF, the same joints")):
+            chain = f"chain_N={n}"
+            cells = []
+            for f, _ in FLOATING_FAMILIES:
+                a = floating_per_dof(medians, counters, f, robot)
+                b = floating_per_dof(medians, counters, f, chain)
+                cells.append(fmt_ratio(a / b if a is not None and b else None))
+            if any(c != "—" for c in cells):
+                w(f"| {robot} / `{chain}` ({what}) | " + " | ".join(cells) + " |")
+    w("")
+
+
 def cpu_model():
     try:
         with open("/proc/cpuinfo") as f:
@@ -407,6 +493,18 @@ def main():
                     target_row(f"tree b = {b} / chain, {ttext}, worst over every N = 7…128 (at N = {at_all}; "
                                "a leaf with fewer than 6 joints above it: rank < 6, the least-squares path)",
                                worst_all, "—", None)
+    # Issue 15: friction with every joint stuck at most 4× the plain solve, on the two floating robots; their
+    # cost per DOF against the fixed-base chain with as many DOF, for information.
+    for robot, _, nv, dof in FLOATING_ROBOTS:
+        r = ratio(med, floating_name("fric_as_m12_kall", robot), floating_name("hd_m12", robot))
+        if r is not None:
+            target_row(f"{robot} (free base, {dof} joints, 12 foot rows), all joints stuck: friction (active set) / "
+                       "plain solve", r, f"≤ {FLOATING_FRICTION_LIMIT:g}×", lambda v: v <= FLOATING_FRICTION_LIMIT)
+        for family, text in (("hd_m0", "plain, no rows"), ("hd_m12", "plain, 12 rows")):
+            a = floating_per_dof(med, counters, family, robot)
+            b = floating_per_dof(med, counters, family, f"chain_N={nv}")
+            if a is not None and b:
+                target_row(f"{robot} cost per DOF / fixed-base chain N = {nv} (its nv), {text}", a / b, "—", None)
     w("## The issue's targets")
     w("")
     w("| ratio | measured | target | |")
@@ -436,6 +534,7 @@ def main():
               f"{fmt_ns(c.get('p99.99_ns'))} | {fmt_ns(c.get('max_ns'))} |")
         w("")
     tree_section(w, med, counters, ctx)
+    floating_section(w, med, counters, ctx)
     w("## Friction solve versus the report's methods")
     w("")
     w("Time of the method divided by the time of `solveWithFriction` (active set) on the same problem.")

@@ -31,6 +31,18 @@
 //                          pose: 12 rows (each hand, tool0, held still in world axes) or 6 rows (the left
 //                          hand held to the right one: Task::addRelativeConstraint, the right hand's axes);
 //                          plain (solveHybridDynamics) and with friction, all 15 joints stuck (q̇ = 0)
+// Floating bases (issue 15):
+//   floating_hd_{m0,m12}/<robot>, floating_fric_as_{m0,m12}_kall/<robot>
+//                          <robot> = humanoid (models/simple_humanoid.urdf, 29 joints, free base, nv = 35)
+//                          or solo12 (models/solo12.urdf, 12 joints, free base, nv = 18), standing at rest
+//                          (q̇ = 0, τ = 0); m12: the feet held by contacts (Task::addContact, world axes):
+//                          6 rows per humanoid foot, 3 linear rows per solo12 foot; m0: no rows (free
+//                          fall). plain (solveHybridDynamics) and with friction, every joint stuck (breakaway
+//                          friction raised to kStuckBreakaway so that all stay stuck; checked before timing)
+//                          <robot> = chain_N=<n>: the fixed-base random chain of the chain benchmarks
+//                          (randomChain, same seed) with n = nv or n = dof of a robot (35, 29, 18, 12), the
+//                          same friction, at rest; m12: contacts holding the last link and the middle link
+//                          (6 rows each, world axes); extra counters nv and bodies (moving bodies)
 // Solvers, workspaces, tasks and KDL arrays are made outside the timed loops.
 // Before anything is timed, main() checks that ours and KDL solve the same
 // problems (q̈ and RNEA torques) and puts the largest differences into the
@@ -80,6 +92,9 @@ struct Problem {
   std::string tip2;         // dual arm: the other hand (the right one; tip is the left)
   int branching = 0;        // trees: children per body (1: the chain); 0: not a tree benchmark
   int depth = 0;            // trees: joints from the base to `tip`
+  // floating benchmarks: the frames held by contacts, with their rows (6: the
+  // whole acceleration, 3: the linear part), world axes
+  std::vector<std::pair<std::string, int>> feet;
 };
 
 constexpr std::uint64_t kSeed = 0x2a5eedULL;  // fixed: the same chains in every run
@@ -274,6 +289,135 @@ std::string dualPandaHands(const Problem& p) {
     out += buffer;
   }
   return out;
+}
+
+// ---------------------------------------------------------------------------
+// Floating bases and their fixed-base baselines
+
+// Every joint's breakaway friction for the floating benchmarks' friction solves
+// [N·m]: far above what gravity asks of any joint of these robots (the humanoid
+// weighs about 100 kg on legs 0.65 m long: at most some 640 N·m), so that every
+// stuck joint sticks and the maximiser works on all of them; main() checks it.
+constexpr double kStuckBreakaway = 1e4;
+
+Model withStuckFriction(const Model& model) {
+  ModelBuilder builder(model);
+  for (const Joint& j : model.joints())
+    builder.setFriction(j.name, kStuckBreakaway, j.kinetic_friction, j.viscous_friction);
+  return builder.build();
+}
+
+// Lifts a free base (identity orientation, at the origin in q) so that the
+// lowest of the feet's frames is at z = 0; returns the feet's positions.
+std::string standOnFeet(Problem& p) {
+  Workspace ws(p.model, 0);
+  if (!forwardKinematics(p.model, ws, p.q)) throw std::runtime_error(p.label + ": forward kinematics failed");
+  std::vector<Eigen::Vector3d> feet;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& foot : p.feet) {
+    Eigen::Isometry3d pose;
+    if (!framePose(p.model, ws, p.model.frameIndex(foot.first), pose))
+      throw std::runtime_error(p.label + ": framePose failed");
+    feet.push_back(pose.translation());
+    lowest = std::min(lowest, pose.translation().z());
+  }
+  p.q[2] = -lowest;
+  std::string out = p.label + ": base at z = " + std::to_string(p.q[2]).substr(0, 6) + " m, feet";
+  for (std::size_t f = 0; f < feet.size(); ++f) {
+    char buffer[96];
+    std::snprintf(buffer, sizeof buffer, " %s (%.3f, %.3f, %.3f)", p.feet[f].first.c_str(), feet[f].x(), feet[f].y(),
+                  feet[f].z() - lowest);
+    out += buffer;
+  }
+  return out;
+}
+
+// The smallest distance of a joint from its limits in the problem's pose [rad].
+double limitMargin(const Problem& p) {
+  double margin = std::numeric_limits<double>::infinity();
+  const int offset = p.model.baseConfigurationSize();
+  for (int j = 0; j < p.model.dof(); ++j) {
+    const Joint& joint = p.model.joint(j);
+    margin = std::min({margin, p.q[offset + j] - joint.lower, joint.upper - p.q[offset + j]});
+  }
+  return margin;
+}
+
+// A free-base robot from models/, at rest (q̇ = 0, τ = 0), its base upright at
+// the height that puts its feet on the ground.
+std::unique_ptr<Problem> floatingRobotProblem(const std::string& label, const std::string& file,
+                                              const std::vector<std::pair<std::string, double>>& pose,
+                                              const std::vector<std::pair<std::string, int>>& feet,
+                                              std::string* description) {
+  UrdfOptions options;
+  options.base = BaseType::Free;
+  auto p = std::make_unique<Problem>();
+  p->label = label;
+  p->model = withStuckFriction(loadUrdfFile(std::string(ZWANG_BENCH_MODELS_DIR) + "/" + file, options));
+  p->n = p->model.dof();
+  p->q = Eigen::VectorXd::Zero(p->model.nq());
+  p->q[3] = 1.0;  // quaternion w: upright
+  for (const auto& [joint, value] : pose) p->q[7 + p->model.jointIndex(joint)] = value;
+  p->qd = Eigen::VectorXd::Zero(p->model.nv());
+  p->tau = Eigen::VectorXd::Zero(p->model.nv());  // motors off: friction and the contacts carry the robot
+  p->feet = feet;
+  *description = standOnFeet(*p);
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, ", every joint at least %.3f rad inside its limits", limitMargin(*p));
+  *description += buffer;
+  if (!(limitMargin(*p) > 0.01)) throw std::runtime_error(label + ": a joint is at or beyond a limit");
+  return p;
+}
+
+// models/simple_humanoid.urdf standing on both feet, knees slightly bent (hip
+// pitch + knee + ankle pitch = 0 keeps the soles level). The file has no sole
+// links: the ankle links (r_ankle, l_ankle) are the feet. Its limits are not
+// mirrored left to right (the knees' ranges are [0, 2.618] and [−2.095, 0.7]),
+// hence the values: one posture inside both sides' ranges.
+std::unique_ptr<Problem> humanoidProblem(std::string* description) {
+  std::vector<std::pair<std::string, double>> pose;
+  for (const char* side : {"RLEG_", "LLEG_"})
+    for (const auto& [joint, value] : {std::pair{"HIP_P", -0.3}, std::pair{"KNEE", 0.25}, std::pair{"ANKLE_P", 0.05}})
+      pose.emplace_back(std::string(side) + joint, value);
+  for (const char* side : {"RARM_", "LARM_"})
+    for (const auto& [joint, value] :
+         {std::pair{"SHOULDER_R", 0.1}, std::pair{"ELBOW", -0.3}, std::pair{"WRIST_Y", -0.1}})
+      pose.emplace_back(std::string(side) + joint, value);
+  auto p =
+      floatingRobotProblem("humanoid", "simple_humanoid.urdf", pose, {{"r_ankle", 6}, {"l_ankle", 6}}, description);
+  if (p->n != 29) throw std::runtime_error("humanoid: not 29 joints");
+  return p;
+}
+
+// models/solo12.urdf standing on its four point feet (the crouch
+// test/python/test_floating.py uses: knees 1.6 rad, front and hind legs mirrored).
+std::unique_ptr<Problem> solo12Problem(std::string* description) {
+  std::vector<std::pair<std::string, double>> pose;
+  for (const char* leg : {"FL_", "FR_"}) {
+    pose.emplace_back(std::string(leg) + "HFE", 0.8);
+    pose.emplace_back(std::string(leg) + "KFE", -1.6);
+  }
+  for (const char* leg : {"HL_", "HR_"}) {
+    pose.emplace_back(std::string(leg) + "HFE", -0.8);
+    pose.emplace_back(std::string(leg) + "KFE", 1.6);
+  }
+  auto p = floatingRobotProblem("solo12", "solo12.urdf", pose,
+                                {{"FL_FOOT", 3}, {"FR_FOOT", 3}, {"HL_FOOT", 3}, {"HR_FOOT", 3}}, description);
+  if (p->n != 12) throw std::runtime_error("solo12: not 12 joints");
+  return p;
+}
+
+// The fixed-base baseline: the random chain of the chain benchmarks (same
+// seed, same pose) at rest, with the robots' friction; m12 holds its last
+// and its middle link (6 rows each).
+std::unique_ptr<Problem> floatingBaselineChain(int n) {
+  auto p = randomProblemOfSize(n);
+  p->label = "chain_N=" + std::to_string(n);
+  p->model = withStuckFriction(p->model);
+  p->qd.setZero();
+  p->tau.setZero();
+  p->feet = {{p->tip, 6}, {p->middle, 6}};
+  return p;
 }
 
 // ---------------------------------------------------------------------------
@@ -518,6 +662,68 @@ void benchWorstCase(benchmark::State& state, const Problem* p, TaskKind kind, in
 }
 
 // ---------------------------------------------------------------------------
+// Floating bases: the robots and their fixed-base chains, plain and with every
+// joint stuck.
+
+Task floatingTask(const Problem& p, bool held) {
+  Task task(p.model);
+  task.gravity = p.gravity;
+  if (held)
+    for (const auto& [frame, rows] : p.feet)
+      task.addContact(frame, ConstraintMatrix::Identity(6, 6).leftCols(rows), Expressed::World);
+  return task;
+}
+
+void setFloatingCounters(benchmark::State& state, const Problem& p, int m, int k) {
+  setCounters(state, p, m, k);
+  state.counters["nv"] = p.model.nv();
+  state.counters["bodies"] = p.model.hasFloatingBase() ? p.model.bodyCount() : p.model.dof();  // moving ones
+}
+
+void benchFloatingHybrid(benchmark::State& state, const Problem* p, bool held) {
+  const Task task = floatingTask(*p, held);
+  Workspace ws(p->model, task);
+  if (Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws); !s) {
+    state.SkipWithError(s.message);
+    return;
+  }
+  const int rank = ws.solution.balance.rank;
+  for (auto _ : state) {
+    const Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  setFloatingCounters(state, *p, task.constraintRows(), 0);
+  state.counters["rank"] = rank;
+}
+
+void benchFloatingFriction(benchmark::State& state, const Problem* p, bool held) {
+  const Task task = floatingTask(*p, held);
+  Workspace ws(p->model, task);
+  if (Status s = solveWithFriction(p->model, task, p->q, p->qd, p->tau, ws); !s) {
+    state.SkipWithError(s.message);
+    return;
+  }
+  // Every joint stuck (q̇ = 0) and staying stuck: what the benchmark is about.
+  if (static_cast<int>(ws.friction.stuck.size()) != p->n ||
+      std::any_of(ws.friction.state.begin(), ws.friction.state.end(),
+                  [](JointState js) { return js != JointState::Stick; })) {
+    state.SkipWithError("not every joint sticks");
+    return;
+  }
+  for (auto _ : state) {
+    const Status s = solveWithFriction(p->model, task, p->q, p->qd, p->tau, ws);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  setFloatingCounters(state, *p, task.constraintRows(), p->n);
+  state.counters["iterations"] = ws.friction.iterations;
+  state.counters["indeterminate"] = ws.friction.indeterminate ? 1 : 0;
+}
+
+// ---------------------------------------------------------------------------
 // Static friction: the report's method and a naive gradient method, both
 // calling the full solver (solveHybridDynamics) for every evaluation of g.
 //
@@ -697,12 +903,20 @@ std::string fmt(double x) {
 int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Problem>> problems, trees;
   std::unique_ptr<Problem> dual;
+  std::vector<std::unique_ptr<Problem>> floating;  // the robots first, then their chains
+  std::string floating_poses;
   try {
     for (int n : {1, 2, 4, 7, 16, 32, 64, 128}) problems.push_back(randomProblemOfSize(n));
     problems.push_back(pandaProblem());
     for (int n : {7, 16, 32, 64, 128})
       for (int b : {1, 2, 4}) trees.push_back(treeProblemOfSize(n, b));
     dual = dualPandaProblem();
+    std::string humanoid_pose, solo_pose;
+    floating.push_back(humanoidProblem(&humanoid_pose));
+    floating.push_back(solo12Problem(&solo_pose));
+    floating_poses = humanoid_pose + "; " + solo_pose;
+    // The chains of the same size: as many joints as each robot's nv, and as its dof.
+    for (int n : {35, 29, 18, 12}) floating.push_back(floatingBaselineChain(n));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "zwang_bench: %s\n", e.what());
     return 1;
@@ -722,6 +936,8 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("zwang_build_type", ZWANG_BENCH_BUILD_TYPE);
   benchmark::AddCustomContext("zwang_chain_seed", std::to_string(kSeed));
   benchmark::AddCustomContext("zwang_dual_panda_hands", dualPandaHands(*dual));
+  benchmark::AddCustomContext("zwang_floating_poses", floating_poses);
+  benchmark::AddCustomContext("zwang_floating_breakaway", fmt(kStuckBreakaway));
 
   auto reg = [](const std::string& family, const Problem& p, auto&& fn) {
     benchmark::RegisterBenchmark((family + "/" + p.label).c_str(), fn)->Unit(benchmark::kNanosecond);
@@ -789,6 +1005,16 @@ int main(int argc, char** argv) {
     reg(std::string("fric_as_") + name + "_kall", *dual, [q = dual.get(), kind = kind](benchmark::State& s) {
       benchFriction(s, q, kind, q->n, FrictionMethod::ActiveSet);
     });
+
+  // Floating bases and the chains of the same size.
+  for (const bool held : {false, true}) {
+    const std::string rows = held ? "m12" : "m0";
+    for (const auto& p : floating)
+      reg("floating_hd_" + rows, *p, [q = p.get(), held](benchmark::State& s) { benchFloatingHybrid(s, q, held); });
+    for (const auto& p : floating)
+      reg("floating_fric_as_" + rows + "_kall", *p,
+          [q = p.get(), held](benchmark::State& s) { benchFloatingFriction(s, q, held); });
+  }
 
   // Worst case over 10⁶ calls, Panda with every joint stuck (plain and 6 rows).
   for (const auto& p : problems)

@@ -47,7 +47,77 @@ Transform basePose(const Model& model, const VectorRef& q_base) {
   return Transform::fromPose(R, p);
 }
 
+// A free base's D₀ = I^A₀ is always 6 × 6: its Cholesky factor L seen as a
+// fixed-size matrix (the storage of a 6 × 6 MatrixXmax6 is a plain
+// column-major 6 × 6 array). Through the dynamic-size (at most 6) types Eigen
+// takes its general triangular-solve and product kernels: the base's step took
+// 8,200 of the 62,300 instructions of the humanoid's plain solve, 2,900 this
+// way (callgrind, inclusive counts under solveHybridDynamics, zwang_bench's
+// floating_hd_m0/humanoid). The substitutions multiply by the reciprocals of
+// L's diagonal, found once: a division inside them would sit on each
+// right-hand side's chain of dependent operations.
+struct FreeBaseFactor {
+  explicit FreeBaseFactor(const Workspace& ws)
+      : L(ws.D_base.matrixLLT().data()), inverse_diagonal(L.diagonal().cwiseInverse()) {}
+  // X ← D₀⁻¹ X for a 6-row X (its columns in lock step): a Vec6 or a Mat6.
+  template <typename Rhs>
+  void solveInPlace(Rhs&& X) const {
+    for (int i = 0; i < 6; ++i) {  // L Y = X
+      for (int j = 0; j < i; ++j) X.row(i) -= L(i, j) * X.row(j);
+      X.row(i) *= inverse_diagonal[i];
+    }
+    for (int i = 5; i >= 0; --i) {  // Lᵀ X = Y
+      for (int j = i + 1; j < 6; ++j) X.row(i) -= L(j, i) * X.row(j);
+      X.row(i) *= inverse_diagonal[i];
+    }
+  }
+  Eigen::Map<const Mat6> L;
+  Vec6 inverse_diagonal;
+};
+
+// Lines 13–21 for a free base, S₀ = 1: I^A₀ S₀ = I^A₀, D₀ = I^A₀ and S₀ᵀ A₀ =
+// A₀, with fixed-size arithmetic. The same quantities as the general path
+// (baseInward below), without its products with the identity.
+void freeBaseInward(const Task& task, const Vec6& pA, Workspace& ws) {
+  const int m = task.solverColumns();
+  const FreeBaseFactor factor(ws);
+  ws.IAS_base = ws.IA[0];
+  ws.u_base -= pA;
+  // ‖D₀⁻¹‖₁ is the scale rounding in 𝓛 is judged against (L_scale): only
+  // for it is the inverse formed. D₀⁻¹ A₀ below comes from solves with the
+  // factor, backward stable where the explicit inverse is not: I^A₀ is taken
+  // about the world origin, ill-conditioned for a base far from it.
+  Mat6 D_inverse = Mat6::Identity();
+  factor.solveInPlace(D_inverse);
+  ws.base_D_inverse_norm = D_inverse.cwiseAbs().colwise().sum().maxCoeff();
+  Vec6 u_D = ws.u_base;
+  factor.solveInPlace(u_D);
+
+  ConstraintMatrix& A = ws.Ahat;
+  ws.SA_base.leftCols(m) = A.leftCols(m);  // S₀ᵀ A₀
+  for (int col = 0; col < m; ++col) {
+    const Vec6 a = A.col(col);
+    Vec6 a_D = a;  // D₀⁻¹ S₀ᵀ A₀, a column at a time: fixed sizes throughout
+    factor.solveInPlace(a_D);
+    ws.SA_base_D.col(col) = a_D;
+    ws.L_scale[col] += a.squaredNorm() * ws.base_D_inverse_norm;
+    ws.U[col] += a.dot(ws.c[0]) + a.dot(u_D);                                            // line 20
+    for (int r = col; r < m; ++r) ws.L(r, col) += ws.SA_base.col(r).head<6>().dot(a_D);  // line 21, lower triangle
+  }
+  A.leftCols(m).setZero();  // line 19: P^A₀ = 0 exactly, I^A₀ (I^A₀)⁻¹ = 1
+}
+
 }  // namespace
+
+void baseSolveInPlace(const Model& model, const Workspace& ws, VectorXmax6& x) {
+  if (model.baseType() == BaseType::Free) {
+    Vec6 y = x;
+    FreeBaseFactor(ws).solveInPlace(y);
+    x = y;
+  } else {
+    x = ws.D_base.solve(x);
+  }
+}
 
 void baseKinematics(const Model& model, const VectorRef& q_base, const VectorRef& v_base, Workspace& ws,
                     bool with_inertia) {
@@ -95,9 +165,13 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
   Vec6 pA = ws.FA[0];
   pA.noalias() += IA * ws.c[0];  // F^A₀ + I^A₀ Ẍ_bias,0
   const Matrix6Xmax& S = ws.S_base;
-  ws.IAS_base.noalias() = IA * S;
-  const MatrixXmax6 D = S.transpose() * ws.IAS_base;  // line 13 (no rotor inertia at the base)
-  ws.D_base.compute(D);
+  const bool free = model.baseType() == BaseType::Free;
+  if (free) {
+    ws.D_base.compute(IA);  // line 13: D₀ = I^A₀ (S₀ = 1, no rotor inertia at the base)
+  } else {
+    ws.IAS_base.noalias() = IA * S;
+    ws.D_base.compute(S.transpose() * ws.IAS_base);  // line 13 (no rotor inertia at the base)
+  }
   if (ws.D_base.info() != Eigen::Success || !(ws.D_base.matrixLLT().diagonal().minCoeff() > 1e-150))
     return Status::error(StatusCode::Degenerate,
                          "the %s base has no inertia to move here (D₀ is not positive definite): the robot "
@@ -105,13 +179,14 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
                          toString(model.baseType()));
   // u₀ = τ₀ − S₀ᵀ(F^A₀ + I^A₀ Ẍ_bias,0), τ₀ in the sweep's coordinates: for a
   // free base the wrench ⁰X_B* τ_B whose power with Ẋ₀ is τ_Bᵀ v_B.
-  if (model.baseType() == BaseType::Free) {
+  if (free) {
     Vec6 tauB;
     tauB << tau_base.head<3>(), tau_base.tail<3>();
-    ws.u_base = ws.Xworld[0].inverseApplyForce(tauB) - pA;
-  } else {
-    ws.u_base = tau_base - S.transpose() * pA;
+    ws.u_base = ws.Xworld[0].inverseApplyForce(tauB);
+    freeBaseInward(task, pA, ws);
+    return {};
   }
+  ws.u_base = tau_base - S.transpose() * pA;
   const MatrixXmax6 D_inverse = ws.D_base.solve(MatrixXmax6::Identity(k, k));
   ws.base_D_inverse_norm = D_inverse.cwiseAbs().colwise().sum().maxCoeff();
   const VectorXmax6 u_D = ws.D_base.solve(ws.u_base);
@@ -127,16 +202,22 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
     ws.U[col] += A.col(col).dot(ws.c[0]) + sA.col(col).dot(u_D);                 // line 20
     for (int r = col; r < m; ++r) ws.L(r, col) += sA.col(r).dot(sA_D.col(col));  // line 21, lower triangle
   }
-  if (model.baseType() == BaseType::Free)
-    A.leftCols(m).setZero();  // P^A₀ = 0 exactly: I^A₀ (I^A₀)⁻¹ = 1
-  else
-    A.leftCols(m).noalias() -= ws.IAS_base * sA_D;  // line 19
+  A.leftCols(m).noalias() -= ws.IAS_base * sA_D;  // line 19 (a free base took freeBaseInward)
   return {};
 }
 
 void baseAcceleration(const Model& model, const Task& task, Workspace& ws) {
   const int m = task.solverColumns();
   const Vec6 a_world = gravityAcceleration(task.gravity);
+  if (model.baseType() == BaseType::Free) {  // S₀ = 1, I^A₀ S₀ = I^A₀: the same lines in fixed sizes
+    Vec6 rhs = ws.u_base;
+    rhs.noalias() -= ws.IA[0].transpose() * a_world;
+    rhs.noalias() += ws.SA_base.leftCols(m) * ws.nu.head(m);  // A₀ ν
+    FreeBaseFactor(ws).solveInPlace(rhs);                     // line 28
+    ws.qdd_base = rhs;
+    ws.a[0] = a_world + rhs + ws.c[0];  // line 29
+    return;
+  }
   VectorXmax6 rhs = ws.u_base;
   rhs.noalias() -= ws.IAS_base.transpose() * a_world;
   rhs.noalias() += ws.SA_base.topLeftCorner(model.baseVelocitySize(), m) * ws.nu.head(m);  // S₀ᵀ A₀ ν

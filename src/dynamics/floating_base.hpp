@@ -27,6 +27,9 @@ void baseKinematics(const Model& model, const VectorRef& q_base, const VectorRef
 // D₀ is not positive definite.
 Status baseInward(const Model& model, const Task& task, const VectorRef& tau_base, Workspace& ws);
 
+// x ← D₀⁻¹ x (k entries) with the factorisation baseInward made.
+void baseSolveInPlace(const Model& model, const Workspace& ws, VectorXmax6& x);
+
 // Lines 28–29 for the base joint, from ws.nu: q̈₀ (ws.qdd_base) and Ẍ₀ (ws.a[0]).
 void baseAcceleration(const Model& model, const Task& task, Workspace& ws);
 

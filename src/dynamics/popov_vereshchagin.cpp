@@ -392,9 +392,14 @@ namespace {
 void baseUnitTorques(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Matrix6X>& dF,
                      Eigen::Ref<Eigen::MatrixXd> du_base, Eigen::Ref<Eigen::MatrixXd> dU) {
   const int kb = model.baseVelocitySize();
+  const bool free = model.baseType() == BaseType::Free;
   for (Eigen::Index c = 0; c < dF.cols(); ++c) {
-    du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));
-    const VectorXmax6 du_D = ws.D_base.solve(du_base.col(c).head(kb));
+    if (free)
+      du_base.col(c).head<6>() = -dF.col(c);  // S₀ = 1
+    else
+      du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));
+    VectorXmax6 du_D = du_base.col(c).head(kb);
+    baseSolveInPlace(model, ws, du_D);
     for (int r = 0; r < m; ++r) dU(r, c) += ws.SA_base.col(r).head(kb).dot(du_D);
   }
 }
@@ -458,10 +463,13 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   da.col(0).setZero();
   for (Eigen::Index c = 0; c < k; ++c) {
     if (floating) {
-      VectorXmax6 rhs = du_base.col(c).head(kb);
-      rhs.noalias() += ws.SA_base.topLeftCorner(kb, m) * dnu.col(c).head(m);
-      const VectorXmax6 dq_base = ws.D_base.solve(rhs);
-      da.col(0) = ws.S_base * dq_base;
+      VectorXmax6 dq_base = du_base.col(c).head(kb);
+      dq_base.noalias() += ws.SA_base.topLeftCorner(kb, m) * dnu.col(c).head(m);
+      baseSolveInPlace(model, ws, dq_base);
+      if (model.baseType() == BaseType::Free)
+        da.col(0) = dq_base;  // S₀ = 1
+      else
+        da.col(0) = ws.S_base * dq_base;
       publishBaseAcceleration(model, ws, dq_base, dqdd.col(c).head(kb));
     }
     for (int i = 1; i <= N; ++i) {

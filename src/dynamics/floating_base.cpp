@@ -110,7 +110,8 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
     tauB << tau_base.head<3>(), tau_base.tail<3>();
     ws.u_base = ws.Xworld[0].inverseApplyForce(tauB) - pA;
   } else {
-    ws.u_base = tau_base - S.transpose() * pA;
+    ws.u_base = tau_base;  // in two steps: `tau_base − Sᵀ pA` made a heap temporary for the product
+    ws.u_base.noalias() -= S.transpose() * pA;
   }
   const MatrixXmax6 D_inverse = ws.D_base.solve(MatrixXmax6::Identity(k, k));
   ws.base_D_inverse_norm = D_inverse.cwiseAbs().colwise().sum().maxCoeff();

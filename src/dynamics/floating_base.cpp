@@ -186,7 +186,8 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
     freeBaseInward(task, pA, ws);
     return {};
   }
-  ws.u_base = tau_base - S.transpose() * pA;
+  ws.u_base = tau_base;  // in two steps: `tau_base − Sᵀ pA` made a heap temporary for the product
+  ws.u_base.noalias() -= S.transpose() * pA;
   const MatrixXmax6 D_inverse = ws.D_base.solve(MatrixXmax6::Identity(k, k));
   ws.base_D_inverse_norm = D_inverse.cwiseAbs().colwise().sum().maxCoeff();
   const VectorXmax6 u_D = ws.D_base.solve(ws.u_base);

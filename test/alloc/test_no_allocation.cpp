@@ -1,7 +1,13 @@
-// Once the workspace exists, the hot-path calls make no heap allocation.
+// Once the workspace exists, the hot-path calls make no heap allocation: the
+// replaced malloc (counting_malloc.cpp) counts every allocation of the calls,
+// on the Panda, trees, and floating bases (the humanoid, solo12, random trees).
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <random>
+#include <string>
 #include <type_traits>
+#include <utility>
 
 #include "counting_malloc.hpp"
 #include "support/bad_inputs.hpp"
@@ -373,4 +379,197 @@ TEST_CASE("a tree with constraints on two branches and a relative constraint all
   });
   CHECK(all_ok);
   CHECK(count == 0);
+}
+
+// ---------------------------------------------------------------------------
+// Floating bases (issue #15): the same promise with a free or planar base —
+// the base's step in every sweep, contacts, joint rows, the friction
+// maximiser with the base's rows in ∂q̈/∂μ, the least-effort choice and the
+// errors only a floating base has. Real robots (the humanoid on two feet,
+// solo12 on four) loaded with the base option, and random trees.
+
+namespace {
+
+// A floating problem ready to solve: the model, a task with contacts and
+// joint rows, a state (some joints stuck) and the friction options.
+struct FloatingCase {
+  Model model;
+  Task task;
+  Eigen::VectorXd q, v, tau;
+  FrictionOptions options;
+  explicit FloatingCase(Model m) : model(std::move(m)), task(model) {}
+};
+
+// The state every case starts from: the base at the origin (free: turned a
+// little, moving), the joints at q_j = 0.1·sin(j) moving at 0.3, except every
+// third joint stuck.
+void baseState(FloatingCase& c) {
+  const Model& m = c.model;
+  c.q = Eigen::VectorXd::Zero(m.nq());
+  c.v = Eigen::VectorXd::Zero(m.nv());
+  c.tau = Eigen::VectorXd::Zero(m.nv());
+  const int iq = m.baseConfigurationSize(), iv = m.baseVelocitySize();
+  if (m.baseType() == BaseType::Free) {
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
+    c.q.segment<4>(3) << turn.w(), turn.x(), turn.y(), turn.z();
+  }
+  for (int k = 0; k < iv; ++k) c.v[k] = 0.1 * (k + 1);
+  for (int j = 0; j < m.dof(); ++j) {
+    c.q[iq + j] = std::clamp(0.1 * std::sin(j), m.joint(j).lower, m.joint(j).upper);
+    c.v[iv + j] = j % 3 == 0 ? 0.0 : 0.3;
+    c.tau[iv + j] = std::cos(j);
+  }
+}
+
+// The humanoid standing on both ankles (6 world rows each), each arm's
+// elbow held by its motor (a joint row on a stuck joint: μ* is not unique
+// there), friction from per-solve overrides (its URDF has none).
+FloatingCase humanoidOnTwoFeet(BaseType base) {
+  UrdfOptions options;
+  options.base = base;
+  FloatingCase c(loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/simple_humanoid.urdf", options));
+  c.task.addContact("l_ankle", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  c.task.addContact("r_ankle", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  c.task.addJointConstraint("LARM_ELBOW");
+  c.task.addJointConstraint("RARM_ELBOW");
+  baseState(c);
+  c.v[c.model.baseVelocitySize() + c.model.jointIndex("LARM_ELBOW")] = 0.0;
+  c.v[c.model.baseVelocitySize() + c.model.jointIndex("RARM_ELBOW")] = 0.0;
+  c.options.breakaway = Eigen::VectorXd::Constant(c.model.dof(), 5.0);
+  return c;
+}
+
+// solo12 on its four feet (3 world rows each: point contacts), its own friction.
+FloatingCase soloOnFourFeet(BaseType base) {
+  UrdfOptions options;
+  options.base = base;
+  FloatingCase c(loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/solo12.urdf", options));
+  for (const char* foot : {"FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"})
+    c.task.addContact(foot, ConstraintMatrix::Identity(6, 3), Expressed::World);
+  baseState(c);
+  return c;
+}
+
+// A random 10-joint tree with a frame row on a branch, a relative row, a
+// joint row, a contact and a wrench.
+FloatingCase randomFloatingTree(BaseType base, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  zwang::testing::RandomTreeOptions tree;
+  tree.min_moving_joints = tree.max_moving_joints = 10;
+  const zwang::testing::ChainSpec spec = zwang::testing::randomTree(rng, tree);
+  zwang::testing::FloatingBase kind;
+  kind.kind = base == BaseType::Free ? zwang::testing::BaseKind::Free : zwang::testing::BaseKind::Planar;
+  FloatingCase c(zwang::testing::floatingModelFromSpec(spec, kind));
+  const int last = c.model.bodyFrame(c.model.bodyCount() - 1);
+  c.task.addConstraint(c.model.bodyFrame(4), ConstraintMatrix::Identity(6, 2), Expressed::World);
+  c.task.addRelativeConstraint(last, c.model.bodyFrame(2), ConstraintMatrix::Identity(6, 1));
+  c.task.addJointConstraint(5);
+  c.task.addContact(c.model.bodyFrame(7), ConstraintMatrix::Identity(6, 3), Expressed::World);
+  c.task.wrench(c.task.addWrench(last, Expressed::World)) << 1, 2, 3, 0.1, 0.2, 0.3;
+  baseState(c);
+  return c;
+}
+
+// Everything a control cycle calls on a floating model, counted after a
+// warm-up: the plain solve, friction by both maximisers, RNEA, CRBA, a
+// Jacobian; every status kept for the caller to check.
+struct FloatingCounts {
+  long allocations = 0;
+  bool ok = true;
+  std::string first_error;
+  bool indeterminate = false;
+  int stuck = 0;
+};
+
+FloatingCounts countFloatingSolves(FloatingCase& c) {
+  Workspace ws(c.model, c.task);
+  FrictionOptions gradient = c.options;
+  gradient.method = FrictionMethod::ProjectedGradient;
+  Eigen::MatrixXd J(6, c.model.nv());
+  const int frame = c.model.bodyFrame(c.model.bodyCount() - 1);
+  Status statuses[6];
+  const auto cycle = [&] {
+    statuses[0] = solveHybridDynamics(c.model, c.task, c.q, c.v, c.tau, ws);
+    statuses[1] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, gradient);
+    statuses[2] = inverseDynamics(c.model, c.task, c.q, c.v, c.tau, ws);
+    statuses[3] = jointSpaceInertia(c.model, c.q, ws);
+    statuses[4] = frameJacobian(c.model, ws, c.q, frame, Expressed::World, J);
+    statuses[5] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options);  // last: its result is read
+  };
+  cycle();  // warm
+  FloatingCounts out;
+  out.allocations = allocationsDuring(cycle);
+  for (const Status& s : statuses)
+    if (!s.ok() && out.ok) {
+      out.ok = false;
+      out.first_error = s.message;
+    }
+  out.indeterminate = ws.friction.indeterminate;
+  out.stuck = static_cast<int>(ws.friction.stuck.size());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("floating bases: humanoid, solo12 and random trees allocate nothing (plain, friction, RNEA, CRBA)",
+          "[floating]") {
+  for (const BaseType base : {BaseType::Free, BaseType::Planar}) {
+    FloatingCase cases[] = {humanoidOnTwoFeet(base), soloOnFourFeet(base), randomFloatingTree(base, 5),
+                            randomFloatingTree(base, 6)};
+    const char* names[] = {"humanoid on two feet", "solo12 on four feet", "random tree (seed 5)",
+                           "random tree (seed 6)"};
+    for (std::size_t k = 0; k < 4; ++k) {
+      INFO(toString(base) << " base, " << names[k]);
+      const FloatingCounts counts = countFloatingSolves(cases[k]);
+      INFO("first error: " << counts.first_error);
+      CHECK(counts.ok);
+      CHECK(counts.allocations == 0);
+      CHECK(counts.stuck > 0);
+      if (k == 0) CHECK(counts.indeterminate);  // the held elbows: the least-effort choice ran
+    }
+  }
+}
+
+TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the base's errors allocate nothing",
+          "[floating]") {
+  FloatingCase c = humanoidOnTwoFeet(BaseType::Free);
+  const int iq = c.model.baseConfigurationSize(), iv = c.model.baseVelocitySize();
+  const int knee = c.model.jointIndex("LLEG_KNEE");
+  c.q[iq + knee] = c.model.joint(knee).lower;  // stuck on its lower limit
+  c.v[iv + knee] = 0.0;
+  Workspace ws(c.model, c.task);
+  REQUIRE(solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options));  // warm
+  bool ok = false;
+  CHECK(allocationsDuring([&] { ok = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options).ok(); }) == 0);
+  CHECK(ok);
+
+  // The knee held on its limit and asked to accelerate into it: Infeasible.
+  Task into(c.model);
+  into.addJointConstraint(knee);
+  into.targets()[0] = -1.0;
+  Workspace ws_into(c.model, into);
+  Status status = solveWithFriction(c.model, into, c.q, c.v, c.tau, ws_into, c.options);  // warm
+  CHECK(allocationsDuring([&] { status = solveWithFriction(c.model, into, c.q, c.v, c.tau, ws_into, c.options); }) ==
+        0);
+  CHECK(status.code == StatusCode::Infeasible);
+
+  // A quaternion off unit length, a q of the fixed base's length, a workspace
+  // made for the fixed base.
+  Eigen::VectorXd off_unit = c.q;
+  off_unit.segment<4>(3) *= 1.01;
+  const Eigen::VectorXd joints_only = c.q.tail(c.model.dof());
+  const Model fixed = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/simple_humanoid.urdf");
+  Workspace ws_fixed(fixed, c.task.constraintRows());
+  StatusCode codes[4];
+  const long count = allocationsDuring([&] {
+    codes[0] = solveHybridDynamics(c.model, c.task, off_unit, c.v, c.tau, ws).code;
+    codes[1] = solveWithFriction(c.model, c.task, off_unit, c.v, c.tau, ws, c.options).code;
+    codes[2] = solveHybridDynamics(c.model, c.task, joints_only, c.v, c.tau, ws).code;
+    codes[3] = solveHybridDynamics(c.model, c.task, c.q, c.v, c.tau, ws_fixed).code;
+  });
+  CHECK(count == 0);
+  CHECK(codes[0] == StatusCode::BadConfiguration);
+  CHECK(codes[1] == StatusCode::BadConfiguration);
+  CHECK(codes[2] == StatusCode::SizeMismatch);
+  CHECK(codes[3] == StatusCode::ModelMismatch);
 }

@@ -3,13 +3,20 @@
 // 0–1e4, limits), a state (speeds to 1e3, joints exactly stuck or on a limit),
 // wrenches, constraints on up to three frames (random, repeated or on the base:
 // singular tasks), mimic joints (laws to any other joint: chains, cycles the
-// builder refuses, states on or off the law) and friction options. Calls solveHybridDynamics, both
-// friction maximisers, RNEA, CRBA and a Jacobian.
+// builder refuses, states on or off the law) and friction options; a base,
+// fixed, free or planar (a random plane), with the base link's own inertia, a
+// base state (a free base's quaternion unit, off unit by 1e-12–1e-2, or any,
+// zero included), base velocities and generalized forces; contacts and joint
+// rows among the task's rows. Calls solveHybridDynamics, both friction
+// maximisers, RNEA, CRBA and a Jacobian.
 //
 // Fails (abort) when a call that returns Ok — or Infeasible, whose outputs
 // docs/friction.md promises finite — leaves a NaN or Inf in its outputs, when a
-// maximiser reports more iterations than its cap, or when a status other than
-// the documented ones comes back.
+// maximiser reports more iterations than its cap, when a status other than
+// the documented ones comes back, or when a free base's quaternion is not
+// judged as docs/conventions.md says: a finite one off unit length by more
+// than kQuaternionNormTolerance must be BadConfiguration, one within it must
+// not, and normalizeConfiguration must fix every non-zero one.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
@@ -181,69 +188,147 @@ bool documented(StatusCode code) {
   return false;
 }
 
-}  // namespace
+// A free base's quaternion against docs/conventions.md ("Floating base"):
+// off unit length by more than kQuaternionNormTolerance ⇒ BadConfiguration,
+// within it ⇒ not; norms within rounding of the tolerance are not judged.
+void checkQuaternionVerdict(const Model& model, const Eigen::VectorXd& q, StatusCode code, const char* where) {
+  if (model.baseType() != BaseType::Free || !q.allFinite()) return;
+  const double off = std::abs(q.segment<4>(3).norm() - 1.0);
+  const double margin = 1e-12;  // the norm's own rounding is ~1e-16; well clear of it
+  if (off > kQuaternionNormTolerance + margin && code != StatusCode::BadConfiguration)
+    fuzz::failure("a quaternion off unit length beyond the tolerance was not refused", where);
+  if (off < kQuaternionNormTolerance - margin && code == StatusCode::BadConfiguration)
+    fuzz::failure("BadConfiguration for a quaternion within the tolerance", where);
+}
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  FuzzedDataProvider in(data, size);
-  Chain chain;
-  if (!buildChain(in, chain)) return 0;
-  const Model& model = chain.model;
-  const int n = model.dof();
-  const int frames = static_cast<int>(chain.frames.size());
+// The task as drawn, so that it can be made for the model it is solved on:
+// the draws that choose the base come after the task's (see
+// LLVMFuzzerTestOneInput). One entry per add call, in order.
+struct RowGroup {
+  enum class Kind { Frame, Relative, Contact, Joints } kind = Kind::Frame;
+  int frame = 0, reference = -1;
+  Expressed expressed = Expressed::Local;
+  ConstraintMatrix A;
+  std::vector<int> joints;  // Kind::Joints: one row each
+};
+struct WrenchDraw {
+  int frame;
+  Expressed expressed;
+  Vec6 value;
+};
+struct TaskDraw {
+  Vec3 gravity = Vec3::Zero();
+  std::vector<WrenchDraw> wrenches;
+  std::vector<RowGroup> groups;
+  Eigen::VectorXd targets;  // one per row, in the order of the groups
+  BalanceOptions balance;
+};
 
+void addGroup(const RowGroup& g, Task& task) {
+  switch (g.kind) {
+    case RowGroup::Kind::Frame: task.addConstraint(g.frame, g.A, g.expressed); break;
+    case RowGroup::Kind::Relative: task.addRelativeConstraint(g.frame, g.reference, g.A, g.expressed); break;
+    case RowGroup::Kind::Contact: task.addContact(g.frame, g.A, g.expressed); break;
+    case RowGroup::Kind::Joints:
+      for (const int j : g.joints) task.addJointConstraint(j);
+      break;
+  }
+}
+
+Task buildTask(const Model& model, const TaskDraw& draw) {
   Task task(model);
-  task.gravity = in.ConsumeBool() ? Vec3(0, 0, -9.81) : Vec3(9.81 * direction(in) * in.ConsumeProbability<double>());
+  task.gravity = draw.gravity;
+  for (const WrenchDraw& w : draw.wrenches) task.wrench(task.addWrench(w.frame, w.expressed)) = w.value;
+  for (const RowGroup& g : draw.groups) addGroup(g, task);
+  task.targets() = draw.targets;
+  task.balance = draw.balance;
+  return task;
+}
+
+// Gravity, wrenches, up to 8 frame rows (absolute or relative) in up to three
+// groups, set points, and the balance options anywhere in their valid ranges
+// (0 < rank_tolerance < singular_threshold < 1). `chain` is the fixed-base
+// model, whose task gives a repeated column its source.
+TaskDraw drawTask(FuzzedDataProvider& in, const Model& chain, int frames) {
+  TaskDraw draw;
+  Task task(chain);
+  draw.gravity = in.ConsumeBool() ? Vec3(0, 0, -9.81) : Vec3(9.81 * direction(in) * in.ConsumeProbability<double>());
   const int wrenches = in.ConsumeIntegralInRange(0, 3);
   for (int w = 0; w < wrenches; ++w) {
-    const int index = task.addWrench(in.ConsumeIntegralInRange(0, frames - 1),
-                                     in.ConsumeBool() ? Expressed::Local : Expressed::World);
-    for (int k = 0; k < 6; ++k) task.wrench(index)[k] = signedLog(in, 1e-3, 1e4);
+    WrenchDraw wrench{in.ConsumeIntegralInRange(0, frames - 1), in.ConsumeBool() ? Expressed::Local : Expressed::World,
+                      Vec6::Zero()};
+    for (int k = 0; k < 6; ++k) wrench.value[k] = signedLog(in, 1e-3, 1e4);
+    draw.wrenches.push_back(wrench);
   }
   int rows = in.ConsumeIntegralInRange(0, 8);
   const ConstraintMatrix* previous = nullptr;
   for (int g = 0; g < 3 && rows > 0; ++g) {
     const int here = g == 2 ? rows : in.ConsumeIntegralInRange(1, rows);
     rows -= here;
-    const ConstraintMatrix A = constraintColumns(in, here, previous);
-    const int frame = in.ConsumeIntegralInRange(0, frames - 1);  // 0: the fixed base (singular)
-    const int reference = in.ConsumeIntegralInRange(-1, frames - 1);
+    RowGroup group;
+    group.A = constraintColumns(in, here, previous);
+    group.frame = in.ConsumeIntegralInRange(0, frames - 1);  // 0: the base (fixed: singular)
+    group.reference = in.ConsumeIntegralInRange(-1, frames - 1);
     const int axes = in.ConsumeIntegralInRange(0, 2);
-    const Expressed expressed = axes == 0 ? Expressed::Local : axes == 1 ? Expressed::World : Expressed::Reference;
-    if (reference >= 0 && reference != frame)  // relative to another frame, on any branch
-      task.addRelativeConstraint(frame, reference, A, expressed);
-    else
-      task.addConstraint(frame, A, expressed);
+    group.expressed = axes == 0 ? Expressed::Local : axes == 1 ? Expressed::World : Expressed::Reference;
+    // relative to another frame, on any branch
+    group.kind =
+        group.reference >= 0 && group.reference != group.frame ? RowGroup::Kind::Relative : RowGroup::Kind::Frame;
+    addGroup(group, task);
+    draw.groups.push_back(group);
     previous = &task.groups().back().A;
   }
-  for (Eigen::Index r = 0; r < task.targets().size(); ++r) task.targets()[r] = signedLog(in, 1e-3, 1e3);
-  // The balance options anywhere in their valid ranges (0 < rank_tolerance < singular_threshold < 1).
-  task.balance.singular_threshold = in.ConsumeBool() ? 1e-6 : logUniform(in, 1e-16, 1e-1);
-  task.balance.rank_tolerance = in.ConsumeBool() ? std::min(1e-11, 0.5 * task.balance.singular_threshold)
-                                                 : task.balance.singular_threshold * logUniform(in, 1e-8, 0.99);
-  task.balance.residual_tolerance = in.ConsumeBool() ? 1e-9 : logUniform(in, 1e-14, 1e-3);
+  draw.targets.resize(task.constraintRows());
+  for (Eigen::Index r = 0; r < draw.targets.size(); ++r) draw.targets[r] = signedLog(in, 1e-3, 1e3);
+  draw.balance.singular_threshold = in.ConsumeBool() ? 1e-6 : logUniform(in, 1e-16, 1e-1);
+  draw.balance.rank_tolerance = in.ConsumeBool() ? std::min(1e-11, 0.5 * draw.balance.singular_threshold)
+                                                 : draw.balance.singular_threshold * logUniform(in, 1e-8, 0.99);
+  draw.balance.residual_tolerance = in.ConsumeBool() ? 1e-9 : logUniform(in, 1e-14, 1e-3);
+  return draw;
+}
 
-  Eigen::VectorXd q(n), qd(n), tau(n);
+// The joints' state: each on a limit or anywhere, exactly stuck or moving;
+// whether mimic joints are put on their law (90 %); occasionally one
+// non-finite entry (applied by applyJointState once the base is known).
+struct JointStateDraw {
+  Eigen::VectorXd q, qd, tau;
+  bool follow_leaders = true;
+  int poison = -1;          // the joint whose entry is not finite, −1: none
+  int poisoned_vector = 0;  // 0 q, 1 qd, 2 tau
+  double poison_value = 0.0;
+};
+
+JointStateDraw drawJointState(FuzzedDataProvider& in, const Model& chain) {
+  const int n = chain.dof();
+  JointStateDraw d;
+  d.q.resize(n);
+  d.qd.resize(n);
+  d.tau.resize(n);
   for (int j = 0; j < n; ++j) {
-    const Joint& joint = model.joint(j);
+    const Joint& joint = chain.joint(j);
     const int pick = in.ConsumeIntegralInRange(0, 3);
     if (pick == 0 && std::isfinite(joint.lower))
-      q[j] = joint.lower;
+      d.q[j] = joint.lower;
     else if (pick == 1 && std::isfinite(joint.upper))
-      q[j] = joint.upper;
+      d.q[j] = joint.upper;
     else
-      q[j] = in.ConsumeFloatingPointInRange(-10.0, 10.0);
-    qd[j] = in.ConsumeBool() ? 0.0 : signedLog(in, 1e-9, 1e3);
-    tau[j] = signedLog(in, 1e-3, 1e4);
+      d.q[j] = in.ConsumeFloatingPointInRange(-10.0, 10.0);
+    d.qd[j] = in.ConsumeBool() ? 0.0 : signedLog(in, 1e-9, 1e3);
+    d.tau[j] = signedLog(in, 1e-3, 1e4);
   }
-  if (in.ConsumeProbability<double>() < 0.9) model.followLeaders(q, qd);  // else most likely MimicMismatch
+  d.follow_leaders = in.ConsumeProbability<double>() < 0.9;  // else most likely MimicMismatch
   // Occasionally a non-finite input: must come back as NonFinite, not as a crash.
   const int poison = in.ConsumeIntegralInRange(0, 40);
   if (poison < n) {
-    Eigen::VectorXd* v[] = {&q, &qd, &tau};
-    (*v[in.ConsumeIntegralInRange(0, 2)])[poison] =
+    d.poison = poison;
+    d.poisoned_vector = in.ConsumeIntegralInRange(0, 2);
+    d.poison_value =
         in.ConsumeBool() ? std::numeric_limits<double>::quiet_NaN() : std::numeric_limits<double>::infinity();
   }
+  return d;
+}
 
+FrictionOptions drawFrictionOptions(FuzzedDataProvider& in, int n) {
   FrictionOptions options;
   options.velocity_tolerance = in.ConsumeBool() ? 1e-6 : logUniform(in, 1e-12, 1.0, 0.2);
   options.limit_tolerance = in.ConsumeBool() ? 1e-9 : logUniform(in, 1e-12, 1e-3, 0.2);
@@ -255,15 +340,107 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     options.breakaway.resize(n);
     for (int j = 0; j < n; ++j) options.breakaway[j] = logUniform(in, 1e-3, 1e4, 0.3);
   }
+  return options;
+}
 
-  Workspace ws(model, task);
+// A base for the chain: fixed (the chain as built), or free or planar (a
+// random plane) with the base link's own inertia. False when the builder
+// refuses it.
+bool drawBase(FuzzedDataProvider& in, Chain& chain) {
+  const int pick = in.ConsumeIntegralInRange(0, 2);
+  if (pick == 0) return true;
+  try {
+    ModelBuilder builder(chain.model);
+    builder.addBaseLinkInertia(body(in));
+    if (pick == 1)
+      builder.setBase(BaseType::Free);
+    else
+      builder.setBase(BaseType::Planar,
+                      Transform::fromPose(rotation(in), logUniform(in, 1e-3, 10.0, 0.5) * direction(in)));
+    chain.model = builder.build();
+  } catch (const ModelError&) {
+    return false;
+  }
+  return true;
+}
+
+// One more group of rows, none (a third of the inputs), a contact or joint
+// rows (one per row, on any joint: repeated ones are singular), with its set
+// points appended.
+void drawContactOrJointRows(FuzzedDataProvider& in, const Model& model, int frames, TaskDraw& draw) {
+  const int kind = in.ConsumeIntegralInRange(0, 2);
+  if (kind == 0) return;
+  const int rows = in.ConsumeIntegralInRange(1, 6);
+  RowGroup group;
+  if (kind == 1) {
+    group.kind = RowGroup::Kind::Contact;
+    group.A = constraintColumns(in, rows, nullptr);
+    group.frame = in.ConsumeIntegralInRange(0, frames - 1);
+    group.expressed = in.ConsumeBool() ? Expressed::Local : Expressed::World;
+  } else {
+    group.kind = RowGroup::Kind::Joints;
+    for (int r = 0; r < rows; ++r) group.joints.push_back(in.ConsumeIntegralInRange(0, model.dof() - 1));
+  }
+  draw.groups.push_back(group);
+  const Eigen::Index first = draw.targets.size();
+  draw.targets.conservativeResize(first + rows);
+  for (int r = 0; r < rows; ++r) draw.targets[first + r] = signedLog(in, 1e-3, 1e3);
+}
+
+// The base's coordinates, velocities and generalized forces (the first
+// entries of q, qd, tau). A free base's quaternion: unit (half the draws),
+// off unit by a relative 1e-12–1e-2 either way (across
+// kQuaternionNormTolerance), or as drawn (any norm up to 2, zero included).
+void drawBaseState(FuzzedDataProvider& in, const Model& model, Eigen::VectorXd& q, Eigen::VectorXd& qd,
+                   Eigen::VectorXd& tau) {
+  for (int k = 0; k < model.baseConfigurationSize(); ++k) q[k] = signedLog(in, 1e-3, 1e2);
+  if (model.baseType() == BaseType::Free) {
+    Eigen::Vector4d quat;
+    for (int k = 0; k < 4; ++k) quat[k] = in.ConsumeFloatingPointInRange(-1.0, 1.0);
+    const int pick = in.ConsumeIntegralInRange(0, 3);
+    if (pick <= 1 && quat.norm() > 0.0) quat.normalize();
+    if (pick == 1) quat *= 1.0 + (in.ConsumeBool() ? 1.0 : -1.0) * logUniform(in, 1e-12, 1e-2);
+    if (pick == 2) quat.setZero();
+    q.segment<4>(3) = quat;
+  }
+  const bool pushed = in.ConsumeProbability<double>() < 0.3;  // usually 0: no motor at the base
+  for (int k = 0; k < model.baseVelocitySize(); ++k) {
+    qd[k] = signedLog(in, 1e-9, 1e3);
+    tau[k] = pushed ? signedLog(in, 1e-3, 1e4) : 0.0;
+  }
+  // A non-finite base coordinate now and then (0, as when the bytes ran out: none).
+  const int poison = in.ConsumeIntegralInRange(0, 12);
+  if (poison >= 1 && poison <= model.baseConfigurationSize()) q[poison - 1] = std::numeric_limits<double>::infinity();
+}
+
+// q (nq), qd and tau (nv): the base's entries, then the joints' as drawn.
+void assembleState(FuzzedDataProvider& in, const Model& model, const JointStateDraw& joints, Eigen::VectorXd& q,
+                   Eigen::VectorXd& qd, Eigen::VectorXd& tau) {
+  q.setZero(model.nq());
+  qd.setZero(model.nv());
+  tau.setZero(model.nv());
+  const int iq = model.baseConfigurationSize(), iv = model.baseVelocitySize();
+  q.tail(model.dof()) = joints.q;
+  qd.tail(model.dof()) = joints.qd;
+  tau.tail(model.dof()) = joints.tau;
+  drawBaseState(in, model, q, qd, tau);
+  if (joints.follow_leaders) model.followLeaders(q, qd);
+  if (joints.poison >= 0) {
+    Eigen::VectorXd* v[] = {&q, &qd, &tau};
+    (*v[joints.poisoned_vector])[(joints.poisoned_vector == 0 ? iq : iv) + joints.poison] = joints.poison_value;
+  }
+}
+
+// The solves, each status documented, every output of a successful one finite.
+void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+               const Eigen::VectorXd& tau, FrictionOptions& options, Workspace& ws) {
   const bool finite_inputs = q.allFinite() && qd.allFinite() && tau.allFinite();
-
   Status status = solveHybridDynamics(model, task, q, qd, tau, ws);
   if (!documented(status.code)) fuzz::failure("undocumented status", "solveHybridDynamics");
   if (finite_inputs && status.code == StatusCode::NonFinite)
     fuzz::failure("NonFinite for finite inputs", status.message);
   if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "solveHybridDynamics");
+  checkQuaternionVerdict(model, q, status.code, "solveHybridDynamics");
   if (status.ok()) checkSolution(ws, "solveHybridDynamics");
 
   for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
@@ -273,6 +450,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     status = solveWithFriction(model, task, q, qd, tau, ws, options);
     if (!documented(status.code)) fuzz::failure("undocumented status", where);
     if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", where);
+    checkQuaternionVerdict(model, q, status.code, where);
     if (status.ok() || status.code == StatusCode::Infeasible) checkFriction(ws, options, where);
   }
 
@@ -284,9 +462,52 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       fuzz::failure("undocumented status", "inverseDynamics");
     status = jointSpaceInertia(model, q, ws);
     if (status.ok()) fuzz::requireFinite(ws.H, "H", "jointSpaceInertia");
-    Eigen::MatrixXd J(6, n);
-    status = frameJacobian(model, ws, q, frames - 1, Expressed::World, J);
+    Eigen::MatrixXd J(6, model.nv());
+    status = frameJacobian(model, ws, q, static_cast<int>(model.frames().size()) - 1, Expressed::World, J);
     if (status.ok()) fuzz::requireFinite(J, "J", "frameJacobian");
   }
+}
+
+// A free base's quaternion refused: normalizeConfiguration must fix any
+// finite non-zero one (docs/conventions.md), and the solve then take it.
+void checkNormalisation(const Model& model, const Task& task, Eigen::VectorXd q, const Eigen::VectorXd& qd,
+                        const Eigen::VectorXd& tau, Workspace& ws) {
+  if (model.baseType() != BaseType::Free || !q.allFinite()) return;
+  const Status normalised = normalizeConfiguration(model, q);
+  const bool zero = q.segment<4>(3).squaredNorm() == 0.0;
+  if (normalised.ok() == zero)
+    fuzz::failure("normalizeConfiguration: Ok exactly when the quaternion is non-zero", normalised.message);
+  if (!normalised.ok()) return;
+  const Status status = solveHybridDynamics(model, task, q, qd, tau, ws);
+  if (status.code == StatusCode::BadConfiguration)
+    fuzz::failure("BadConfiguration after normalizeConfiguration", status.message);
+  if (status.ok()) checkSolution(ws, "solveHybridDynamics (normalised q)");
+}
+
+}  // namespace
+
+// The draws of the fixed-base chain, its task, state and options come first,
+// in the order they always had, so that the seed corpus written before the
+// floating base (and the crash input found then) means what it meant: an
+// input whose bytes run out there, or right after, is a fixed base with
+// nothing more (every later draw is 0). Then the base, a contact or joint
+// rows, and the base's state.
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  FuzzedDataProvider in(data, size);
+  Chain chain;
+  if (!buildChain(in, chain)) return 0;
+  const int frames = static_cast<int>(chain.frames.size());
+  TaskDraw task_draw = drawTask(in, chain.model, frames);
+  const JointStateDraw joints = drawJointState(in, chain.model);
+  FrictionOptions options = drawFrictionOptions(in, chain.model.dof());
+  if (!drawBase(in, chain)) return 0;
+  const Model& model = chain.model;
+  drawContactOrJointRows(in, model, frames, task_draw);
+  const Task task = buildTask(model, task_draw);
+  Eigen::VectorXd q, qd, tau;
+  assembleState(in, model, joints, q, qd, tau);
+  Workspace ws(model, task);
+  runSolves(model, task, q, qd, tau, options, ws);
+  checkNormalisation(model, task, q, qd, tau, ws);
   return 0;
 }

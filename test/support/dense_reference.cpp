@@ -250,6 +250,8 @@ DenseResult denseDynamics(const ChainSpec& spec, const DynamicsInput& input) {
   for (const ConstraintInput& c : input.constraints) {
     if (c.b.size() != c.A.cols())
       throw std::invalid_argument("dense reference: constraint b must have A.cols() entries");
+    if (c.joint >= 0 || c.contact)
+      throw std::invalid_argument("dense reference: joint rows and contacts are floatingDynamics' (BaseKind::Fixed)");
     const int link = spec.linkIndex(c.link);
     const auto li = static_cast<std::size_t>(link);
     const Eigen::Vector3d p = kin.poses[li].translation();

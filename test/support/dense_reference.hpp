@@ -62,12 +62,23 @@ struct WrenchInput {
 // (the derivatives in r's frame of R_rᵀ d and R_rᵀ(ω − ω_r), turned back to
 // world axes), dotted with the columns; the wrench A ν acts on link and −A ν
 // on r, both at link's origin.
+//
+// Two kinds of row only floatingDynamics reads (denseDynamics refuses them;
+// a fixed base is BaseKind::Fixed there):
+//  * a joint row (Task::addJointConstraint), `joint` ≥ 0: q̈ of that moving
+//    joint (dof index) = b(0); A has one column, unused, and link is unused.
+//    Its force is a generalized force on the joint's own coordinate (its motor);
+//  * a contact (Task::addContact), `contact`: an absolute frame constraint
+//    whose force the environment supplies, so it moves the robot like any
+//    row but is left out of τ_c and τ_control.
 struct ConstraintInput {
   std::string link;
   Matrix6Xd A;
   Eigen::VectorXd b;
   Axes axes = Axes::Local;
   std::string relative_to;  // empty: absolute (relative to the world)
+  int joint = -1;           // ≥ 0: a joint row (see above)
+  bool contact = false;     // the environment's force (see above)
 };
 
 struct DynamicsInput {

@@ -128,6 +128,16 @@ Eigen::VectorXd generalizedForce(const ChainSpec& spec, const FloatingKinematics
 
 }  // namespace
 
+Eigen::VectorXd motorRows(const FloatingInput& input, int rows) {
+  Eigen::VectorXd motor = Eigen::VectorXd::Ones(rows);
+  int row = 0;
+  for (const ConstraintInput& c : input.constraints) {
+    if (c.contact) motor.segment(row, c.A.cols()).setZero();
+    row += static_cast<int>(c.A.cols());
+  }
+  return motor;
+}
+
 const char* toString(BaseKind kind) {
   switch (kind) {
     case BaseKind::Fixed: return "fixed";
@@ -318,6 +328,16 @@ FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base,
   for (const ConstraintInput& c : input.constraints) {
     if (c.b.size() != c.A.cols())
       throw std::invalid_argument("floating reference: constraint b must have A.cols() entries");
+    if (c.contact && (c.joint >= 0 || !c.relative_to.empty()))
+      throw std::invalid_argument("floating reference: a contact is an absolute frame constraint");
+    if (c.joint >= 0) {  // q̈_joint = b: its force is the joint's own generalized force
+      if (c.A.cols() != 1 || c.joint >= spec.dof())
+        throw std::invalid_argument("floating reference: a joint row has one column and a joint of the spec");
+      out.G(row, nb + c.joint) = 1.0;
+      out.gamma(row) = c.b(0);
+      ++row;
+      continue;
+    }
     if (!c.relative_to.empty()) {
       relativeRows(spec, kin, c, row, out.G, out.gamma);
       row += static_cast<int>(c.A.cols());
@@ -356,7 +376,7 @@ FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base,
   x += lu.solve(LongVector(rhs - K * x));
   out.qdd = x.head(n).cast<double>();
   out.nu = x.tail(m).cast<double>();
-  out.tau_c = out.G.transpose() * out.nu;
+  out.tau_c = out.G.transpose() * motorRows(input, m).cwiseProduct(out.nu);  // the contacts' force is not the motors'
   out.tau_control = input.tau + out.tau_c;
   for (const MimicLaw& law : spec.mimicLaws()) {
     out.tau_control(nb + law.leader) += law.multiplier * out.tau_control(nb + law.joint);

@@ -135,7 +135,14 @@ struct FloatingResult {
 };
 
 // Forward dynamics: the KKT system in long double (full-pivot LU, one refinement step).
+// Joint rows and contacts (ConstraintInput::joint, ::contact) are read here: a
+// joint row is the row e_jᵀ of its joint's coordinate; a contact is in G and
+// ν like any row, and out of tau_c and tau_control (τ_c = Gᵀ diag(motorRows) ν).
 FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base, const FloatingInput& input);
+
+// Per row of G (the input's rows, then `rows` − constraintRows() mimic rows):
+// 1 when the motors carry its force, 0 for a contact's.
+Eigen::VectorXd motorRows(const FloatingInput& input, int rows);
 
 // Z(v̇) = Σ_i ½ a_iᵀ I_i a_i + (v_i ×* I_i v_i − f_ext,i − f_grav,i)ᵀ a_i + Σ_j ½ d_j v̇_j² − τ_j v̇_j
 // (base entries included in the τ sum), a_i = J_i v̇ + J̇_i v, for any v̇ (constraints not applied).

@@ -9,6 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 
 #include "support/random_chain.hpp"
@@ -114,132 +115,341 @@ Eigen::VectorXd kineticTorque(const FrictionSetup& setup, const Eigen::VectorXd&
   return t;
 }
 
-FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
-                                     const BruteForceOptions& options) {
-  checkSetup(spec, input, setup);
-  const int n = spec.dof();
-  const int k = static_cast<int>(setup.stuck.size());
-  const DynamicsInput in = withKinetic(input, setup);  // τ' = τ + τ_kinetic
-  const DenseResult base = denseDynamics(spec, in);    // H, C, G, γ (independent of τ)
-  const int m = static_cast<int>(base.G.rows());
-  const Eigen::MatrixXd Hinv = base.H.llt().solve(Eigen::MatrixXd::Identity(n, n));
+namespace {
 
-  // The choices of each stuck joint (docs/friction.md, "Joint position limits").
-  std::vector<std::vector<Choice>> choices(static_cast<std::size_t>(k));
-  for (int s = 0; s < k; ++s) {
-    const int side = limitSide(setup, setup.stuck[static_cast<std::size_t>(s)]);
-    auto& c = choices[static_cast<std::size_t>(s)];
-    c.push_back(Choice::Stick);
-    if (side != 1) c.push_back(Choice::SlipPositive);   // not into the upper limit
-    if (side != -1) c.push_back(Choice::SlipNegative);  // not into the lower limit
+// The choices of each stuck coordinate (docs/friction.md, "Joint position limits").
+std::vector<std::vector<Choice>> patternChoices(const FrictionSystem& system) {
+  std::vector<std::vector<Choice>> choices(system.stuck.size());
+  for (std::size_t s = 0; s < system.stuck.size(); ++s) {
+    const int side = system.limit_side.size() == 0 ? 0 : system.limit_side(system.stuck[s]);
+    choices[s].push_back(Choice::Stick);
+    if (side != 1) choices[s].push_back(Choice::SlipPositive);   // not into the upper limit
+    if (side != -1) choices[s].push_back(Choice::SlipNegative);  // not into the lower limit
   }
+  return choices;
+}
+
+// The next pattern (mixed radix); false after the last.
+bool nextPattern(const std::vector<std::vector<Choice>>& choices, std::vector<int>& digit) {
+  for (std::size_t s = 0; s < digit.size(); ++s) {
+    if (++digit[s] < static_cast<int>(choices[s].size())) return true;
+    digit[s] = 0;
+  }
+  return false;
+}
+
+// True when [G; E_S] is rank deficient: its coupling matrix [G; E_S] H⁻¹ [G; E_S]ᵀ has
+// λ_min ≤ threshold·λ_max.
+bool singularRows(const Eigen::MatrixXd& rows, const Eigen::MatrixXd& Hinv, double threshold) {
+  if (rows.rows() == 0) return false;
+  const Eigen::MatrixXd L = rows * Hinv * rows.transpose();
+  const Eigen::VectorXd ev =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(0.5 * (L + L.transpose()), Eigen::EigenvaluesOnly).eigenvalues();
+  return !(ev(0) > threshold * ev(ev.size() - 1));
+}
+
+// τ_control of a pattern: the motors' τ plus the force of the rows they carry, the
+// leaders carrying their mimic joints' share.
+Eigen::VectorXd controlTorque(const FrictionSystem& system, const Eigen::VectorXd& nu) {
+  Eigen::VectorXd tau = system.tau_motor + system.G.transpose() * system.motor.cwiseProduct(nu);
+  for (const MimicLaw& law : system.mimic_laws) {  // resolved leaders are independent: any order
+    tau(law.leader) += law.multiplier * tau(law.joint);
+    tau(law.joint) = 0.0;
+  }
+  return tau;
+}
+
+// Maximum dissipation for a solved pattern (docs/theory.md §5; docs/friction.md,
+// "Joint position limits"); writes the pattern's letters.
+bool dissipates(const FrictionSystem& system, const std::vector<Choice>& chosen, const Eigen::VectorXd& qdd,
+                const Eigen::VectorXd& mu, const BruteForceOptions& options, std::string& pattern) {
+  const double f_scale = std::max(1.0, system.stuck.empty() ? 0.0 : system.breakaway.maxCoeff());
+  const double t_tol = options.torque_tolerance * std::max(f_scale, mu.cwiseAbs().maxCoeff());
+  const double a_tol = options.acceleration_tolerance * std::max(1.0, qdd.cwiseAbs().maxCoeff());
+  bool valid = true;
+  pattern.clear();
+  for (std::size_t s = 0; s < system.stuck.size(); ++s) {
+    const int j = system.stuck[s];
+    const int side = system.limit_side.size() == 0 ? 0 : system.limit_side(j);
+    const double f = system.breakaway(j);
+    if (chosen[s] == Choice::Stick) {
+      const bool above = mu(j) > f + t_tol, below = mu(j) < -f - t_tol;
+      if ((above && side <= 0) || (below && side >= 0)) valid = false;
+      pattern += (above || below) ? 'L' : 's';
+    } else if (chosen[s] == Choice::SlipPositive) {
+      if (qdd(j) < -a_tol) valid = false;
+      pattern += '+';
+    } else {
+      if (qdd(j) > a_tol) valid = false;
+      pattern += '-';
+    }
+  }
+  return valid;
+}
+
+// Record a valid pattern: the first becomes the reference's answer, the others
+// measure the spread.
+void addValidPattern(FrictionPattern pattern, FrictionReference& out) {
+  if (out.valid.empty()) {
+    out.feasible = true;
+    out.qdd = pattern.qdd;
+    out.mu = pattern.mu;
+    out.nu = pattern.nu;
+    out.tau_control = pattern.tau_control;
+    out.gauss_dual = pattern.gauss_dual;
+    out.pattern = pattern.pattern;
+  } else {
+    const Eigen::VectorXd d = pattern.qdd - out.qdd;
+    out.qdd_spread = std::max(out.qdd_spread, d.cwiseAbs().maxCoeff() / std::max(1.0, out.qdd.cwiseAbs().maxCoeff()));
+    out.gauss_spread = std::max(out.gauss_spread, std::abs(pattern.gauss_dual - out.gauss_dual) /
+                                                      std::max(1.0, std::abs(out.gauss_dual)));
+    out.mu_spread = std::max(out.mu_spread, (pattern.mu - out.mu).cwiseAbs().maxCoeff());
+  }
+  out.valid.push_back(std::move(pattern));
+  out.valid_patterns = static_cast<int>(out.valid.size());
+}
+
+// FrictionReference::pinned: the rows [G; e_jᵀ for every sticking j] rank deficient.
+bool pinnedSticking(const FrictionSystem& system, const Eigen::VectorXd& qdd, const Eigen::MatrixXd& Hinv,
+                    const BruteForceOptions& options) {
+  const double a_tol = options.acceleration_tolerance * std::max(1.0, qdd.cwiseAbs().maxCoeff());
+  std::vector<int> sticking;
+  for (const int j : system.stuck)
+    if (std::abs(qdd(j)) <= a_tol) sticking.push_back(j);
+  if (sticking.empty()) return false;
+  const auto m = system.G.rows();
+  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(m + static_cast<Eigen::Index>(sticking.size()), system.H.rows());
+  rows.topRows(m) = system.G;
+  for (std::size_t s = 0; s < sticking.size(); ++s) rows(m + static_cast<Eigen::Index>(s), sticking[s]) = 1.0;
+  return singularRows(rows, Hinv, options.singular_threshold);
+}
+
+}  // namespace
+
+FrictionReference bruteForceFriction(const FrictionSystem& system, const BruteForceOptions& options) {
+  const auto n = static_cast<int>(system.H.rows());
+  const auto m = static_cast<int>(system.G.rows());
+  const auto k = static_cast<int>(system.stuck.size());
+  const Eigen::MatrixXd Hinv = system.H.llt().solve(Eigen::MatrixXd::Identity(n, n));
+  const std::vector<std::vector<Choice>> choices = patternChoices(system);
 
   FrictionReference out;
-  out.tau_kinetic = in.tau - input.tau;
-  const double f_scale = std::max(1.0, k > 0 ? setup.breakaway.maxCoeff() : 0.0);
   std::vector<int> digit(static_cast<std::size_t>(k), 0);
-  for (;;) {
+  std::vector<Choice> chosen(static_cast<std::size_t>(k));
+  do {
     ++out.patterns;
-    // Build the pattern's system.
+    // The pattern's system: slipping coordinates get ∓f as a torque, sticking ones a row e_jᵀ ẍ = 0.
     std::vector<int> stick;
-    Eigen::VectorXd tau = in.tau;
+    Eigen::VectorXd tau = system.tau;
     Eigen::VectorXd mu = Eigen::VectorXd::Zero(n);
     for (int s = 0; s < k; ++s) {
-      const int j = setup.stuck[static_cast<std::size_t>(s)];
-      const Choice c =
-          choices[static_cast<std::size_t>(s)][static_cast<std::size_t>(digit[static_cast<std::size_t>(s)])];
-      if (c == Choice::Stick) {
+      const auto su = static_cast<std::size_t>(s);
+      const int j = system.stuck[su];
+      chosen[su] = choices[su][static_cast<std::size_t>(digit[su])];
+      if (chosen[su] == Choice::Stick) {
         stick.push_back(j);
       } else {
-        mu(j) = c == Choice::SlipPositive ? setup.breakaway(j) : -setup.breakaway(j);
-        tau(j) -= mu(j);  // the joint feels −μ_j
+        mu(j) = chosen[su] == Choice::SlipPositive ? system.breakaway(j) : -system.breakaway(j);
+        tau(j) -= mu(j);  // the coordinate feels −μ_j
       }
     }
     const int r = m + static_cast<int>(stick.size());
-    Eigen::MatrixXd Gaug = Eigen::MatrixXd::Zero(r, n);
+    Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(r, n);
     Eigen::VectorXd gamma = Eigen::VectorXd::Zero(r);
-    Gaug.topRows(m) = base.G;
-    gamma.head(m) = base.gamma;
-    for (std::size_t s = 0; s < stick.size(); ++s) Gaug(m + static_cast<int>(s), stick[s]) = 1.0;
-
-    bool singular = false;
-    if (r > 0) {
-      const Eigen::MatrixXd L = Gaug * Hinv * Gaug.transpose();
-      const Eigen::VectorXd ev =
-          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(0.5 * (L + L.transpose()), Eigen::EigenvaluesOnly)
-              .eigenvalues();
-      singular = !(ev(0) > options.singular_threshold * ev(ev.size() - 1));
-    }
-    if (singular) {
+    rows.topRows(m) = system.G;
+    gamma.head(m) = system.gamma;
+    for (std::size_t s = 0; s < stick.size(); ++s) rows(m + static_cast<int>(s), stick[s]) = 1.0;
+    if (singularRows(rows, Hinv, options.singular_threshold)) {
       ++out.singular_patterns;
-    } else {
-      const LongSolver solver(kktMatrix(base.H, Gaug));
-      Eigen::VectorXd rhs(n + r);
-      rhs << tau - base.C, gamma;
-      const Eigen::VectorXd x = solver.solve(rhs);
-      const Eigen::VectorXd qdd = x.head(n);
-      for (std::size_t s = 0; s < stick.size(); ++s) mu(stick[s]) = -x(n + m + static_cast<int>(s));
-
-      // Maximum dissipation (docs/theory.md §5; docs/friction.md, "Joint position limits").
-      const double t_tol = options.torque_tolerance * std::max(f_scale, mu.cwiseAbs().maxCoeff());
-      const double a_tol = options.acceleration_tolerance * std::max(1.0, qdd.cwiseAbs().maxCoeff());
-      bool valid = true;
-      std::string pattern;
-      for (int s = 0; s < k; ++s) {
-        const int j = setup.stuck[static_cast<std::size_t>(s)];
-        const int side = limitSide(setup, j);
-        const double f = setup.breakaway(j);
-        const Choice c =
-            choices[static_cast<std::size_t>(s)][static_cast<std::size_t>(digit[static_cast<std::size_t>(s)])];
-        if (c == Choice::Stick) {
-          const bool above = mu(j) > f + t_tol, below = mu(j) < -f - t_tol;
-          if ((above && side <= 0) || (below && side >= 0)) valid = false;
-          pattern += (above || below) ? 'L' : 's';
-        } else if (c == Choice::SlipPositive) {
-          if (qdd(j) < -a_tol) valid = false;
-          pattern += '+';
-        } else {
-          if (qdd(j) > a_tol) valid = false;
-          pattern += '-';
-        }
-      }
-      if (valid) {
-        // g(μ) = Z(q̈) + μᵀWq̈, Z with τ + τ_kinetic.
-        const double g = gaussFunction(spec, in, qdd) + mu.dot(qdd);
-        if (out.valid_patterns == 0) {
-          out.feasible = true;
-          out.qdd = qdd;
-          out.mu = mu;
-          out.nu = x.segment(n, m);
-          out.gauss_dual = g;
-          out.pattern = pattern;
-        } else {
-          Eigen::VectorXd d = qdd - out.qdd;
-          out.qdd_spread =
-              std::max(out.qdd_spread, d.cwiseAbs().maxCoeff() / std::max(1.0, out.qdd.cwiseAbs().maxCoeff()));
-          out.gauss_spread =
-              std::max(out.gauss_spread, std::abs(g - out.gauss_dual) / std::max(1.0, std::abs(out.gauss_dual)));
-          out.mu_spread = std::max(out.mu_spread, (mu - out.mu).cwiseAbs().maxCoeff());
-        }
-        ++out.valid_patterns;
-      }
+      continue;
     }
-
-    // Next pattern (mixed radix).
-    int s = 0;
-    while (s < k) {
-      auto& d = digit[static_cast<std::size_t>(s)];
-      if (++d < static_cast<int>(choices[static_cast<std::size_t>(s)].size())) break;
-      d = 0;
-      ++s;
-    }
-    if (s == k) break;
-  }
+    const LongSolver solver(kktMatrix(system.H, rows));
+    Eigen::VectorXd rhs(n + r);
+    rhs << tau - system.C, gamma;
+    const Eigen::VectorXd x = solver.solve(rhs);
+    FrictionPattern pattern;
+    pattern.qdd = x.head(n);
+    for (std::size_t s = 0; s < stick.size(); ++s) mu(stick[s]) = -x(n + m + static_cast<int>(s));
+    if (!dissipates(system, chosen, pattern.qdd, mu, options, pattern.pattern)) continue;
+    pattern.mu = mu;
+    pattern.nu = x.segment(n, m);
+    pattern.tau_control = controlTorque(system, pattern.nu);
+    // g(μ) = Z(ẍ) + μᵀWẍ, Z the quadratic of the system (with τ + τ_kinetic).
+    pattern.gauss_dual = system.gauss_at_rest + 0.5 * pattern.qdd.dot(system.H * pattern.qdd) +
+                         (system.C - system.tau).dot(pattern.qdd) + mu.dot(pattern.qdd);
+    addValidPattern(std::move(pattern), out);
+  } while (nextPattern(choices, digit));
+  if (out.feasible) out.pinned = pinnedSticking(system, out.qdd, Hinv, options);
   if (!out.feasible) {
     out.qdd = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
     out.mu = out.qdd;
     out.gauss_dual = std::numeric_limits<double>::quiet_NaN();
   }
+  return out;
+}
+
+FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
+                                     const BruteForceOptions& options) {
+  checkSetup(spec, input, setup);
+  const DynamicsInput in = withKinetic(input, setup);  // τ' = τ + τ_kinetic
+  const DenseResult dense = denseDynamics(spec, in);   // H, C, G, γ (independent of τ)
+  FrictionSystem system;
+  system.H = dense.H;
+  system.C = dense.C;
+  system.G = dense.G;
+  system.gamma = dense.gamma;
+  system.tau = in.tau;
+  system.gauss_at_rest = gaussFunction(spec, in, Eigen::VectorXd::Zero(spec.dof()));
+  system.stuck = setup.stuck;
+  system.breakaway = setup.breakaway;
+  system.limit_side = setup.limit_side;
+  system.tau_motor = input.tau;
+  system.motor = Eigen::VectorXd::Ones(dense.G.rows());
+  system.mimic_laws = spec.mimicLaws();
+  FrictionReference out = bruteForceFriction(system, options);
+  out.tau_kinetic = in.tau - input.tau;
+  return out;
+}
+
+FrictionReference bruteForceFloatingFriction(const ChainSpec& spec, const FloatingBase& base,
+                                             const FloatingInput& input, const FrictionSetup& setup,
+                                             const BruteForceOptions& options) {
+  const int n = spec.dof(), nb = base.nvBase();
+  if (input.v.size() != nb + n || input.tau.size() != nb + n)
+    throw std::invalid_argument("friction reference: v and tau must have nv entries");
+  if (setup.breakaway.size() != n || setup.kinetic.size() != n || setup.viscous.size() != n ||
+      (setup.limit_side.size() != 0 && setup.limit_side.size() != n))
+    throw std::invalid_argument("friction reference: the setup must have spec.dof() entries per joint");
+  FloatingInput in = input;
+  const Eigen::VectorXd kinetic = kineticTorque(setup, input.v.tail(n));
+  in.tau.tail(n) += kinetic;  // τ' = τ + τ_kinetic
+  const FloatingResult dense = floatingDynamics(spec, base, in);
+  FrictionSystem system;
+  system.H = dense.H;
+  system.C = dense.C;
+  system.G = dense.G;
+  system.gamma = dense.gamma;
+  system.tau = in.tau;
+  system.gauss_at_rest = floatingGaussFunction(spec, base, in, Eigen::VectorXd::Zero(nb + n));
+  for (const int j : setup.stuck) system.stuck.push_back(nb + j);  // the base is never stuck
+  system.breakaway = Eigen::VectorXd::Zero(nb + n);
+  system.breakaway.tail(n) = setup.breakaway;
+  if (setup.limit_side.size() != 0) {
+    system.limit_side = Eigen::VectorXi::Zero(nb + n);
+    system.limit_side.tail(n) = setup.limit_side;
+  }
+  system.tau_motor = input.tau;
+  system.motor = motorRows(input, static_cast<int>(dense.G.rows()));
+  for (MimicLaw law : spec.mimicLaws()) {
+    law.joint += nb;
+    law.leader += nb;
+    system.mimic_laws.push_back(law);
+  }
+  FrictionReference out = bruteForceFriction(system, options);
+  out.tau_kinetic = kinetic;
+  // μ per joint, as the fixed base's (the base has none).
+  const Eigen::VectorXd mu = out.mu.tail(n);
+  out.mu = mu;
+  for (FrictionPattern& p : out.valid) {
+    const Eigen::VectorXd joint_mu = p.mu.tail(n);
+    p.mu = joint_mu;
+  }
+  return out;
+}
+
+namespace {
+
+// min ‖Σ α_i p_i‖ over Σ α_i = 1 (the affine hull's least-norm point), from
+// the bordered system [PᵀP 1; 1ᵀ 0][α; λ] = [0; 1] by a complete orthogonal
+// decomposition (the least-norm solution if the points are affinely dependent).
+Eigen::VectorXd affineMinimizer(const Eigen::MatrixXd& P) {
+  const Eigen::Index s = P.cols();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(s + 1, s + 1);
+  K.topLeftCorner(s, s) = P.transpose() * P;
+  K.topRightCorner(s, 1).setOnes();
+  K.bottomLeftCorner(1, s).setOnes();
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(s + 1);
+  rhs(s) = 1.0;
+  return Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(K).solve(rhs).head(s);
+}
+
+// The columns of `points` named by `set`.
+Eigen::MatrixXd columns(const Eigen::MatrixXd& points, const std::vector<int>& set) {
+  Eigen::MatrixXd P(points.rows(), static_cast<Eigen::Index>(set.size()));
+  for (std::size_t i = 0; i < set.size(); ++i) P.col(static_cast<Eigen::Index>(i)) = points.col(set[i]);
+  return P;
+}
+
+// Wolfe's minor cycle: from weights w on `set` (all > 0) move to the affine
+// minimiser of the set, dropping the points whose weight reaches 0 on the way,
+// until the affine minimiser lies inside the simplex.
+void wolfeMinorCycle(const Eigen::MatrixXd& points, std::vector<int>& set, Eigen::VectorXd& w) {
+  constexpr double kTiny = 1e-14;  // a weight this small is 0: rounding of weights that sum to 1
+  for (;;) {
+    const Eigen::VectorXd alpha = affineMinimizer(columns(points, set));
+    if (alpha.minCoeff() > kTiny) {
+      w = alpha;
+      return;
+    }
+    double theta = 1.0;
+    for (Eigen::Index i = 0; i < alpha.size(); ++i)
+      if (alpha(i) <= kTiny) theta = std::min(theta, w(i) / (w(i) - alpha(i)));
+    w = ((1.0 - theta) * w + theta * alpha).eval();
+    std::vector<int> kept;
+    std::vector<double> kept_w;
+    for (Eigen::Index i = 0; i < w.size(); ++i)
+      if (w(i) > kTiny) {
+        kept.push_back(set[static_cast<std::size_t>(i)]);
+        kept_w.push_back(w(i));
+      }
+    set = kept;
+    w = Eigen::Map<const Eigen::VectorXd>(kept_w.data(), static_cast<Eigen::Index>(kept_w.size()));
+    w /= w.sum();
+  }
+}
+
+}  // namespace
+
+LeastEffort leastEffortMaximiser(const FrictionReference& reference) {
+  if (!reference.feasible) throw std::invalid_argument("leastEffortMaximiser: no valid pattern");
+  // The hull's points, repeats merged (two patterns at one vertex).
+  double scale = 1.0;
+  for (const FrictionPattern& p : reference.valid) scale = std::max(scale, p.tau_control.cwiseAbs().maxCoeff());
+  std::vector<const FrictionPattern*> distinct;
+  for (const FrictionPattern& p : reference.valid) {
+    bool repeat = false;
+    for (const FrictionPattern* d : distinct)
+      repeat = repeat || (p.tau_control - d->tau_control).cwiseAbs().maxCoeff() <= 1e-12 * scale;
+    if (!repeat) distinct.push_back(&p);
+  }
+  const auto count = static_cast<Eigen::Index>(distinct.size());
+  Eigen::MatrixXd points(reference.tau_control.size(), count);
+  for (Eigen::Index i = 0; i < count; ++i) points.col(i) = distinct[static_cast<std::size_t>(i)]->tau_control;
+
+  // Wolfe (1976): start at the point of least norm; add the point that most
+  // lowers xᵀp while it lowers it by more than rounding; re-solve on the set.
+  Eigen::Index start = 0;
+  points.colwise().squaredNorm().minCoeff(&start);
+  std::vector<int> set{static_cast<int>(start)};
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(1);
+  for (int iteration = 0; iteration < 10 * static_cast<int>(count) + 10; ++iteration) {
+    const Eigen::VectorXd x = columns(points, set) * w;
+    Eigen::Index best = 0;
+    const double lowest = (x.transpose() * points).minCoeff(&best);
+    // Stop when no point lowers xᵀp below |x|² by more than rounding of |p|².
+    if (x.squaredNorm() - lowest <= 1e-13 * scale * scale) break;
+    if (std::find(set.begin(), set.end(), static_cast<int>(best)) != set.end()) break;  // rounding: cannot improve
+    set.push_back(static_cast<int>(best));
+    w.conservativeResize(w.size() + 1);
+    w(w.size() - 1) = 0.0;
+    wolfeMinorCycle(points, set, w);
+  }
+  LeastEffort out;
+  out.distinct_points = static_cast<int>(count);
+  out.tau_control = columns(points, set) * w;
+  out.mu = Eigen::VectorXd::Zero(reference.mu.size());
+  for (std::size_t i = 0; i < set.size(); ++i)
+    out.mu += w(static_cast<Eigen::Index>(i)) * distinct[static_cast<std::size_t>(set[i])]->mu;
   return out;
 }
 

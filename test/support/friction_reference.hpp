@@ -1,5 +1,5 @@
 // Independent references for static friction (docs/friction.md), built only on the
-// dense KKT reference (dense_reference.hpp) — no code of zwang's solver.
+// dense KKT references (dense_reference.hpp, floating_reference.hpp) — no code of zwang's solver.
 //
 // Notation (docs/theory.md §3): Θ₀ = the stuck joints (k of them), W the k×n selector of
 // their rows, f_j the breakaway torques. A stuck joint feels the torque −μ_j
@@ -38,6 +38,11 @@
 // 2. sampledFriction is the report's own method (chapter 5, "Implementation"):
 //    g(μ) evaluated by a full dense forward-dynamics solve on a regular grid
 //    over the box, k = 1 or 2; returns the grid maximiser.
+// 3. bruteForceFloatingFriction: the enumeration of 1. on the dense
+//    floating-base reference (floating_reference.hpp), whose rows may include
+//    joint rows and contacts; leastEffortMaximiser: among the maximisers, the
+//    least ‖τ_control‖ (docs/friction.md, "When μ* is not unique"), from the
+//    valid patterns alone.
 #pragma once
 
 #include <random>
@@ -48,6 +53,7 @@
 
 #include "support/chain_spec.hpp"
 #include "support/dense_reference.hpp"
+#include "support/floating_reference.hpp"
 #include "support/random_chain.hpp"
 
 namespace zwang::testing {
@@ -83,15 +89,28 @@ struct BruteForceOptions {
   double singular_threshold = 1e-10;      // λ_min/λ_max of the augmented coupling matrix
 };
 
+// One valid pattern: a maximiser of g (FrictionReference::valid).
+struct FrictionPattern {
+  std::string pattern;  // as FrictionReference::pattern
+  Eigen::VectorXd qdd, mu, nu;
+  Eigen::VectorXd tau_control;  // τ + the motors' Gᵀν (the leaders carrying their mimic joints')
+  double gauss_dual = 0.0;
+};
+
 struct FrictionReference {
-  bool feasible = false;  // some pattern is valid
-  Eigen::VectorXd qdd;    // q̈*
-  Eigen::VectorXd mu;     // a valid μ* (per dof, 0 off Θ₀)
-  Eigen::VectorXd nu;     // the task's multipliers for that pattern
+  bool feasible = false;        // some pattern is valid
+  Eigen::VectorXd qdd;          // q̈*
+  Eigen::VectorXd mu;           // a valid μ* (per dof, 0 off Θ₀)
+  Eigen::VectorXd nu;           // the task's multipliers for that pattern
+  Eigen::VectorXd tau_control;  // τ + the motors' Gᵀν for that pattern
   Eigen::VectorXd tau_kinetic;
   double gauss_dual = 0.0;  // g(μ*) = Z(q̈*) + μ*ᵀ W q̈*
   std::string pattern;  // one char per stuck joint: 's' stick, '+' slip+, '-' slip−, 'L' stick beyond f at a limit
-  int patterns = 0;     // enumerated
+  // Every valid pattern, the first (above) included. The maximisers of g are
+  // the convex hull of their μ (every vertex of that polytope is a valid
+  // pattern, see the file comment; every valid pattern is a maximiser).
+  std::vector<FrictionPattern> valid;
+  int patterns = 0;  // enumerated
   int valid_patterns = 0;
   int singular_patterns = 0;  // skipped as rank deficient
   // Spread among the valid patterns (uniqueness checks): q̈ and g must agree;
@@ -99,11 +118,60 @@ struct FrictionReference {
   double qdd_spread = 0.0;    // max relativeError between valid patterns' q̈
   double gauss_spread = 0.0;  // max |Δg| / max(1, |g|)
   double mu_spread = 0.0;     // max |Δμ|
+  // Some direction of μ on the sticking coordinates (q̈*_j = 0) moves no
+  // acceleration: [G; E_Σ] is rank deficient (K_ΣΣ singular). Then μ* is not
+  // unique unless the box stops that direction both ways — and where a stuck
+  // joint rests on a limit the set of maximisers is unbounded, with one vertex
+  // only: mu_spread = 0 does not make μ* unique then.
+  bool pinned = false;
 };
 
 FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
                                      const BruteForceOptions& options = {});
 
+// The enumeration itself, on any dense system in n generalized coordinates x:
+//   H ẍ + C = τ + Gᵀν − Σ_{j ∈ Θ₀} μ_j e_j,   G ẍ = γ,
+//   Z(ẍ) = Z(0) + ½ ẍᵀHẍ + (C − τ)ᵀẍ   (every dense Gauss function here is this quadratic),
+// τ with the kinetic torques in it. Stuck coordinates, breakaway torques and
+// limit sides per coordinate (a floating base's coordinates are simply never
+// stuck). tau_control = tau_motor + Gᵀ diag(motor) ν, then each mimic pair
+// (joint, leader, multiplier) folded onto its leader.
+struct FrictionSystem {
+  Eigen::MatrixXd H, G;
+  Eigen::VectorXd C, tau, gamma;
+  double gauss_at_rest = 0.0;        // Z(0)
+  std::vector<int> stuck;            // coordinates, ascending
+  Eigen::VectorXd breakaway;         // per coordinate
+  Eigen::VectorXi limit_side;        // per coordinate (−1 lower, +1 upper, 0 none), or empty
+  Eigen::VectorXd tau_motor;         // the user's τ (without the kinetic torques), for tau_control
+  Eigen::VectorXd motor;             // per row of G: 1 when the motors carry it, 0 for a contact
+  std::vector<MimicLaw> mimic_laws;  // coordinates (a floating base's offset added)
+};
+FrictionReference bruteForceFriction(const FrictionSystem& system, const BruteForceOptions& options = {});
+
+// The same brute force on a floating base (floating_reference.hpp): the system
+// is the dense floating-base one, nv coordinates with the base's first
+// (unactuated and frictionless: never stuck); `setup` is per joint (spec.dof()
+// entries, as for the fixed base). qdd and tau_control have nv entries, mu one
+// per joint, nu one per row of floatingDynamics (the input's rows, joint rows
+// and contacts included, then the mimic rows); a contact's force is not in
+// tau_control (ConstraintInput::contact).
+FrictionReference bruteForceFloatingFriction(const ChainSpec& spec, const FloatingBase& base,
+                                             const FloatingInput& input, const FrictionSetup& setup,
+                                             const BruteForceOptions& options = {});
+
+// The least-effort maximiser (docs/friction.md, "When μ* is not unique": the
+// maximiser with the least ‖τ_control‖). On the maximisers q̈* is fixed and ν is
+// affine in μ (G of full row rank), so τ_control is affine there and the set of
+// its values is the convex hull of the valid patterns' τ_control: the answer
+// is the point of least norm in that hull (Wolfe's algorithm, exact up to
+// rounding), unique even where μ is not. Returns it, and one μ that gives it.
+struct LeastEffort {
+  Eigen::VectorXd tau_control;
+  Eigen::VectorXd mu;
+  int distinct_points = 0;  // the hull's points after merging repeats
+};
+LeastEffort leastEffortMaximiser(const FrictionReference& reference);
 // q̈(μ) and g(μ) for a given μ (per dof; entries off Θ₀ ignored) by one full
 // dense solve with τ + τ_kinetic − Wᵀμ.
 struct FrictionDual {

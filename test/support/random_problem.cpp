@@ -125,8 +125,15 @@ Task taskFromInput(const Model& model, const DynamicsInput& input) {
   };
   for (const WrenchInput& w : input.wrenches) task.wrench(task.addWrench(w.link, expressed(w.axes))) = w.wrench;
   for (const ConstraintInput& c : input.constraints) {
-    const int first = c.relative_to.empty() ? task.addConstraint(c.link, c.A, expressed(c.axes))
-                                            : task.addRelativeConstraint(c.link, c.relative_to, c.A, expressed(c.axes));
+    int first = 0;
+    if (c.joint >= 0)
+      first = task.addJointConstraint(c.joint);
+    else if (c.contact)
+      first = task.addContact(c.link, c.A, expressed(c.axes));
+    else if (c.relative_to.empty())
+      first = task.addConstraint(c.link, c.A, expressed(c.axes));
+    else
+      first = task.addRelativeConstraint(c.link, c.relative_to, c.A, expressed(c.axes));
     task.targets().segment(first, c.b.size()) = c.b;
   }
   return task;

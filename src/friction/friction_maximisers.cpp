@@ -96,10 +96,10 @@ Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
   const auto sticking = s.sticking.head(ns);
   auto K_sticking = s.K_sticking.topLeftCorner(ns, ns);
   const int* sub = sticking.data();
-  for (Eigen::Index b = 0; b < ns; ++b) {  // raw gathers: ns² of them
+  for (Eigen::Index b = 0; b < ns; ++b) {  // raw gathers of the lower triangle, all nearNullSpace reads
     const double* k_column = K.data() + sub[b] * K.outerStride();
     double* ks_column = K_sticking.data() + b * K_sticking.outerStride();
-    for (Eigen::Index a = 0; a < ns; ++a) ks_column[a] = k_column[sub[a]];
+    for (Eigen::Index a = b; a < ns; ++a) ks_column[a] = k_column[sub[a]];
   }
   // Flat: a curvature that moves q̈ by at most the acceleration tolerance
   // across the box, shared among the ns directions.

@@ -30,9 +30,9 @@ struct MaximiserChoiceScratch {
         qp(n) {}
   Eigen::VectorXd qdd_star;             // q̈*_Θ = q̈_Θ(0) − K_ΘΘ μ* (k)
   Eigen::VectorXi sticking;             // position in Θ₀ of each sticking joint (ns)
-  Eigen::MatrixXd K_sticking;           // K_ΣΣ (ns × ns), factored in place by nearNullSpace
+  Eigen::MatrixXd K_sticking;           // K_ΣΣ (ns × ns, lower triangle), factored in place by nearNullSpace
   Eigen::MatrixXd null_basis;           // N: orthonormal basis of null(K_ΣΣ) (ns × nullity)
-  Eigen::VectorXi pivots;               // nearNullSpace's pivot order
+  Eigen::VectorXi pivots;               // nearNullSpace's pivot exchanges
   Eigen::VectorXd mu_first;             // μ* on Σ as the maximiser returned it
   Eigen::VectorXd lo, hi;               // Λ on Σ, then the margin box
   Eigen::VectorXd curvature_direction;  // v ⟂ N when K_ΣΣ has rank one

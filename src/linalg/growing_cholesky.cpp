@@ -78,62 +78,110 @@ void GrowingCholesky::solveInPlace(Eigen::Ref<Eigen::VectorXd> x) const {
   }
 }
 
-Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::Ref<Eigen::MatrixXd> N,
-                           Eigen::Ref<Eigen::VectorXi> perm) {
+namespace {
+
+// The two kernels of the pivoted factor and its reflectors, on contiguous
+// column segments of length `length`: plain loops that the compiler
+// vectorises, without the per-call set-up of Eigen's expressions, which
+// outweighs the arithmetic at these lengths (up to a few tens). The dot
+// product keeps two partial sums (even and odd entries) so that the pairs go
+// through the vector unit together: one sequential sum cannot be reordered.
+double dotSegment(const double* x, const double* y, Eigen::Index length) {
+  double even = 0.0, odd = 0.0;
+  Eigen::Index i = 0;
+  for (; i + 1 < length; i += 2) {
+    even += x[i] * y[i];
+    odd += x[i + 1] * y[i + 1];
+  }
+  if (i < length) even += x[i] * y[i];
+  return even + odd;
+}
+
+// y ← y − a·x.
+void subtractScaled(double a, const double* x, double* y, Eigen::Index length) {
+  for (Eigen::Index i = 0; i < length; ++i) y[i] -= a * x[i];
+}
+
+// Symmetric pivoting of the lower triangle only: rows/columns r and p > r of
+// the trailing Schur complement trade places, and with them rows r and p of
+// the factored columns 0…r−1 (LAPACK's dpstrf does the same exchanges).
+void swapLowerSymmetric(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Index r, Eigen::Index p) {
   const Eigen::Index n = A.rows();
-  for (Eigen::Index i = 0; i < n; ++i) perm[i] = static_cast<int>(i);
+  A.row(r).head(r).swap(A.row(p).head(r));
+  std::swap(A(r, r), A(p, p));
+  for (Eigen::Index i = r + 1; i < p; ++i) std::swap(A(i, r), A(p, i));
+  A.col(r).tail(n - p - 1).swap(A.col(p).tail(n - p - 1));
+}
+
+// Diagonally pivoted Cholesky of the lower triangle of A, in place, until every
+// remaining Schur-complement diagonal is at most `floor`; returns the rank r.
+// pivot_row[t] is the row step t swapped in. Only the lower triangle is read
+// or written: the Schur update is one contiguous column segment per column.
+Eigen::Index pivotedCholesky(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::Ref<Eigen::VectorXi> pivot_row) {
+  const Eigen::Index n = A.rows();
   Eigen::Index r = 0;
   for (; r < n; ++r) {
     Eigen::Index p = r;  // the largest remaining Schur diagonal leads
     for (Eigen::Index i = r + 1; i < n; ++i)
       if (A(i, i) > A(p, p)) p = i;
     if (!(A(p, p) > floor)) break;
-    if (p != r) {
-      A.row(r).swap(A.row(p));
-      A.col(r).swap(A.col(p));
-      std::swap(perm[r], perm[p]);
-    }
+    pivot_row[r] = static_cast<int>(p);
+    if (p != r) swapLowerSymmetric(A, r, p);
     const double l = std::sqrt(A(r, r));
     A(r, r) = l;
-    for (Eigen::Index i = r + 1; i < n; ++i) A(i, r) /= l;
-    for (Eigen::Index j = r + 1; j < n; ++j)  // Schur complement, both triangles
-      for (Eigen::Index i = r + 1; i < n; ++i) A(i, j) -= A(i, r) * A(j, r);
+    A.col(r).tail(n - r - 1) /= l;
+    const double* l_column = &A(0, r);
+    for (Eigen::Index j = r + 1; j < n; ++j) subtractScaled(l_column[j], l_column + j, &A(j, j), n - j);
   }
+  return r;
+}
+
+// Householder QR of the factored columns L (n × r, lower trapezoidal): each
+// reflector H_j = I − 2 v vᵀ (‖v‖ = 1) is kept in column j of A, rows j…n−1.
+void householderOfFactor(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Index r) {
+  const Eigen::Index n = A.rows();
+  for (Eigen::Index j = 0; j < r; ++j) {
+    auto column = A.col(j);
+    column.head(j).setZero();               // L is lower trapezoidal (above: scratch)
+    for (Eigen::Index h = 0; h < j; ++h) {  // the earlier reflectors act on column j
+      const double* v = &A(h, h);
+      subtractScaled(2.0 * dotSegment(v, &column[h], n - h), v, &column[h], n - h);
+    }
+    const double norm = column.tail(n - j).norm();
+    const double alpha = column[j] >= 0.0 ? norm : -norm;
+    column[j] += alpha;                                        // v = x + sign(x_j)‖x‖ e_j, then normalised
+    const double v_norm = std::sqrt(2.0 * alpha * column[j]);  // ‖v‖² = 2α(x_j + α)
+    column.tail(n - j) *= v_norm > 0.0 ? 1.0 / v_norm : 0.0;
+  }
+}
+
+}  // namespace
+
+Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::Ref<Eigen::MatrixXd> N,
+                           Eigen::Ref<Eigen::VectorXi> pivot_row) {
+  const Eigen::Index n = A.rows();
+  const Eigen::Index r = pivotedCholesky(A, floor, pivot_row);
   // The near null space is the orthogonal complement of the factored
   // columns L (n × r, pivoted order): for d ⟂ range(L), dᵀAd = d₂ᵀ S d₂ with
   // S the remaining Schur complement. Householder QR of L gives it directly
   // as the last n − r columns of Q = H₀…H_{r−1}: O(n·r·(n − r)), no
-  // Gram–Schmidt. Each reflector H_j = I − 2 v vᵀ (‖v‖ = 1) is kept in
-  // column j of L, rows j…n−1.
+  // Gram–Schmidt.
   const Eigen::Index nullity = n - r;
   if (nullity == 0) return 0;
-  for (Eigen::Index j = 0; j < r; ++j) {
-    for (Eigen::Index i = 0; i < j; ++i) A(i, j) = 0.0;  // L is lower trapezoidal (above: scratch)
-    for (Eigen::Index h = 0; h < j; ++h) {               // the earlier reflectors act on column j
-      double dot = 0.0;
-      for (Eigen::Index i = h; i < n; ++i) dot += A(i, h) * A(i, j);
-      for (Eigen::Index i = h; i < n; ++i) A(i, j) -= 2.0 * dot * A(i, h);
-    }
-    double norm2 = 0.0;
-    for (Eigen::Index i = j; i < n; ++i) norm2 += A(i, j) * A(i, j);
-    const double alpha = A(j, j) >= 0.0 ? std::sqrt(norm2) : -std::sqrt(norm2);
-    A(j, j) += alpha;                                        // v = x + sign(x_j)‖x‖ e_j, then normalised
-    const double v_norm = std::sqrt(2.0 * alpha * A(j, j));  // ‖v‖² = 2α(x_j + α)
-    const double scale = v_norm > 0.0 ? 1.0 / v_norm : 0.0;
-    for (Eigen::Index i = j; i < n; ++i) A(i, j) *= scale;
-  }
-  // N = Q [0; I], rows back in the original order: start from the unit
-  // columns e_{r+e} and apply H_{r−1}, …, H₀.
+  householderOfFactor(A, r);
+  // N = Q [0; I]: start from the unit columns e_{r+e} and apply H_{r−1}, …, H₀.
   for (Eigen::Index e = 0; e < nullity; ++e) {
     auto d = N.col(e).head(n);
     d.setZero();
-    d[perm[r + e]] = 1.0;
+    d[r + e] = 1.0;
     for (Eigen::Index h = r - 1; h >= 0; --h) {
-      double dot = 0.0;
-      for (Eigen::Index i = h; i < n; ++i) dot += A(i, h) * d[perm[i]];
-      for (Eigen::Index i = h; i < n; ++i) d[perm[i]] -= 2.0 * dot * A(i, h);
+      const double* v = &A(h, h);
+      subtractScaled(2.0 * dotSegment(v, &d[h], n - h), v, &d[h], n - h);
     }
   }
+  // Rows back in the original order: the pivot exchanges undone, last first.
+  for (Eigen::Index t = r - 1; t >= 0; --t)
+    if (pivot_row[t] != t) N.row(t).head(nullity).swap(N.row(pivot_row[t]).head(nullity));
   return nullity;
 }
 

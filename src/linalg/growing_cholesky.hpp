@@ -48,9 +48,9 @@ class GrowingCholesky {
 // returns their number n − r: the orthogonal complement of the r factored
 // columns (Householder QR of them). Each has curvature dᵀ A d ≤ (n − r)·floor:
 // for d ⟂ range(L), dᵀAd = d₂ᵀ S d₂ with the Schur complement S positive
-// semi-definite and trace S ≤ (n − r)·floor. A is overwritten; `perm` (n) is
-// scratch. O(n³/3).
+// semi-definite and trace S ≤ (n − r)·floor. Only A's lower triangle is read;
+// A is overwritten; `pivot_row` (n) is scratch. O(n³/6).
 Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::Ref<Eigen::MatrixXd> N,
-                           Eigen::Ref<Eigen::VectorXi> perm);
+                           Eigen::Ref<Eigen::VectorXi> pivot_row);
 
 }  // namespace zwang::internal

@@ -490,6 +490,34 @@ void setCounters(benchmark::State& state, const Problem& p, int m, int k) {
   state.counters["k"] = k;
 }
 
+// The timed benchmarks below first solve once outside the clock: a failed solve
+// skips the benchmark with its message (a number for a wrong problem is worse
+// than none), and the first call warms the workspace.
+bool firstSolveSucceeded(benchmark::State& state, const Status& first) {
+  if (!first) state.SkipWithError(first.message);
+  return static_cast<bool>(first);
+}
+
+void timeHybridSolves(benchmark::State& state, const Problem& p, const Task& task, const Eigen::VectorXd& qd,
+                      Workspace& ws) {
+  for (auto _ : state) {
+    const Status s = solveHybridDynamics(p.model, task, p.q, qd, p.tau, ws);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+void timeFrictionSolves(benchmark::State& state, const Problem& p, const Task& task, const Eigen::VectorXd& qd,
+                        const FrictionOptions& options, Workspace& ws) {
+  for (auto _ : state) {
+    const Status s = solveWithFriction(p.model, task, p.q, qd, p.tau, ws, options);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Ours
 
@@ -497,16 +525,8 @@ void benchOursHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
   const DynamicsInput in = makeInput(*p, kind, p->qd);
   const Task task = taskFromInput(p->model, in);
   Workspace ws(p->model, task);
-  if (Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws); !s) {
-    state.SkipWithError(s.message);
-    return;
-  }
-  for (auto _ : state) {
-    const Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws);
-    benchmark::DoNotOptimize(s.code);
-    benchmark::DoNotOptimize(ws.solution.qdd.data());
-    benchmark::ClobberMemory();
-  }
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws))) return;
+  timeHybridSolves(state, *p, task, p->qd, ws);
   setCounters(state, *p, task.constraintRows(), 0);
 }
 
@@ -514,17 +534,9 @@ void benchOursHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
 void benchTreeHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
   const Task task = taskFromInput(p->model, makeInput(*p, kind, p->qd));
   Workspace ws(p->model, task);
-  if (Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws); !s) {
-    state.SkipWithError(s.message);
-    return;
-  }
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws))) return;
   const int rank = ws.solution.balance.rank;
-  for (auto _ : state) {
-    const Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws);
-    benchmark::DoNotOptimize(s.code);
-    benchmark::DoNotOptimize(ws.solution.qdd.data());
-    benchmark::ClobberMemory();
-  }
+  timeHybridSolves(state, *p, task, p->qd, ws);
   setCounters(state, *p, task.constraintRows(), 0);
   state.counters["b"] = p->branching;
   state.counters["depth"] = p->depth;
@@ -612,20 +624,12 @@ void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int
   Workspace ws(p->model, task);
   FrictionOptions options;
   options.method = method;
-  if (Status s = solveWithFriction(p->model, task, p->q, qd, p->tau, ws, options); !s) {
-    state.SkipWithError(s.message);
-    return;
-  }
+  if (!firstSolveSucceeded(state, solveWithFriction(p->model, task, p->q, qd, p->tau, ws, options))) return;
   if (static_cast<int>(ws.friction.stuck.size()) != k) {
     state.SkipWithError("stuck set has the wrong size");
     return;
   }
-  for (auto _ : state) {
-    const Status s = solveWithFriction(p->model, task, p->q, qd, p->tau, ws, options);
-    benchmark::DoNotOptimize(s.code);
-    benchmark::DoNotOptimize(ws.solution.qdd.data());
-    benchmark::ClobberMemory();
-  }
+  timeFrictionSolves(state, *p, task, qd, options, ws);
   setCounters(state, *p, task.constraintRows(), k);
   state.counters["iterations"] = ws.friction.iterations;
 }
@@ -683,17 +687,9 @@ void setFloatingCounters(benchmark::State& state, const Problem& p, int m, int k
 void benchFloatingHybrid(benchmark::State& state, const Problem* p, bool held) {
   const Task task = floatingTask(*p, held);
   Workspace ws(p->model, task);
-  if (Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws); !s) {
-    state.SkipWithError(s.message);
-    return;
-  }
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws))) return;
   const int rank = ws.solution.balance.rank;
-  for (auto _ : state) {
-    const Status s = solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws);
-    benchmark::DoNotOptimize(s.code);
-    benchmark::DoNotOptimize(ws.solution.qdd.data());
-    benchmark::ClobberMemory();
-  }
+  timeHybridSolves(state, *p, task, p->qd, ws);
   setFloatingCounters(state, *p, task.constraintRows(), 0);
   state.counters["rank"] = rank;
 }
@@ -701,10 +697,8 @@ void benchFloatingHybrid(benchmark::State& state, const Problem* p, bool held) {
 void benchFloatingFriction(benchmark::State& state, const Problem* p, bool held) {
   const Task task = floatingTask(*p, held);
   Workspace ws(p->model, task);
-  if (Status s = solveWithFriction(p->model, task, p->q, p->qd, p->tau, ws); !s) {
-    state.SkipWithError(s.message);
-    return;
-  }
+  const FrictionOptions options;
+  if (!firstSolveSucceeded(state, solveWithFriction(p->model, task, p->q, p->qd, p->tau, ws, options))) return;
   // Every joint stuck (q̇ = 0) and staying stuck: what the benchmark is about.
   if (static_cast<int>(ws.friction.stuck.size()) != p->n ||
       std::any_of(ws.friction.state.begin(), ws.friction.state.end(),
@@ -712,12 +706,7 @@ void benchFloatingFriction(benchmark::State& state, const Problem* p, bool held)
     state.SkipWithError("not every joint sticks");
     return;
   }
-  for (auto _ : state) {
-    const Status s = solveWithFriction(p->model, task, p->q, p->qd, p->tau, ws);
-    benchmark::DoNotOptimize(s.code);
-    benchmark::DoNotOptimize(ws.solution.qdd.data());
-    benchmark::ClobberMemory();
-  }
+  timeFrictionSolves(state, *p, task, p->qd, options, ws);
   setFloatingCounters(state, *p, task.constraintRows(), p->n);
   state.counters["iterations"] = ws.friction.iterations;
   state.counters["indeterminate"] = ws.friction.indeterminate ? 1 : 0;

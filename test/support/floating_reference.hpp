@@ -96,15 +96,11 @@ Eigen::VectorXd integrateConfiguration(const FloatingBase& base, const Eigen::Ve
                                        double dt, int steps = 4);
 
 // Everything that depends only on (q, v), for every link (index as spec.links).
-struct FloatingKinematics {
-  std::vector<Eigen::Isometry3d> poses;  // ⁰T_link (poses[0] = the base pose)
-  std::vector<Eigen::MatrixXd> J;        // 6×nv spatial Jacobians at the world origin (base columns first)
-  std::vector<Vector6d> v;               // spatial velocity J v
-  std::vector<Vector6d> bias;            // J̇ v
-  std::vector<Matrix6d> inertia;         // world-frame spatial inertia at the world origin
-  std::vector<int> dof_of_joint;         // joints[k] → index in v (base entries first), −1 when fixed
-  Eigen::VectorXd reflected;             // nv: 0 on the base, d_j on the joints
-};
+// The dense reference's kinematics (dense_reference.hpp), over the whole
+// velocity vector: poses[0] is the base pose, J_i is 6×nv with the base
+// columns first, dof_of_joint indexes v (base entries first), and reflected is
+// 0 on the base entries.
+using FloatingKinematics = DenseKinematics;
 
 FloatingKinematics floatingKinematics(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q,
                                       const Eigen::VectorXd& v);

@@ -26,18 +26,25 @@ struct EntryName {
   char text[96] = {};
 };
 
-EntryName configurationEntry(const Model& model, Eigen::Index k) {
-  static const char* const kFree[] = {"base position x",   "base position y",   "base position z",  "base quaternion w",
-                                      "base quaternion x", "base quaternion y", "base quaternion z"};
-  static const char* const kPlanar[] = {"base x", "base y", "base yaw psi"};
+// Entry k of a state vector whose first `base` entries are the base's, named
+// by `base_names` (free or planar), the rest one per joint.
+EntryName stateEntry(const Model& model, Eigen::Index k, int base, const char* const* free_names,
+                     const char* const* planar_names) {
   EntryName name;
-  const int base = model.baseConfigurationSize();
   if (k < base)
-    std::snprintf(name.text, sizeof name.text, "%s", model.baseType() == BaseType::Free ? kFree[k] : kPlanar[k]);
+    std::snprintf(name.text, sizeof name.text, "%s",
+                  model.baseType() == BaseType::Free ? free_names[k] : planar_names[k]);
   else
     std::snprintf(name.text, sizeof name.text, "joint '%.60s'",
                   model.joints()[static_cast<std::size_t>(k - base)].name.c_str());
   return name;
+}
+
+EntryName configurationEntry(const Model& model, Eigen::Index k) {
+  static const char* const kFree[] = {"base position x",   "base position y",   "base position z",  "base quaternion w",
+                                      "base quaternion x", "base quaternion y", "base quaternion z"};
+  static const char* const kPlanar[] = {"base x", "base y", "base yaw psi"};
+  return stateEntry(model, k, model.baseConfigurationSize(), kFree, kPlanar);
 }
 
 EntryName velocityEntry(const Model& model, Eigen::Index k) {
@@ -45,14 +52,7 @@ EntryName velocityEntry(const Model& model, Eigen::Index k) {
                                       "base linear velocity z (base axes)",  "base angular velocity x (base axes)",
                                       "base angular velocity y (base axes)", "base angular velocity z (base axes)"};
   static const char* const kPlanar[] = {"base x rate", "base y rate", "base yaw rate"};
-  EntryName name;
-  const int base = model.baseVelocitySize();
-  if (k < base)
-    std::snprintf(name.text, sizeof name.text, "%s", model.baseType() == BaseType::Free ? kFree[k] : kPlanar[k]);
-  else
-    std::snprintf(name.text, sizeof name.text, "joint '%.60s'",
-                  model.joints()[static_cast<std::size_t>(k - base)].name.c_str());
-  return name;
+  return stateEntry(model, k, model.baseVelocitySize(), kFree, kPlanar);
 }
 
 Status checkConfigurationSize(const Model& model, const char* what, Eigen::Index size) {

@@ -233,7 +233,16 @@ def test_configuration_errors():
         zwang.difference(model, q, np.zeros(18))
     assert e.value.code == "SizeMismatch"
     assert zwang.check_configuration(model, q) is None
-    assert zwang.QUATERNION_NORM_TOLERANCE == 1e-6
+    # The published tolerance is the one the check applies: a quaternion norm off by half of it passes, twice it
+    # is refused (the norm is scaled along w, the only non-zero component of the neutral quaternion).
+    tolerance = zwang.QUATERNION_NORM_TOLERANCE
+    inside, outside = q.copy(), q.copy()
+    inside[3] = 1 + 0.5 * tolerance
+    outside[3] = 1 + 2 * tolerance
+    assert zwang.check_configuration(model, inside) is None
+    with pytest.raises(zwang.SolveError) as e:
+        zwang.check_configuration(model, outside)
+    assert e.value.code == "BadConfiguration"
 
 
 # ---- contacts and joint rows --------------------------------------------------------------------------------

@@ -219,6 +219,47 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
   }
 }
 
+// ---- When μ* is not unique, how the joints' τ_control moves along the flat
+// directions N (EffortChange). Without contacts every row's force is in
+// τ_control, so on the maximisers τ_control moves one for one with μ on Σ and
+// nowhere else (Own). With them, τ_control = τ + τ_c(ν), ν(μ) = ν(0) − δν μ
+// and τ_c linear in ν (contacts excluded): along N's column e it moves by
+// B_e = −τ_c(δν_Σ N_e), the mimic joints' carried by their leaders as
+// controlTorques does; one pass of constraintTorques per flat direction. B
+// is then compared with Own's E_Σ N (E_Σ: the sticking joints' unit rows):
+// a contact that takes no share of the friction keeps the Own path.
+EffortChange effortAlongFlatDirections(const Model& model, const Task& task, const std::vector<int>& stuck,
+                                       Eigen::Index ns, Eigen::Index nullity, Workspace& ws, FrictionScratch& fs) {
+  if (!task.hasContacts()) return EffortChange::Own;
+  const int m = task.solverColumns(), n = model.dof();
+  bool motor_rows = false;
+  for (int col = 0; col < m && !motor_rows; ++col) motor_rows = !task.contactColumns()[static_cast<std::size_t>(col)];
+  if (!motor_rows) return EffortChange::Fixed;  // τ_c ≡ 0: τ_control = τ whatever μ
+  MaximiserChoiceScratch& s = fs.choice;
+  const auto N = s.null_basis.topLeftCorner(ns, nullity);
+  const auto sticking = s.sticking.head(ns);
+  auto B = s.effort_gradient.topLeftCorner(n, nullity);
+  auto nu_direction = s.nu_direction.head(m);
+  auto tau_direction = s.tau_direction.tail(n);
+  // B is τ_control per unit of friction: 1e-9 of it moves τ_control by 1e-9
+  // of the box's width, what the choice counts as one maximiser (mu_scale).
+  constexpr double kSameChange = 1e-9;
+  double largest = 0.0, off_own = 0.0;
+  for (Eigen::Index e = 0; e < nullity; ++e) {
+    nu_direction.setZero();  // −δν_Σ N_e
+    for (Eigen::Index t = 0; t < ns; ++t) nu_direction.noalias() -= N(t, e) * fs.dnu.col(sticking[t]).head(m);
+    constraintTorques(model, task, ws, nu_direction, s.tau_direction);
+    carryMimicTorques(model, s.tau_direction);
+    B.col(e) = tau_direction;
+    largest = std::max(largest, tau_direction.cwiseAbs().maxCoeff());
+    for (Eigen::Index t = 0; t < ns; ++t) tau_direction[stuck[static_cast<std::size_t>(sticking[t])]] -= N(t, e);
+    off_own = std::max(off_own, tau_direction.cwiseAbs().maxCoeff());
+  }
+  s.effort_first.head(n) = fs.tau_control_first.tail(n);
+  if (!(largest > kSameChange)) return EffortChange::Fixed;
+  return off_own <= kSameChange ? EffortChange::Own : EffortChange::Shared;
+}
+
 // ---- The motion at μ*: the sweeps are linear in the torques, so
 // q̈(μ*) = q̈(0) + (∂q̈/∂τ_Θ)(−μ*) and ν(μ*) likewise (lines 26–30 by
 // superposition), then Ẍ from q̈ (line 29). With nothing stuck, μ* is
@@ -314,10 +355,11 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
                                    : 0;
   if (nullity > 0) {
     effortAtFirstMaximiser(model, task, tau, fr.stuck, options, ws, fs);
+    const EffortChange change = effortAlongFlatDirections(model, task, fr.stuck, sticking, nullity, ws, fs);
     const double mu_scale = 1e-9 * (1.0 + fs.breakaway.cwiseAbs().maxCoeff());  // maximisers this close are one
     fr.indeterminate =
         leastEffortMaximiser(fs.lo.head(k), fs.hi.head(k), fs.margin_limit.head(k), fs.effort_offset.head(k), sticking,
-                             nullity, mu_scale, options.max_iterations, fs.mu.head(k), fs.choice);
+                             nullity, change, model.dof(), mu_scale, options.max_iterations, fs.mu.head(k), fs.choice);
   }
 
   motionAtMaximiser(model, task, k, ws, fs);

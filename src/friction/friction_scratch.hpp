@@ -36,7 +36,7 @@ struct FrictionScratch {
         nu_first(capacity),
         tau_constraint_first(nv),
         tau_control_first(nv),
-        choice(dof),
+        choice(dof, capacity, nv),
         tau_joint(nv) {}
 
   // The model of friction, per joint (the options' overrides, else the model's)

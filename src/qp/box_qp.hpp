@@ -147,8 +147,8 @@ double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
 
 // Least-distance problem  min ½‖z − a‖²  s.t.  lo ≤ x0 + N z ≤ hi  (q = N.cols()
 // unknowns, k = N.rows() two-sided rows), from the feasible start z (usually 0).
-// Primal active set; z is the result. Used to pick among several friction
-// maximisers μ* + null(K_ΘΘ).
+// Primal active set; z is the result; N need not be orthonormal. Used to pick
+// among several friction maximisers μ* + null(K_ΘΘ).
 QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen::Ref<const Eigen::VectorXd>& a,
                          const Eigen::Ref<const Eigen::VectorXd>& x0, const Eigen::Ref<const Eigen::VectorXd>& lo,
                          const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> z, QpScratch& s,

@@ -1,6 +1,8 @@
 // Least-distance problems of the friction maximiser: which of several
 // maximisers μ* + null(K_ΘΘ) to report (the one nearest a reference).
-//  * leastDistanceQp: min ½‖z − a‖² s.t. lo ≤ x0 + N z ≤ hi, by the textbook
+//  * leastDistanceQp: min ½‖z − a‖² s.t. lo ≤ x0 + N z ≤ hi (N any matrix:
+//    an orthonormal null basis, or N L⁻ᵀ for the least effort where
+//    contacts share the load, friction_maximisers.cpp), by the textbook
 //    primal active-set method (Nocedal & Wright, Numerical Optimization,
 //    §16.5) specialised to the identity Hessian: the subproblem on the
 //    working rows W is z' = a − C_Wᵀ λ with (C_W C_Wᵀ) λ = C_W a − d_W, whose

@@ -573,3 +573,37 @@ TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the 
   CHECK(codes[2] == StatusCode::SizeMismatch);
   CHECK(codes[3] == StatusCode::ModelMismatch);
 }
+
+// The humanoid standing still on both feet with a joint row on every joint
+// (zwang energy's standing scenario): the feet's share of the load moves with
+// friction, so the least-effort step works on the true τ_control (its
+// sensitivities by constraintTorques, a Cholesky factor, the least-distance
+// passes: EffortChange::Shared in src/friction/friction_maximisers.cpp).
+TEST_CASE("floating bases: the standing humanoid, contacts sharing the load with friction, allocates nothing",
+          "[floating]") {
+  FloatingCase c = humanoidOnTwoFeet(BaseType::Free);
+  for (int j = 0; j < c.model.dof(); ++j)
+    if (j != c.model.jointIndex("LARM_ELBOW") && j != c.model.jointIndex("RARM_ELBOW")) c.task.addJointConstraint(j);
+  c.v.setZero();  // at rest: every joint stuck
+  c.tau.setZero();
+  Workspace ws(c.model, c.task);
+  FrictionOptions half = c.options;
+  half.margin = 0.5;
+  Status statuses[2];
+  const auto solves = [&] {
+    statuses[0] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, half);
+    statuses[1] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options);
+  };
+  solves();  // warm
+  CHECK(allocationsDuring(solves) == 0);
+  CHECK(statuses[0]);
+  CHECK(statuses[1]);
+  CHECK(ws.friction.stuck.size() == static_cast<std::size_t>(c.model.dof()));
+  CHECK(ws.friction.indeterminate);
+  // The feet took a share: what the joints feel, τ_control − μ, is not the
+  // plain solve's τ_control (the standing scenario measures up to 1.9 N·m).
+  const int n = c.model.dof();
+  const Eigen::VectorXd felt = ws.solution.tau_control.tail(n) - ws.friction.mu;
+  REQUIRE(solveHybridDynamics(c.model, c.task, c.q, c.v, c.tau, ws));
+  CHECK((felt - ws.solution.tau_control.tail(n)).cwiseAbs().maxCoeff() > 1e-3);
+}

@@ -359,18 +359,23 @@ FrictionReference bruteForceFloatingFriction(const ChainSpec& spec, const Floati
 
 namespace {
 
-// min ‖Σ α_i p_i‖ over Σ α_i = 1 (the affine hull's least-norm point), from
-// the bordered system [PᵀP 1; 1ᵀ 0][α; λ] = [0; 1] by a complete orthogonal
-// decomposition (the least-norm solution if the points are affinely dependent).
+// min ‖Σ α_i p_i‖ over Σ α_i = 1 (the affine hull's least-norm point), as
+// p₀ + D β with D = [p_i − p₀]: β = −D⁺p₀ by a complete orthogonal
+// decomposition of D (the least-norm β if the points are affinely
+// dependent), α = (1 − Σβ, β). (Not from the bordered system
+// [PᵀP 1; 1ᵀ 0]: with points far from the origin next to their spread — a
+// torque of 6e3 N·m that friction moves by 1e2 — PᵀP's entries agree to 1e-3
+// and that system's rank is misjudged, which stalled Wolfe's method on the
+// draws of "the contacts share the load".)
 Eigen::VectorXd affineMinimizer(const Eigen::MatrixXd& P) {
   const Eigen::Index s = P.cols();
-  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(s + 1, s + 1);
-  K.topLeftCorner(s, s) = P.transpose() * P;
-  K.topRightCorner(s, 1).setOnes();
-  K.bottomLeftCorner(1, s).setOnes();
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(s + 1);
-  rhs(s) = 1.0;
-  return Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(K).solve(rhs).head(s);
+  Eigen::VectorXd alpha(s);
+  if (s == 1) return Eigen::VectorXd::Ones(1);
+  const Eigen::MatrixXd D = P.rightCols(s - 1).colwise() - P.col(0);
+  const Eigen::VectorXd beta = -Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(D).solve(P.col(0));
+  alpha(0) = 1.0 - beta.sum();
+  alpha.tail(s - 1) = beta;
+  return alpha;
 }
 
 // The columns of `points` named by `set`.
@@ -410,21 +415,24 @@ void wolfeMinorCycle(const Eigen::MatrixXd& points, std::vector<int>& set, Eigen
 
 }  // namespace
 
-LeastEffort leastEffortMaximiser(const FrictionReference& reference) {
+LeastEffort leastEffortMaximiser(const FrictionReference& reference, Eigen::Index first) {
   if (!reference.feasible) throw std::invalid_argument("leastEffortMaximiser: no valid pattern");
+  const Eigen::Index counted = reference.tau_control.size() - first;
   // The hull's points, repeats merged (two patterns at one vertex).
   double scale = 1.0;
-  for (const FrictionPattern& p : reference.valid) scale = std::max(scale, p.tau_control.cwiseAbs().maxCoeff());
+  for (const FrictionPattern& p : reference.valid)
+    scale = std::max(scale, p.tau_control.tail(counted).cwiseAbs().maxCoeff());
   std::vector<const FrictionPattern*> distinct;
   for (const FrictionPattern& p : reference.valid) {
     bool repeat = false;
     for (const FrictionPattern* d : distinct)
-      repeat = repeat || (p.tau_control - d->tau_control).cwiseAbs().maxCoeff() <= 1e-12 * scale;
+      repeat = repeat || (p.tau_control - d->tau_control).tail(counted).cwiseAbs().maxCoeff() <= 1e-12 * scale;
     if (!repeat) distinct.push_back(&p);
   }
   const auto count = static_cast<Eigen::Index>(distinct.size());
-  Eigen::MatrixXd points(reference.tau_control.size(), count);
-  for (Eigen::Index i = 0; i < count; ++i) points.col(i) = distinct[static_cast<std::size_t>(i)]->tau_control;
+  Eigen::MatrixXd points(counted, count);
+  for (Eigen::Index i = 0; i < count; ++i)
+    points.col(i) = distinct[static_cast<std::size_t>(i)]->tau_control.tail(counted);
 
   // Wolfe (1976): start at the point of least norm; add the point that most
   // lowers xᵀp while it lowers it by more than rounding; re-solve on the set.

@@ -161,17 +161,19 @@ FrictionReference bruteForceFloatingFriction(const ChainSpec& spec, const Floati
                                              const BruteForceOptions& options = {});
 
 // The least-effort maximiser (docs/friction.md, "When μ* is not unique": the
-// maximiser with the least ‖τ_control‖). On the maximisers q̈* is fixed and ν is
-// affine in μ (G of full row rank), so τ_control is affine there and the set of
-// its values is the convex hull of the valid patterns' τ_control: the answer
-// is the point of least norm in that hull (Wolfe's algorithm, exact up to
-// rounding), unique even where μ is not. Returns it, and one μ that gives it.
+// maximiser with the least ‖τ_control‖ of the joints). On the maximisers q̈*
+// is fixed and ν is affine in μ (G of full row rank), so τ_control is affine
+// there and the set of its values is the convex hull of the valid patterns'
+// τ_control: the answer is the point of least norm in that hull (Wolfe's
+// algorithm, exact up to rounding), unique even where μ is not. Only the
+// coordinates from `first` on count (a floating base's nb are not motor
+// effort: pass nb). Returns them, and one μ that gives them.
 struct LeastEffort {
-  Eigen::VectorXd tau_control;
+  Eigen::VectorXd tau_control;  // the coordinates from `first` on
   Eigen::VectorXd mu;
   int distinct_points = 0;  // the hull's points after merging repeats
 };
-LeastEffort leastEffortMaximiser(const FrictionReference& reference);
+LeastEffort leastEffortMaximiser(const FrictionReference& reference, Eigen::Index first = 0);
 // q̈(μ) and g(μ) for a given μ (per dof; entries off Θ₀ ignored) by one full
 // dense solve with τ + τ_kinetic − Wᵀμ.
 struct FrictionDual {

@@ -32,6 +32,7 @@ using zwang::internal::leastDistanceQp;
 using zwang::internal::nearNullSpace;
 using zwang::internal::QpReport;
 using zwang::internal::QpScratch;
+using zwang::internal::TermSizes;
 
 namespace {
 
@@ -757,8 +758,8 @@ TEST_CASE("boxQpActiveSet: a zero-curvature descent direction with an infinite b
     for (const bool active_set : {true, false}) {
       x1.setZero();
       const QpReport rounding =
-          active_set ? boxQpActiveSet(P1, c1, lo1, hi1, x1, scratch1, kMaxIterations, 1e-12, 1.0)
-                     : boxQpProjectedGradient(P1, c1, lo1, hi1, x1, scratch1, kPgMaxIterations, 1e-12, 1.0);
+          active_set ? boxQpActiveSet(P1, c1, lo1, hi1, x1, scratch1, kMaxIterations, 1e-12, TermSizes{1.0})
+                     : boxQpProjectedGradient(P1, c1, lo1, hi1, x1, scratch1, kPgMaxIterations, 1e-12, TermSizes{1.0});
       CAPTURE(active_set, rounding.iterations, x1[0]);
       REQUIRE(rounding.unbounded);
       REQUIRE(rounding.unbounded_index == 0);

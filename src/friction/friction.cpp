@@ -150,6 +150,48 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   return {};
 }
 
+// ---- The size of the terms each stuck joint's entries of K_ΘΘ and q̈_Θ(0)
+// are sums of (line 28 of the sweep, for q̈(0) and for a unit torque at
+// joint j, body i): a joint the task holds still has both at rounding level
+// of these, however small they come out.
+//   q̈_j(0) = (u_i − (I^A_iS_i)ᵀ Ẍ_parent + S_iᵀA_i ν) / D_i
+//   −K_jj  = (1 − (I^A_iS_i)ᵀ δẌ_parent + S_iᵀA_i δν) / D_i
+// Each sum is taken term by term in absolute value; δẌ_parent, sweep
+// scratch by now, is rebuilt term by term from the column's δq̈ on the path
+// to the base (line 29, every motion in the world frame).
+Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const FrictionScratch& fs, Eigen::Index a,
+                             int body) {
+  const int kb = model.baseVelocitySize();
+  Vec6 terms = Vec6::Zero();
+  for (int l = model.parent(body); l > 0; l = model.parent(l))
+    terms += ws.S[static_cast<std::size_t>(l)].cwiseAbs() * std::abs(fs.dqdd(kb + l - 1, a));
+  if (model.hasFloatingBase()) {  // δẌ₀ = S₀ δq̈₀ (a free base's published in its own frame)
+    const auto base = fs.dqdd.col(a).head(kb);
+    const Vec6 base_motion =
+        model.baseType() == BaseType::Free ? baseTrueAcceleration(model, ws, base) : Vec6(ws.S_base * base);
+    terms += base_motion.cwiseAbs();
+  }
+  return terms;
+}
+
+void termSizes(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
+               FrictionScratch& fs) {
+  for (std::size_t b = 0; b < stuck.size(); ++b) {
+    const auto a = static_cast<Eigen::Index>(b);
+    const int i = bodyOfJoint(stuck[b]);
+    const auto at_i = static_cast<std::size_t>(i);
+    const int first = task.firstColumn(i), count = task.activeColumns(i) - first;
+    const auto SA = ws.SA.col(i).segment(first, count).cwiseAbs();
+    const Vec6 IAS = ws.IAS[at_i].cwiseAbs();
+    fs.curvature_terms[a] = (1.0 + IAS.dot(parentAccelerationTerms(model, ws, fs, a, i)) +
+                             SA.dot(fs.dnu.col(a).segment(first, count).cwiseAbs())) *
+                            ws.inverse_D[at_i];
+    fs.slope_terms[a] = (std::abs(ws.u[at_i]) + IAS.dot(ws.a[static_cast<std::size_t>(model.parent(i))].cwiseAbs()) +
+                         SA.dot(ws.nu.segment(first, count).cwiseAbs())) *
+                        ws.inverse_D[at_i];
+  }
+}
+
 // ---- The maximiser: K_ΘΘ and q̈_Θ(0) gathered from the columns, the scales
 // its tests are relative to, and the box QP. μ* into fs.mu.
 QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
@@ -189,15 +231,18 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
       curvature_scale = std::max(curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
                                                       ws.SA.topRows(m).cwiseAbs().maxCoeff() / min_D);
   }
+  termSizes(model, task, ws, stuck, fs);
   const double tolerance = options.kkt_tolerance * acc_scale;
   auto mu = fs.mu.head(k);
   mu.setZero();  // feasible: 0 ∈ Λ
   if (k == 0) return {};
+  const TermSizes terms{curvature_scale, Eigen::Map<const Eigen::VectorXd>(fs.curvature_terms.data(), k),
+                        Eigen::Map<const Eigen::VectorXd>(fs.slope_terms.data(), k)};
   return options.method == FrictionMethod::ActiveSet
              ? boxQpActiveSet(K, fs.qdd0_stuck.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp, options.max_iterations,
-                              tolerance, curvature_scale)
+                              tolerance, terms)
              : boxQpProjectedGradient(K, fs.qdd0_stuck.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp,
-                                      options.max_iterations, tolerance, curvature_scale);
+                                      options.max_iterations, tolerance, terms);
 }
 
 // ---- When μ* is not unique: what each stuck joint's motor would carry at the

@@ -29,6 +29,8 @@ struct FrictionScratch {
         da(6, bodies),
         K(dof, dof),
         qdd0_stuck(dof),
+        curvature_terms(dof),
+        slope_terms(dof),
         mu(dof),
         qp(dof),
         margin_limit(dof),
@@ -56,9 +58,11 @@ struct FrictionScratch {
   Matrix6X da;              // 6 × bodies: δẌ of one unit torque (sweep scratch)
 
   // The maximiser: min ½ μᵀ K_ΘΘ μ − μᵀ q̈_Θ(0) over Λ
-  Eigen::MatrixXd K;           // K_ΘΘ = rows Θ of −∂q̈/∂μ
-  Eigen::VectorXd qdd0_stuck;  // q̈_Θ(0)
-  Eigen::VectorXd mu;          // μ* on Θ₀
+  Eigen::MatrixXd K;                // K_ΘΘ = rows Θ of −∂q̈/∂μ
+  Eigen::VectorXd qdd0_stuck;       // q̈_Θ(0)
+  Eigen::VectorXd curvature_terms;  // per stuck joint: the size of the terms its column of K_ΘΘ is a sum of
+  Eigen::VectorXd slope_terms;      // per stuck joint: the size of the terms its q̈_j(0) is a sum of
+  Eigen::VectorXd mu;               // μ* on Θ₀
   QpScratch qp;
 
   // When μ* is not unique

@@ -14,6 +14,7 @@ ActiveSetScratch::ActiveSetScratch(int n)
       gradient_noise(n),
       row_sums(n),
       fixed(n),
+      flat(n),
       step(n),
       direction(n),
       delta(n),
@@ -59,6 +60,16 @@ double reachScale(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<
   const double curvature = std::max(lambda_max_bound, curvature_scale);
   if (curvature > 0.0 && c.size() > 0) scale = std::max(scale, c.cwiseAbs().maxCoeff() / curvature);
   return scale;
+}
+
+double roundingSlope(const TermSizes& terms, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index j) {
+  double slope = terms.slope_of.size() == x.size() ? kSlopeRounding * terms.slope_of[j] : 0.0;
+  if (terms.curvature_of.size() == x.size()) {
+    double weighted_x = 0.0;  // Σ_l √t_l |x_l|
+    for (Eigen::Index l = 0; l < x.size(); ++l) weighted_x += std::sqrt(terms.curvature_of[l]) * std::abs(x[l]);
+    slope += kTermRounding * std::sqrt(terms.curvature_of[j]) * weighted_x;
+  }
+  return slope;
 }
 
 double boxQpKktResidual(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,

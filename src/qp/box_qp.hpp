@@ -24,6 +24,20 @@ namespace zwang::internal {
 // the two methods agree on what is unbounded.
 inline constexpr double kReach = 1e12;
 
+// Rounding of P and c relative to the size of the terms they were computed
+// from (TermSizes), where the caller knows it. Measured over the friction
+// tests (test_friction, test_friction_limits, test_floating_friction,
+// test_mimic, test_singular), per stuck joint: a joint the task holds still
+// has its entries of K_ΘΘ at 1e-17..1e-12 of their terms, once 1.2e-11
+// (behind a balance of condition 3e5), and its q̈_j(0) at 1e-18..1e-13;
+// real ones are above 1e-7 and 1e-5 there, and test_stress's extreme chains
+// with damped singular tasks have real ones down to 1e-13 and 2.4e-12.
+// kTermRounding: an entry of P (a curvature) this small next to its terms is
+// zero; kSlopeRounding: likewise c_j, 10× above its largest rounding seen
+// and 2.4× below the smallest real slope seen.
+inline constexpr double kTermRounding = 1e-11;
+inline constexpr double kSlopeRounding = 1e-12;
+
 // Scratch of boxQpActiveSet (k ≤ n variables).
 struct ActiveSetScratch {
   explicit ActiveSetScratch(int n);
@@ -31,6 +45,7 @@ struct ActiveSetScratch {
   Eigen::VectorXd gradient_noise;  // n, a bound on the rounding of each ∇φ_j
   Eigen::VectorXd row_sums;        // n, Σ_l |P_jl| (for gradient_noise and λ_max(P))
   Eigen::VectorXi fixed;           // n, 1 for a variable not in F
+  Eigen::VectorXi flat;            // n, 1 for a fixed variable on a flat direction (roundingSlope): not released
   Eigen::VectorXd step;            // n, the Newton step on F, in F's order
   Eigen::VectorXd direction;       // n, the zero-curvature direction on F, in F's order
   Eigen::VectorXd delta;           // n, the projected Newton step Δ (zero off F)
@@ -81,6 +96,18 @@ struct QpScratch {
   HyperplaneScratch hyperplane;
 };
 
+// What the caller knows of how P and c were computed: the size of the terms
+// each entry is a sum of. A value at rounding level of its terms (a zero
+// computed as a tiny number) is then told from a small real one, which the
+// entries' own size cannot do: a column of P that is rounding throughout is
+// tiny next to its terms, not next to itself. Zero, or an empty vector: not
+// known (the entries' own size stands in).
+struct TermSizes {
+  double curvature = 0.0;                                      // the largest over P (the reach rule)
+  Eigen::Map<const Eigen::VectorXd> curvature_of{nullptr, 0};  // per variable j: of P's row and column j
+  Eigen::Map<const Eigen::VectorXd> slope_of{nullptr, 0};      // per variable j: of c_j
+};
+
 struct QpReport {
   int iterations = 0;
   double kkt_residual = 0.0;  // boxQpKktResidual at the result
@@ -94,34 +121,47 @@ struct QpReport {
 // result. Primal active-set method whose free set F always keeps P_FF
 // positive definite, with its Cholesky factor updated by one index per
 // iteration (O(k²)): Newton steps on F; a variable whose Schur pivot is at
-// rounding level (zero curvature relative to P_jj) is not added but moved,
-// with F, along the zero-curvature direction straight to the next bound.
-// `tolerance` is on the projected gradient (plus the rounding of ∇φ).
-// Invariant under diagonal scaling of the variables: badly scaled P is fine.
-// A variable on an infinite bound that travels kReach times the problem's scale
-// max(1, largest finite bound, ‖c‖∞ / max(L, curvature_scale)), L ≥ λ_max(P),
-// is reported unbounded (its curvature is rounding). `curvature_scale` is the
-// size of the terms P was computed from, when the caller knows it: a P that
-// is rounding throughout (every entry ≪ that) then counts as zero.
+// rounding level (zero curvature relative to P_jj, and to the size of the
+// terms of its column, terms.curvature_of, where given) is not added but
+// moved, with F, along the zero-curvature direction straight to the next
+// bound. Where there is none within reach, the direction is unbounded if its
+// slope is above the rounding of its terms (roundingSlope), and flat (the
+// variable stays) otherwise. `tolerance` is on the projected gradient (plus
+// the rounding of ∇φ). Invariant under diagonal scaling of the variables:
+// badly scaled P is fine. A variable on an infinite bound that travels
+// kReach times the problem's scale max(1, largest finite bound, ‖c‖∞ /
+// max(L, terms.curvature)), L ≥ λ_max(P), is reported unbounded (its
+// curvature is rounding). terms.curvature is the size of the terms P was
+// computed from, when the caller knows it: a P that is rounding throughout
+// (every entry ≪ that) then counts as zero.
 QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         Eigen::Ref<Eigen::VectorXd> x, QpScratch& s, int max_iterations, double tolerance,
-                        double curvature_scale = 0.0);
+                        const TermSizes& terms = {});
 
 // The same problem by accelerated projected gradient (FISTA with adaptive
 // restart) in the metric of P's diagonal D (Jacobi preconditioning: the box
 // stays a box), step 1/L̃ with L̃ ≥ λ_max(D^-1/2 P D^-1/2) (Gershgorin or
-// trace bound); a linear problem (P = 0) goes to its vertex. Unbounded by the
-// same rule as above.
+// trace bound); a linear variable (its column of P rounding of its terms,
+// where given) goes to its vertex first and stays, and a linear problem
+// (P = 0) is solved so. Unbounded and flat by the same rules as above.
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                                 const Eigen::Ref<const Eigen::VectorXd>& lo,
                                 const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> x,
-                                QpScratch& s, int max_iterations, double tolerance, double curvature_scale = 0.0);
+                                QpScratch& s, int max_iterations, double tolerance, const TermSizes& terms = {});
 
 // The scale of the reach rule above: max(1, largest finite |bound|,
 // ‖c‖∞ / max(lambda_max_bound, curvature_scale)).
 double reachScale(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                   const Eigen::Ref<const Eigen::VectorXd>& c, double lambda_max_bound, double curvature_scale);
+
+// The largest |∇φ_j| at x that is still rounding of the terms P and c were
+// computed from (`terms`; 0 where not given): c_j's, kSlopeRounding·s_j,
+// and (P x)_j's, kTermRounding·Σ_l √(t_j t_l)|x_l| (an entry P_jl taken to
+// the scale √(t_j t_l), which a symmetric rescaling of the variables keeps).
+// Along a direction of zero curvature a gradient this small is no slope: the
+// direction is flat (any x_j is a minimiser), not unbounded.
+double roundingSlope(const TermSizes& terms, const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index j);
 
 // How far ∇φ_j = g violates optimality at x_j, in the units of ∇φ, whatever
 // the units of x: a free variable's |g|, a bounded one's g pointing into its

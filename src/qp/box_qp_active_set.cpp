@@ -16,12 +16,20 @@
 //    a release takes every variable whose gradient points into its room
 //    (releaseVariables): few iterations even when the start is far;
 //  * a variable running off along an infinite bound is reported unbounded
-//    (the reach rule, kReach in src/qp/box_qp.hpp).
+//    (the reach rule, kReach in src/qp/box_qp.hpp), but a zero-curvature
+//    direction whose slope is rounding of its terms is flat, not unbounded
+//    (roundingSlope): the variable stays, and is not released again until F
+//    changes;
+//  * where the caller gives the size of the terms P and c were computed from
+//    (TermSizes), curvature and slope are measured against them too: a
+//    column of P that is rounding throughout is tiny next to its terms, not
+//    next to its own diagonal.
 // Stages of one iteration (boxQpActiveSet): ∇φ; a Newton step on F unless F
 // is stationary (newtonStep); else release the fixed variable with the most
 // to gain (chooseRelease), or stop. Every test is relative to P's own
-// diagonal, so the method does not care how the variables are scaled
-// (friction torques from 1e-6 to 1e4 N·m).
+// diagonal (and to the terms' sizes, which scale alike), so the method does
+// not care how the variables are scaled (friction torques from 1e-6 to 1e4
+// N·m).
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -56,13 +64,21 @@ struct Box {
   const VectorRef& lo;
   const VectorRef& hi;
   double tolerance;
+  const TermSizes& terms;
 };
 
 // value clamped to x_j's bounds.
 double clampTo(const Box& box, Eigen::Index j, double value) { return std::min(box.hi[j], std::max(box.lo[j], value)); }
 
-// Is `pivot`, the Schur pivot of adding j to F, a real curvature?
-bool independent(const Box& box, double pivot, int j) { return pivot > kDependent * box.P(j, j); }
+// Is `pivot`, the Schur pivot of adding j to F, a real curvature? Above
+// rounding of P_jj, and of the terms P's column j was computed from where
+// the caller knows them: a column that is rounding throughout (a joint the
+// task holds still) has a P_jj as tiny as its pivot, and only its terms
+// tell that both are rounding.
+bool independent(const Box& box, double pivot, int j) {
+  const bool terms_known = box.terms.curvature_of.size() == box.P.rows();
+  return pivot > kDependent * box.P(j, j) && (!terms_known || pivot > kTermRounding * box.terms.curvature_of[j]);
+}
 
 // g = P x − c (P symmetric), and a bound on each entry's rounding from the
 // absolute row sums of P (computed once).
@@ -155,6 +171,7 @@ bool warmStart(const Box& box, VectorOut x, ActiveSetScratch& s, double reach, Q
   const auto k = static_cast<int>(x.size());
   GrowingCholesky& F = s.free_factor;
   for (int j = 0; j < k; ++j) s.fixed[j] = box.lo[j] < box.hi[j] ? 0 : 1;  // a point box never moves
+  s.flat.head(k).setZero();
   growFree(box, k, s);
   if (F.size() == 0) return true;
   gradient(box, x, s);
@@ -238,13 +255,15 @@ NewtonOutcome newtonStep(const Box& box, VectorOut x, ActiveSetScratch& s) {
 
 // Stage 3: the fixed variable with the most to gain (g_j²/P_jj, the decrease
 // of φ it alone would give; a zero-curvature one first) among those whose
-// gradient points into their room; −1 when none does (x is optimal).
+// gradient points into their room and that are not on a flat direction;
+// −1 when none does (x is optimal).
 int chooseRelease(const Box& box, const VectorRef& x, const ActiveSetScratch& s) {
   int release = -1;
   double best = -1.0;
   for (int j = 0; j < x.size(); ++j) {
     const double g = s.gradient[j];
-    if (!s.fixed[j] || !pointsIntoRoom(g, s.gradient_noise[j], x[j], box.lo[j], box.hi[j], box.tolerance)) continue;
+    if (!s.fixed[j] || s.flat[j] || !pointsIntoRoom(g, s.gradient_noise[j], x[j], box.lo[j], box.hi[j], box.tolerance))
+      continue;
     const double gain = box.P(j, j) > 0.0 ? g * g / box.P(j, j) : kInf;
     if (gain > best) {
       best = gain;
@@ -287,11 +306,26 @@ int unboundedIndex(const Box& box, int j, double dir, const GrowingCholesky& F, 
   return index;
 }
 
+// Which variable a zero-curvature direction runs off with, or −1 when it
+// meets a bound: none at all (α = ∞), or j only beyond `reach` (a bound of F
+// that d_F, rounding where j's column is, meets ~1e15 away; a finite bound
+// of j's own is within reach, kReach ≥ 1).
+int runsOff(const Box& box, int j, double dir, double alpha, double reach, const VectorRef& x,
+            const ActiveSetScratch& s) {
+  if (!std::isfinite(alpha)) return unboundedIndex(box, j, dir, s.free_factor, s.direction);
+  return std::abs(x[j] + alpha * dir) > reach ? j : -1;
+}
+
+enum class ZeroCurvature { Moved, Flat, Unbounded };
+
 // Stage 3, zero curvature (j depends on F, the last schurPivot): d_j = ±1
 // downhill, d_F = −P_FF⁻¹ P_Fj d_j keeps F stationary; φ falls linearly
-// along d, so go to the first bound, which leaves F (or stops j). False when
-// there is none (the report says which variable is unbounded).
-bool zeroCurvatureMove(const Box& box, int j, VectorOut x, ActiveSetScratch& s, QpReport& report) {
+// along d at the slope |g_j|, so go to the first bound, which leaves F (or
+// stops j). Where there is none within reach, d is unbounded (the report
+// says which variable runs off) if that slope is above the rounding of its
+// terms (roundingSlope), and flat otherwise: j is marked and stays.
+ZeroCurvature zeroCurvatureMove(const Box& box, int j, double reach, VectorOut x, ActiveSetScratch& s,
+                                QpReport& report) {
   GrowingCholesky& F = s.free_factor;
   const double dir = s.gradient[j] > 0 ? -1.0 : 1.0;
   auto d = s.direction.head(F.size());
@@ -299,10 +333,15 @@ bool zeroCurvatureMove(const Box& box, int j, VectorOut x, ActiveSetScratch& s, 
   d *= dir;
   double alpha = room(x[j], box.lo[j], box.hi[j], dir);
   const int blocking = cutStep(box, x, F, s.direction, alpha);  // −1: j itself
-  if (!std::isfinite(alpha)) {                                  // downhill for ever: a bound at infinity
+  const int off = runsOff(box, j, dir, alpha, reach, x, s);
+  if (off >= 0 && std::abs(s.gradient[j]) <= roundingSlope(box.terms, x, j)) {
+    s.flat[j] = 1;
+    return ZeroCurvature::Flat;
+  }
+  if (off >= 0) {
     report.unbounded = true;
-    report.unbounded_index = unboundedIndex(box, j, dir, F, s.direction);
-    return false;
+    report.unbounded_index = off;
+    return ZeroCurvature::Unbounded;
   }
   moveFree(box, F, s.direction, alpha, x);
   if (blocking < 0) {
@@ -311,7 +350,7 @@ bool zeroCurvatureMove(const Box& box, int j, VectorOut x, ActiveSetScratch& s, 
     x[j] = clampTo(box, j, x[j] + alpha * dir);
     fixAtBound(box, blocking, s.direction[blocking], x, s);
   }
-  return true;
+  return ZeroCurvature::Moved;
 }
 
 }  // namespace
@@ -319,16 +358,16 @@ bool zeroCurvatureMove(const Box& box, int j, VectorOut x, ActiveSetScratch& s, 
 QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                         const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                         Eigen::Ref<Eigen::VectorXd> x, QpScratch& scratch, int max_iterations, double tolerance,
-                        double curvature_scale) {
+                        const TermSizes& terms) {
   if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
   const auto k = static_cast<int>(x.size());
   ActiveSetScratch& s = scratch.active_set;
-  const Box box{P, c, lo, hi, tolerance};
+  const Box box{P, c, lo, hi, tolerance, terms};
   for (int j = 0; j < k; ++j) s.row_sums[j] = P.col(j).cwiseAbs().sum();
   // λ_max(P) ≤ the smaller of Gershgorin's bound and the trace.
   const double reach =
-      kReach * reachScale(lo, hi, c, std::min(s.row_sums.head(k).maxCoeff(), P.diagonal().sum()), curvature_scale);
+      kReach * reachScale(lo, hi, c, std::min(s.row_sums.head(k).maxCoeff(), P.diagonal().sum()), terms.curvature);
   if (!warmStart(box, x, s, reach, report)) {  // stage 1
     report.kkt_residual = boxQpKktResidual(P, c, lo, hi, x);
     return report;
@@ -337,6 +376,7 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
     gradient(box, x, s);
     if (freeNotStationary(box, s) && newton_in_a_row < 2) {  // stage 2
+      s.flat.head(k).setZero();  // F moves: the slopes along zero-curvature directions change
       const NewtonOutcome step = newtonStep(box, x, s);
       newton_in_a_row = step == NewtonOutcome::Full ? newton_in_a_row + 1 : 0;
       if (step != NewtonOutcome::Projected && runAway(s.free_factor, x, reach, report)) break;
@@ -350,10 +390,13 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
     }
     const double pivot = s.free_factor.schurPivot(P, j);
     if (independent(box, pivot, j)) {
+      s.flat.head(k).setZero();  // F grows: so do the directions of zero curvature
       releaseVariables(box, x, j, pivot, s);
       continue;
     }
-    if (!zeroCurvatureMove(box, j, x, s, report) || runAway(s.free_factor, x, reach, report)) break;
+    const ZeroCurvature move = zeroCurvatureMove(box, j, reach, x, s, report);
+    if (move == ZeroCurvature::Unbounded || runAway(s.free_factor, x, reach, report)) break;
+    if (move == ZeroCurvature::Moved) s.flat.head(k).setZero();
   }
   report.kkt_residual = boxQpKktResidual(P, c, lo, hi, x);
   return report;

@@ -10,9 +10,14 @@
 //    linearity;
 //  * the stopping test is the KKT violation in the units of ∇φ
 //    (kktViolation), not a change in x;
-//  * a linear problem (P = 0 to rounding) goes straight to its vertex
-//    (linearVertex), and a variable running off along an infinite bound is
-//    reported unbounded (the reach rule, kReach in src/qp/box_qp.hpp).
+//  * a linear variable (its column of P zero to rounding of its terms, where
+//    the caller gives them: TermSizes) goes straight to the bound its
+//    gradient points to, or stays where that bound is infinite and the
+//    gradient within rounding (a flat direction, as in the active set)
+//    (linearVertex), and the iterations leave it there; a linear problem
+//    (P = 0 to rounding) is solved so entirely;
+//  * a variable running off along an infinite bound is reported unbounded
+//    (the reach rule, kReach in src/qp/box_qp.hpp).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -51,32 +56,55 @@ void clampToBox(const VectorRef& lo, const VectorRef& hi, Eigen::Ref<Eigen::Vect
   for (Index j = 0; j < x.size(); ++j) x[j] = std::min(hi[j], std::max(lo[j], x[j]));
 }
 
-// Stage 0 for φ linear: each variable goes to the bound its gradient points
-// away from (an infinite one: unbounded, reported).
-QpReport linearVertex(const MatrixRef& P, const VectorRef& c, const VectorRef& lo, const VectorRef& hi,
-                      Eigen::Ref<Eigen::VectorXd> x) {
-  QpReport report;
+// Is x_j a linear variable: its column of P rounding of the terms it was
+// computed from (P_jj at most kTermRounding of them, and with it, P being
+// positive semi-definite, the whole column), where the caller knows them?
+bool linearVariable(const MatrixRef& P, const TermSizes& terms, Index j) {
+  return terms.curvature_of.size() == P.rows() && P(j, j) <= kTermRounding * terms.curvature_of[j];
+}
+
+// Is φ linear: P = 0 to rounding of its own entries (kLinear, beside
+// ‖c‖∞), or every variable linear?
+bool linear(const MatrixRef& P, const VectorRef& c, double L, const TermSizes& terms) {
+  if (L <= kLinear * std::max(1.0, c.cwiseAbs().maxCoeff()) && L <= kTiny + kLinear * P.cwiseAbs().maxCoeff())
+    return true;
+  for (Index j = 0; j < P.rows(); ++j)
+    if (!linearVariable(P, terms, j)) return false;
+  return true;
+}
+
+// Stage 0, the linear variables (all of them when φ is linear): each goes to
+// the bound its gradient −c_j points to; towards an infinite one it is
+// unbounded (reported), unless c_j is within the tolerance or the rounding
+// of its terms (roundingSlope): that direction is flat, and x_j stays. The
+// iterations then leave them there. False when one is unbounded.
+bool linearVertex(const MatrixRef& P, const VectorRef& c, const VectorRef& lo, const VectorRef& hi, bool all,
+                  const TermSizes& terms, double tolerance, Eigen::Ref<Eigen::VectorXd> x, QpReport& report) {
   for (Index j = 0; j < x.size(); ++j) {
-    x[j] = c[j] > 0 ? hi[j] : c[j] < 0 ? lo[j] : std::min(hi[j], std::max(lo[j], 0.0));
-    if (!std::isfinite(x[j])) {
+    if (!all && !linearVariable(P, terms, j)) continue;
+    const double bound = c[j] > 0 ? hi[j] : c[j] < 0 ? lo[j] : x[j];
+    const bool flat = std::abs(c[j]) <= tolerance + roundingSlope(terms, x, j);
+    if (std::isfinite(bound)) {
+      x[j] = bound;
+    } else if (!flat && !report.unbounded) {
       report.unbounded = true;
       report.unbounded_index = static_cast<int>(j);
-      x[j] = 0.0;
     }
   }
-  report.converged = !report.unbounded;
-  report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
-  return report;
+  return !report.unbounded;
 }
 
 // Stage 1, the metric: D⁻¹ (inverse_diagonal) and the step 1/L̃ with
 // L̃ ≥ λ_max(D^-1/2 P D^-1/2), Gershgorin of the scaled matrix or its trace
-// (≤ k), whichever is smaller.
-double jacobiMetric(const MatrixRef& P, ProjectedGradientScratch& s) {
+// (≤ k), whichever is smaller. A linear variable does not move (D⁻¹ = 0:
+// stage 0 placed it), and a diagonal entry at rounding level of P's largest
+// is raised to it (that variable is nearly linear, and 1/rounding would
+// fling it).
+double jacobiMetric(const MatrixRef& P, const TermSizes& terms, ProjectedGradientScratch& s) {
   const Index k = P.rows();
   auto inverse_d = s.inverse_diagonal.head(k);
   const double d_floor = kDiagonalFloor * P.diagonal().maxCoeff();
-  for (Index j = 0; j < k; ++j) inverse_d[j] = 1.0 / std::max(P(j, j), d_floor);
+  for (Index j = 0; j < k; ++j) inverse_d[j] = linearVariable(P, terms, j) ? 0.0 : 1.0 / std::max(P(j, j), d_floor);
   auto root_inverse_d = s.root_inverse_diagonal.head(k);
   root_inverse_d = inverse_d.cwiseSqrt();
   double scaled_gershgorin = 0.0;
@@ -88,11 +116,13 @@ double jacobiMetric(const MatrixRef& P, ProjectedGradientScratch& s) {
   return 1.0 / scaled_L;
 }
 
-// max_j kktViolation at x, from P x already computed.
+// max_j kktViolation at x over the variables that move (stage 0 settled the
+// linear ones), from P x already computed.
 double kktAt(const Segment& Px, const VectorRef& c, const VectorRef& lo, const VectorRef& hi,
-             const Eigen::Ref<Eigen::VectorXd>& x) {
+             const Eigen::Ref<Eigen::VectorXd>& x, const Segment& inverse_d) {
   double r = 0.0;
-  for (Index j = 0; j < x.size(); ++j) r = std::max(r, kktViolation(Px[j] - c[j], x[j], lo[j], hi[j]));
+  for (Index j = 0; j < x.size(); ++j)
+    if (inverse_d[j] > 0.0) r = std::max(r, kktViolation(Px[j] - c[j], x[j], lo[j], hi[j]));
   return r;
 }
 
@@ -128,7 +158,7 @@ void momentum(const Eigen::Ref<Eigen::VectorXd>& x, Iterates& v, double& t) {
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                                 const Eigen::Ref<const Eigen::VectorXd>& lo,
                                 const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> x,
-                                QpScratch& scratch, int max_iterations, double tolerance, double curvature_scale) {
+                                QpScratch& scratch, int max_iterations, double tolerance, const TermSizes& terms) {
   if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
   const Index k = x.size();
@@ -138,11 +168,15 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
   double gershgorin = 0.0;
   for (Index j = 0; j < k; ++j) gershgorin = std::max(gershgorin, P.row(j).cwiseAbs().sum());
   const double L = std::max(0.0, std::min(gershgorin, P.diagonal().sum()));
-  if (L <= kLinear * std::max(1.0, c.cwiseAbs().maxCoeff()) && L <= kTiny + kLinear * P.cwiseAbs().maxCoeff())
-    return linearVertex(P, c, lo, hi, x);
+  const bool all_linear = linear(P, c, L, terms);
+  if (!linearVertex(P, c, lo, hi, all_linear, terms, tolerance, x, report) || all_linear) {  // stage 0
+    report.converged = !report.unbounded;
+    report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
+    return report;
+  }
   ProjectedGradientScratch& s = scratch.projected_gradient;
-  const double step = jacobiMetric(P, s);  // stage 1
-  const double reach = kReach * reachScale(lo, hi, c, L, curvature_scale);
+  const double step = jacobiMetric(P, terms, s);  // stage 1
+  const double reach = kReach * reachScale(lo, hi, c, L, terms.curvature);
   Iterates v{s.inverse_diagonal.head(k), s.gradient.head(k), s.y.head(k),           s.x_previous.head(k),
              s.x_change.head(k),         s.Px.head(k),       s.Px_previous.head(k), s.Py.head(k)};
   v.y = x;
@@ -161,7 +195,7 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
       break;
     }
     v.Px.noalias() = P * x;
-    if (kktAt(v.Px, c, lo, hi, x) <= tolerance) {  // stage 3: optimal to the tolerance
+    if (kktAt(v.Px, c, lo, hi, x, v.inverse_d) <= tolerance) {  // stage 3: optimal to the tolerance
       report.converged = true;
       ++report.iterations;  // count this gradient step
       break;

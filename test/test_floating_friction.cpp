@@ -299,6 +299,21 @@ void compareStates(const FloatingFrictionDraw& d, const Workspace& ws, const Fri
   }
 }
 
+// The library's side of a draw: the model and task built from its spec and
+// input, and one friction solve with its options.
+struct LibraryRun {
+  explicit LibraryRun(const FloatingFrictionDraw& d)
+      : model(floatingModelFromSpec(d.problem.spec, d.problem.base)),
+        task(floatingTaskFromInput(model, d.problem.input)),
+        ws(model, task),
+        status(
+            solveWithFriction(model, task, d.problem.input.q, d.problem.input.v, d.problem.input.tau, ws, d.options)) {}
+  const Model model;
+  const Task task;
+  Workspace ws;
+  const Status status;
+};
+
 void countDraw(const FloatingFrictionDraw& d, const FrictionReference& ref, Tally& t) {
   ++t.compared;
   (d.problem.base.kind == BaseKind::Free ? t.free : t.planar) += 1;
@@ -334,11 +349,11 @@ TEST_CASE("floating trees: friction matches the brute-force enumeration of stick
       ++t.ambiguous;
       continue;
     }
-    const Model model = floatingModelFromSpec(d.problem.spec, d.problem.base);
-    const Task task = floatingTaskFromInput(model, d.problem.input);
-    Workspace ws(model, task);
-    const FloatingInput& in = d.problem.input;
-    const Status status = solveWithFriction(model, task, in.q, in.v, in.tau, ws, d.options);
+    const LibraryRun run(d);
+    const Model& model = run.model;
+    const Task& task = run.task;
+    const Workspace& ws = run.ws;
+    const Status& status = run.status;
     INFO("draw " << t.draws << ": " << toString(d.problem.base.kind) << " base, " << model.dof() << " joints, "
                  << task.constraintRows() << " rows (" << d.joint_rows << " joint, " << d.contact_rows
                  << " contact), reference pattern " << ref.pattern << " of " << ref.valid_patterns
@@ -490,11 +505,11 @@ TEST_CASE("floating trees: the least-effort pick where contacts share the load, 
       ++skipped;
       continue;
     }
-    const Model model = floatingModelFromSpec(d.problem.spec, d.problem.base);
-    const Task task = floatingTaskFromInput(model, d.problem.input);
-    Workspace ws(model, task);
-    const FloatingInput& in = d.problem.input;
-    const Status status = solveWithFriction(model, task, in.q, in.v, in.tau, ws, d.options);
+    const LibraryRun run(d);
+    const Model& model = run.model;
+    const Task& task = run.task;
+    const Workspace& ws = run.ws;
+    const Status& status = run.status;
     INFO("draw " << draws << ": " << toString(d.problem.base.kind) << " base, " << model.dof() << " joints, "
                  << task.constraintRows() << " rows (" << d.joint_rows << " joint, " << d.contact_rows << " contact), "
                  << ref.valid_patterns << " valid patterns; status: " << status.message);

@@ -119,6 +119,19 @@ void baseSolveInPlace(const Model& model, const Workspace& ws, VectorXmax6& x) {
   }
 }
 
+void baseSolveLanesInPlace(const Model& model, const Workspace& ws, double* lanes, Eigen::Index width) {
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> X(lanes, model.baseVelocitySize(),
+                                                                                       width);
+  if (model.baseType() == BaseType::Free) {
+    FreeBaseFactor(ws).solveInPlace(X);  // the right-hand sides in lock step, a row at a time
+    return;
+  }
+  for (Eigen::Index c = 0; c < width; ++c) {
+    const VectorXmax6 x = X.col(c);
+    X.col(c) = ws.D_base.solve(x);
+  }
+}
+
 void baseKinematics(const Model& model, const VectorRef& q_base, const VectorRef& v_base, Workspace& ws,
                     bool with_inertia) {
   const Transform X = ws.Xworld[0] = basePose(model, q_base);

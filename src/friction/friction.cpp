@@ -145,8 +145,7 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   outwardAccelerations(model, task, ws, fs.qdd0);
   fs.nu0.head(m) = ws.nu.head(m);
   if (k > 0)
-    unitTorqueColumns(model, task, ws, stuck, fs.du.leftCols(k), fs.du_base.leftCols(k), fs.dU.topLeftCorner(m, k),
-                      fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da);
+    unitTorqueColumns(model, task, ws, stuck, fs.unit_torques, fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k));
   return {};
 }
 

@@ -29,9 +29,11 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
 
 // x ← D₀⁻¹ x (k entries) with the factorisation baseInward made.
 void baseSolveInPlace(const Model& model, const Workspace& ws, VectorXmax6& x);
-// The same for `width` right-hand sides side by side: `lanes` is row-major
-// k × width (row j: base coordinate j of each).
-void baseSolveLanesInPlace(const Model& model, const Workspace& ws, double* lanes, Eigen::Index width);
+// The same for W right-hand sides side by side: `lanes` is row-major k × W
+// (row j: base coordinate j of each). W = 1, 2, 4 or 8 (unitTorqueColumns'
+// blocks of columns).
+template <int W>
+void baseSolveLanesInPlace(const Model& model, const Workspace& ws, double* lanes);
 
 // Lines 28–29 for the base joint, from ws.nu: q̈₀ (ws.qdd_base) and Ẍ₀ (ws.a[0]).
 void baseAcceleration(const Model& model, const Task& task, Workspace& ws);

@@ -388,11 +388,9 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 
 namespace {
 // The base joint's step of unitTorqueColumns' inward pass: δu₀ = −S₀ᵀ δF^a₀
-// (no torque at the base) and its share of δU (line 20), (S₀ᵀA₀)ᵀ D₀⁻¹ δu₀ =
-// (D₀⁻¹ S₀ᵀA₀)ᵀ δu₀ (D₀ is symmetric): the main pass's D₀⁻¹ S₀ᵀA₀, with no
-// further solve.
-void baseUnitTorques(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Matrix6X>& dF,
-                     Eigen::Ref<Eigen::MatrixXd> du_base, Eigen::Ref<Eigen::MatrixXd> dU) {
+// (no torque at the base).
+void baseUnitTorques(const Model& model, const Workspace& ws, const Eigen::Ref<const Matrix6X>& dF,
+                     Eigen::Ref<Eigen::MatrixXd> du_base) {
   const int kb = model.baseVelocitySize();
   if (model.baseType() == BaseType::Free) {
     du_base.topRows<6>() = -dF;  // S₀ = 1
@@ -400,26 +398,34 @@ void baseUnitTorques(const Model& model, const Workspace& ws, int m, const Eigen
     du_base.topRows(kb).noalias() = ws.S_base.transpose() * dF;
     du_base.topRows(kb) *= -1.0;
   }
+}
+
+// The base's share of δU (line 20), (S₀ᵀA₀)ᵀ D₀⁻¹ δu₀ = (D₀⁻¹ S₀ᵀA₀)ᵀ δu₀
+// (D₀ is symmetric): the main pass's D₀⁻¹ S₀ᵀA₀, with no further solve.
+void baseShareOfU(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Eigen::MatrixXd>& du_base,
+                  Eigen::Ref<Eigen::MatrixXd> dU) {
+  const int kb = model.baseVelocitySize();
   dU.noalias() += ws.SA_base_D.topLeftCorner(kb, m).transpose() * du_base.topRows(kb);
 }
 
 // The base joint's step of the outward pass (lines 28–29) for W columns from
 // c0: δq̈₀ = D₀⁻¹(δu₀ + S₀ᵀA₀ δν), published per column, and δẌ₀ = S₀ δq̈₀
 // (the world's acceleration is fixed) into `da0` (W × 6, a column per
-// component). Row j of `dq` holds base coordinate j of the W columns.
+// component). Row j of `du0` and of `dq` holds base coordinate j of the W
+// columns.
 template <int W>
 void baseLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, const UnitTorqueScratch& s,
-               Eigen::Ref<Eigen::MatrixXd> dqdd, double* da0) {
+               const double* du0, Eigen::Ref<Eigen::MatrixXd> dqdd, double* da0) {
   const int kb = model.baseVelocitySize(), m = task.solverColumns();
   Eigen::Matrix<double, 6, W, W == 1 ? Eigen::ColMajor : Eigen::RowMajor> dq;
   double* q = dq.data();
   using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
   for (int j = 0; j < kb; ++j) {
     Eigen::Map<Lanes> row(q + j * W);
-    row = s.du_base.template block<1, W>(j, c0).transpose();
+    row = Eigen::Map<const Lanes>(du0 + j * W);
     for (int r = 0; r < m; ++r) row += ws.SA_base(j, r) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
   }
-  baseSolveLanesInPlace(model, ws, q, W);
+  baseSolveLanesInPlace<W>(model, ws, q);
   if (model.baseType() == BaseType::Free) {
     for (int e = 0; e < 6 * W; ++e) da0[e] = q[e];                                  // S₀ = 1: the same layout
     dqdd.template block<6, W>(0, c0).noalias() = ws.Xworld[0].motionMatrix() * dq;  // v̇_B = ᴮX₀ Ẍ₀
@@ -461,10 +467,17 @@ void balanceSolveLanes(const Eigen::MatrixXd& C, int m, double* lanes, Eigen::In
 template <int W>
 void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, bool solve_balance,
                   UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
+  using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
   const int N = model.dof(), m = task.solverColumns(), kb = model.baseVelocitySize();
+  double du0[6 * W];  // δu₀ of a floating base, row-major kb × W
+  for (int j = 0; j < kb; ++j) Eigen::Map<Lanes>(du0 + j * W) = s.du_base.template block<1, W>(j, c0).transpose();
   auto dnu_lanes = s.dnu_lanes.topLeftCorner(W, m);  // SᵀA δν: whole lanes per row
   if (solve_balance) {
-    dnu_lanes = s.dU.block(0, c0, m, W).transpose();  // −δU₀
+    dnu_lanes = s.dU.block(0, c0, m, W).transpose();  // −δU₀ of the joints, then of the base (baseShareOfU)
+    for (int r = 0; r < m; ++r) {
+      Eigen::Map<Lanes> x(dnu_lanes.col(r).data());
+      for (int j = 0; j < kb; ++j) x -= ws.SA_base_D(j, r) * Eigen::Map<const Lanes>(du0 + j * W);
+    }
     balanceSolveLanes<W>(ws.balance_factorisation.factor, m, dnu_lanes.data(), s.dnu_lanes.outerStride());
     dnu.middleCols(c0, W) = dnu_lanes.transpose();
   } else {
@@ -473,12 +486,13 @@ void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eig
   double* da = s.da.data();
   const Eigen::Index da_stride = s.da.outerStride();
   if (kb > 0)
-    baseLanes<W>(model, task, ws, c0, s, dqdd, da);
+    baseLanes<W>(model, task, ws, c0, s, du0, dqdd, da);
   else
     for (int e = 0; e < 6 * W; ++e) da[e] = 0.0;  // a fixed base: δẌ₀ = 0
-  using Lanes = Eigen::Matrix<double, W, 1>;      // one entry per column
   for (int i = 1; i <= N; ++i) {
-    Lanes dq = s.du.template block<1, W>(i, c0).transpose();
+    Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
+    const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
+    for (Eigen::Index c = from; c < to; ++c) dq[c - c0] = s.du(i, c);
     const int first = task.firstColumn(i), ki = task.activeColumns(i);
     for (int r = first; r < ki; ++r) dq += ws.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
     const double* parent = da + model.parent(i) * da_stride;
@@ -508,8 +522,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   auto dU = s.dU.topLeftCorner(m, k);
   auto dF = s.dF.leftCols(k);
   dU.setZero();
-  dF.setZero();
-  du.setZero();
+  dF.setZero();              // du is written where it is read: on each body's run of columns
   Eigen::Index c_begin = k;  // the first column with its joint's body ≥ i: falls with i
   for (int i = N; i >= 1; --i) {
     while (c_begin > 0 && bodyOfJoint(joints[static_cast<std::size_t>(c_begin - 1)]) >= i) --c_begin;
@@ -519,6 +532,8 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
                                    : std::lower_bound(joints.begin(), joints.end(), end, [](int j, int b) {
                                        return bodyOfJoint(j) < b;
                                      }) - joints.begin();
+    s.run_begin[i] = c_begin;
+    s.run_end[i] = c_end;
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
     const double inverse_D = ws.inverse_D[at(i)];
@@ -532,11 +547,13 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
     }
   }
   if (model.hasFloatingBase())  // every column's δF^a has reached body 0
-    baseUnitTorques(model, ws, m, dF, s.du_base.leftCols(k), dU);
-  dU *= -1.0;  // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+    baseUnitTorques(model, ws, dF, s.du_base.leftCols(k));
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
-  // outward pass's lanes, a block of columns at a time; else here, all at once.
+  // outward pass's lanes, a block of columns at a time, with the base's share
+  // of δU added there; else here, all at once.
   const bool solve_in_lanes = !task.hasRelative() && !ws.balance_factorisation.by_eigen;
+  if (model.hasFloatingBase() && !solve_in_lanes) baseShareOfU(model, ws, m, s.du_base.leftCols(k), dU);
+  dU *= -1.0;                // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
     auto dU_rows = ws.dU_rows.topLeftCorner(rows, k);

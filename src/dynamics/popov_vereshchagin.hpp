@@ -54,13 +54,18 @@ struct UnitTorqueScratch {
         dU(capacity, dof),
         dF(6, dof),
         da(6 * kLanes, bodies),
-        dnu_lanes(kLanes, capacity) {}
+        dnu_lanes(kLanes, capacity),
+        run_begin(bodies),
+        run_end(bodies) {}
   Eigen::MatrixXd du;         // bodies × k: δu_i per unit torque
   Eigen::MatrixXd du_base;    // 6 × k: δu₀ of a floating base per unit torque
   Eigen::MatrixXd dU;         // capacity × k: δU₀ per unit torque
   Matrix6X dF;                // 6 × k: δF^A carried inward per unit torque
   Eigen::MatrixXd da;         // column i: body i's δẌ for up to kLanes columns (kLanes × 6, column-major)
   Eigen::MatrixXd dnu_lanes;  // kLanes × capacity: δν of those columns, one row per column
+  // Body i's run of columns [run_begin[i], run_end[i]): those whose joint's
+  // body lies in i's subtree, the only ones with δu_i ≠ 0 (du is set there only).
+  Eigen::Matrix<Eigen::Index, Eigen::Dynamic, 1> run_begin, run_end;
 };
 
 // k extra right-hand sides through the same sweeps, all at once: column c is

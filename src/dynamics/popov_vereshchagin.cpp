@@ -387,19 +387,6 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 }
 
 namespace {
-// The base joint's step of unitTorqueColumns' inward pass: δu₀ = −S₀ᵀ δF^a₀
-// (no torque at the base).
-void baseUnitTorques(const Model& model, const Workspace& ws, const Eigen::Ref<const Matrix6X>& dF,
-                     Eigen::Ref<Eigen::MatrixXd> du_base) {
-  const int kb = model.baseVelocitySize();
-  if (model.baseType() == BaseType::Free) {
-    du_base.topRows<6>() = -dF;  // S₀ = 1
-  } else {                       // in two steps: the negated product would be a heap temporary
-    du_base.topRows(kb).noalias() = ws.S_base.transpose() * dF;
-    du_base.topRows(kb) *= -1.0;
-  }
-}
-
 // The base's share of δU (line 20), (S₀ᵀA₀)ᵀ D₀⁻¹ δu₀ = (D₀⁻¹ S₀ᵀA₀)ᵀ δu₀
 // (D₀ is symmetric): the main pass's D₀⁻¹ S₀ᵀA₀, with no further solve.
 void baseShareOfU(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Eigen::MatrixXd>& du_base,
@@ -417,8 +404,7 @@ template <int W>
 void baseLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, const UnitTorqueScratch& s,
                const double* du0, Eigen::Ref<Eigen::MatrixXd> dqdd, double* da0) {
   const int kb = model.baseVelocitySize(), m = task.solverColumns();
-  Eigen::Matrix<double, 6, W, W == 1 ? Eigen::ColMajor : Eigen::RowMajor> dq;
-  double* q = dq.data();
+  double q[6 * W];
   using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
   for (int j = 0; j < kb; ++j) {
     Eigen::Map<Lanes> row(q + j * W);
@@ -426,17 +412,7 @@ void baseLanes(const Model& model, const Task& task, const Workspace& ws, Eigen:
     for (int r = 0; r < m; ++r) row += ws.SA_base(j, r) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
   }
   baseSolveLanesInPlace<W>(model, ws, q);
-  if (model.baseType() == BaseType::Free) {
-    for (int e = 0; e < 6 * W; ++e) da0[e] = q[e];                                  // S₀ = 1: the same layout
-    dqdd.template block<6, W>(0, c0).noalias() = ws.Xworld[0].motionMatrix() * dq;  // v̇_B = ᴮX₀ Ẍ₀
-    return;
-  }
-  for (int l = 0; l < W; ++l) {
-    const VectorXmax6 dq_l = dq.col(l).head(kb);
-    const Vec6 a = ws.S_base * dq_l;
-    for (int e = 0; e < 6; ++e) da0[e * W + l] = a[e];
-    publishBaseAcceleration(model, ws, dq_l, dqdd.col(c0 + l).head(kb));
-  }
+  baseMotionLanes<W>(model, ws, q, da0, dqdd.block(0, c0, kb, W));
 }
 
 // Line 25 for W columns as lanes: x ← 𝓛⁻¹ x with 𝓛 = C Cᵀ (a regular

@@ -290,11 +290,9 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   stuckSetAndKineticFriction(model, q, qd, tau, options, fs, fr);
   const auto k = static_cast<Eigen::Index>(fr.stuck.size());
   if (Status s = sweepsWithSensitivities(model, task, q, qd, fr.stuck, ws, fs); !s) return s;
-  for (Eigen::Index j = 0, a = 0; j < model.dof(); ++j)  // μ_j enters as the torque −μ_j; a moving joint has none
-    if (a < k && fr.stuck[static_cast<std::size_t>(a)] == j)
-      fr.dqdd_dmu.col(j) = -fs.dqdd.col(a++);
-    else
-      fr.dqdd_dmu.col(j).setZero();
+  if (k < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
+  for (Eigen::Index a = 0; a < k; ++a)         // μ_j enters as the torque −μ_j
+    fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);
   const int iv = model.baseVelocitySize();
 
   // The acceleration scale, of the stuck joints only (a light, fast joint

@@ -20,7 +20,8 @@ else
   collect=${2:-*}
   valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --toggle-collect="$collect" \
     "$bench" --benchmark_filter="$filter" --benchmark_min_time=0.02
-  callgrind_annotate --auto=no "$tmp/cg.out" | sed -n '/file:function/,$p' | head -25
+  # awk, not head: head would stop reading early, and pipefail end the script
+  callgrind_annotate --auto=no "$tmp/cg.out" | sed -n '/file:function/,$p' | awk 'NR <= 25'
   # Per call: the collected total over the calls into the functions the
   # pattern names (callgrind writes a function's name once, then its number).
   [[ $collect == '*' ]] || awk -v name="${collect//\*/}" '

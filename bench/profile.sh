@@ -4,6 +4,7 @@
 #
 #   bash bench/profile.sh '^ours_hd_m6/N=7$'                       # perf
 #   bash bench/profile.sh '^ours_hd_m6/N=7$' '*solveHybridDynamics*' # callgrind, collecting inside that function
+#     (its last line: the instructions per call of that function)
 #
 # Uses the binary bench/run.sh builds (build-bench/, Release).
 set -euo pipefail
@@ -19,5 +20,19 @@ else
   collect=${2:-*}
   valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.out" --toggle-collect="$collect" \
     "$bench" --benchmark_filter="$filter" --benchmark_min_time=0.02
-  callgrind_annotate --auto=no "$tmp/cg.out" | sed -n '/file:function/,$p' | head -25
+  # awk, not head: head would stop reading early, and pipefail end the script
+  callgrind_annotate --auto=no "$tmp/cg.out" | sed -n '/file:function/,$p' | awk 'NR <= 25'
+  # Per call: the collected total over the calls into the functions the
+  # pattern names (callgrind writes a function's name once, then its number).
+  [[ $collect == '*' ]] || awk -v name="${collect//\*/}" '
+    /^c?fn=\(/ {
+      match($0, /^c?fn=\([0-9]+\)/)
+      id = substr($0, index($0, "("), RLENGTH - index($0, "(") + 1)
+      if (length($0) > RLENGTH) names[id] = substr($0, RLENGTH + 2)
+      if ($0 ~ /^cfn=/) callee = names[id]
+      next
+    }
+    /^calls=/ { split($1, a, "="); if (index(callee, name)) calls += a[2] }
+    /^(summary|totals):/ { total = $2 }
+    END { if (calls) printf "%d instructions in %d calls: %.0f per call\n", total, calls, total / calls }' "$tmp/cg.out"
 fi

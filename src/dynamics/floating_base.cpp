@@ -119,6 +119,25 @@ void baseSolveInPlace(const Model& model, const Workspace& ws, VectorXmax6& x) {
   }
 }
 
+template <int W>
+void baseSolveLanesInPlace(const Model& model, const Workspace& ws, double* lanes) {
+  if (model.baseType() == BaseType::Free) {
+    Eigen::Map<Eigen::Matrix<double, 6, W, W == 1 ? Eigen::ColMajor : Eigen::RowMajor>> X(lanes);
+    FreeBaseFactor(ws).solveInPlace(X);  // the right-hand sides in lock step, a row at a time
+    return;
+  }
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, W, W == 1 ? Eigen::ColMajor : Eigen::RowMajor>> X(
+      lanes, model.baseVelocitySize(), W);
+  for (int c = 0; c < W; ++c) {
+    const VectorXmax6 x = X.col(c);
+    X.col(c) = ws.D_base.solve(x);
+  }
+}
+template void baseSolveLanesInPlace<1>(const Model&, const Workspace&, double*);
+template void baseSolveLanesInPlace<2>(const Model&, const Workspace&, double*);
+template void baseSolveLanesInPlace<4>(const Model&, const Workspace&, double*);
+template void baseSolveLanesInPlace<8>(const Model&, const Workspace&, double*);
+
 void baseKinematics(const Model& model, const VectorRef& q_base, const VectorRef& v_base, Workspace& ws,
                     bool with_inertia) {
   const Transform X = ws.Xworld[0] = basePose(model, q_base);

@@ -12,6 +12,7 @@
 namespace zwang::internal {
 
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
+using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 // Lines 3–6 for the base joint: the base's pose ⁰X₀ (into ws.Xworld[0]), its
 // motion subspace S₀ (ws.S_base), velocity Ẋ₀ (ws.v[0]), bias acceleration
@@ -29,6 +30,51 @@ Status baseInward(const Model& model, const Task& task, const VectorRef& tau_bas
 
 // x ← D₀⁻¹ x (k entries) with the factorisation baseInward made.
 void baseSolveInPlace(const Model& model, const Workspace& ws, VectorXmax6& x);
+// The same for W right-hand sides side by side: `lanes` is row-major k × W
+// (row j: base coordinate j of each). W = 1, 2, 4 or 8 (unitTorqueColumns'
+// blocks of columns).
+template <int W>
+void baseSolveLanesInPlace(const Model& model, const Workspace& ws, double* lanes);
+
+// unitTorqueColumns' base step inward: δu₀ = −S₀ᵀ δF for the wrenches δF
+// (6 × n) carried into body 0 (no torque at the base), into the first k rows
+// of du_base. A free base's S₀ = 1 is taken literally.
+inline void baseUnitTorques(const Model& model, const Workspace& ws, const Eigen::Ref<const Matrix6X>& dF,
+                            Eigen::Ref<Eigen::MatrixXd> du_base) {
+  const int kb = model.baseVelocitySize();
+  if (model.baseType() == BaseType::Free) {
+    du_base.topRows<6>() = -dF;  // S₀ = 1
+  } else {                       // in two steps: the negated product would be a heap temporary
+    du_base.topRows(kb).noalias() = ws.S_base.transpose() * dF;
+    du_base.topRows(kb) *= -1.0;
+  }
+}
+
+// ... and outward, after baseSolveLanesInPlace: from W columns' q̈₀ (`lanes`,
+// row-major k × W, the sweep's coordinates), δẌ₀ = S₀ q̈₀ into `da0` (W × 6,
+// a column per component) and the base's q̈ in the user's coordinates into
+// qdd_base (k × W; linear, as publishBaseAcceleration). Inline: it runs once
+// per block of columns, inside the outward pass.
+template <int W>
+void baseMotionLanes(const Model& model, const Workspace& ws, const double* lanes, double* da0,
+                     Eigen::Ref<Eigen::MatrixXd> qdd_base) {
+  const int kb = model.baseVelocitySize();
+  if (model.baseType() == BaseType::Free) {
+    for (int e = 0; e < 6 * W; ++e) da0[e] = lanes[e];  // S₀ = 1: the same layout
+    const Eigen::Map<const Eigen::Matrix<double, 6, W, W == 1 ? Eigen::ColMajor : Eigen::RowMajor>> q(lanes);
+    Eigen::Map<Eigen::Matrix<double, 6, W>, 0, Eigen::OuterStride<>> out(qdd_base.data(),
+                                                                         Eigen::OuterStride<>(qdd_base.outerStride()));
+    out.noalias() = ws.Xworld[0].motionMatrix() * q;  // v̇_B = ᴮX₀ Ẍ₀, in fixed sizes
+    return;
+  }
+  for (int l = 0; l < W; ++l) {
+    VectorXmax6 q(kb);
+    for (int j = 0; j < kb; ++j) q[j] = lanes[j * W + l];
+    const Vec6 a = ws.S_base * q;
+    for (int e = 0; e < 6; ++e) da0[e * W + l] = a[e];
+    qdd_base.col(l) = q;  // planar: the sweep's coordinates are the user's
+  }
+}
 
 // Lines 28–29 for the base joint, from ws.nu: q̈₀ (ws.qdd_base) and Ẍ₀ (ws.a[0]).
 void baseAcceleration(const Model& model, const Task& task, Workspace& ws);

@@ -387,28 +387,104 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 }
 
 namespace {
-// The base joint's step of unitTorqueColumns' inward pass: δu₀ = −S₀ᵀ δF^a₀
-// (no torque at the base) and its share of δU (line 20), per column.
-void baseUnitTorques(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Matrix6X>& dF,
-                     Eigen::Ref<Eigen::MatrixXd> du_base, Eigen::Ref<Eigen::MatrixXd> dU) {
+// The base's share of δU (line 20), (S₀ᵀA₀)ᵀ D₀⁻¹ δu₀ = (D₀⁻¹ S₀ᵀA₀)ᵀ δu₀
+// (D₀ is symmetric): the main pass's D₀⁻¹ S₀ᵀA₀, with no further solve.
+void baseShareOfU(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Eigen::MatrixXd>& du_base,
+                  Eigen::Ref<Eigen::MatrixXd> dU) {
   const int kb = model.baseVelocitySize();
-  const bool free = model.baseType() == BaseType::Free;
-  for (Eigen::Index c = 0; c < dF.cols(); ++c) {
-    if (free)
-      du_base.col(c).head<6>() = -dF.col(c);  // S₀ = 1
-    else
-      du_base.col(c).head(kb) = -(ws.S_base.transpose() * dF.col(c));
-    VectorXmax6 du_D = du_base.col(c).head(kb);
-    baseSolveInPlace(model, ws, du_D);
-    for (int r = 0; r < m; ++r) dU(r, c) += ws.SA_base.col(r).head(kb).dot(du_D);
+  dU.noalias() += ws.SA_base_D.topLeftCorner(kb, m).transpose() * du_base.topRows(kb);
+}
+
+// The base joint's step of the outward pass (lines 28–29) for W columns from
+// c0: δq̈₀ = D₀⁻¹(δu₀ + S₀ᵀA₀ δν), published per column, and δẌ₀ = S₀ δq̈₀
+// (the world's acceleration is fixed) into `da0` (W × 6, a column per
+// component). Row j of `du0` and of `dq` holds base coordinate j of the W
+// columns.
+template <int W>
+void baseLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, const UnitTorqueScratch& s,
+               const double* du0, Eigen::Ref<Eigen::MatrixXd> dqdd, double* da0) {
+  const int kb = model.baseVelocitySize(), m = task.solverColumns();
+  double q[6 * W];
+  using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
+  for (int j = 0; j < kb; ++j) {
+    Eigen::Map<Lanes> row(q + j * W);
+    row = Eigen::Map<const Lanes>(du0 + j * W);
+    for (int r = 0; r < m; ++r) row += ws.SA_base(j, r) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
+  }
+  baseSolveLanesInPlace<W>(model, ws, q);
+  baseMotionLanes<W>(model, ws, q, da0, dqdd.block(0, c0, kb, W));
+}
+
+// Line 25 for W columns as lanes: x ← 𝓛⁻¹ x with 𝓛 = C Cᵀ (a regular
+// balance's Cholesky factor), x the W × m block at `lanes` (leading dimension
+// `stride`; row w: column w's right-hand side). Forward and backward
+// substitution on whole lanes: each step is one vector operation for all W
+// columns (a column at a time, each step is a short scalar loop).
+template <int W>
+void balanceSolveLanes(const Eigen::MatrixXd& C, int m, double* lanes, Eigen::Index stride) {
+  using Lanes = Eigen::Matrix<double, W, 1>;
+  for (int i = 0; i < m; ++i) {  // C y = x
+    Eigen::Map<Lanes> x(lanes + i * stride);
+    for (int l = 0; l < i; ++l) x -= C(i, l) * Eigen::Map<const Lanes>(lanes + l * stride);
+    x *= 1.0 / C(i, i);
+  }
+  for (int i = m - 1; i >= 0; --i) {  // Cᵀ x = y
+    Eigen::Map<Lanes> x(lanes + i * stride);
+    for (int l = i + 1; l < m; ++l) x -= C(l, i) * Eigen::Map<const Lanes>(lanes + l * stride);
+    x *= 1.0 / C(i, i);
+  }
+}
+
+// Lines 28–29 for the differences, for the W columns from c0 side by side:
+// each body's step is a few loops over W lanes, one per column, which the
+// compiler vectorises, and reads the body's S, I^A S, 1/D and SᵀA once for all
+// W. Body i's δẌ hangs from its parent's: s.da's column i, W × 6 (a column
+// per component).
+template <int W>
+void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, bool solve_balance,
+                  UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
+  using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
+  const int N = model.dof(), m = task.solverColumns(), kb = model.baseVelocitySize();
+  double du0[6 * W];  // δu₀ of a floating base, row-major kb × W
+  for (int j = 0; j < kb; ++j) Eigen::Map<Lanes>(du0 + j * W) = s.du_base.template block<1, W>(j, c0).transpose();
+  auto dnu_lanes = s.dnu_lanes.topLeftCorner(W, m);  // SᵀA δν: whole lanes per row
+  if (solve_balance) {
+    dnu_lanes = s.dU.block(0, c0, m, W).transpose();  // −δU₀ of the joints, then of the base (baseShareOfU)
+    for (int r = 0; r < m; ++r) {
+      Eigen::Map<Lanes> x(dnu_lanes.col(r).data());
+      for (int j = 0; j < kb; ++j) x -= ws.SA_base_D(j, r) * Eigen::Map<const Lanes>(du0 + j * W);
+    }
+    balanceSolveLanes<W>(ws.balance_factorisation.factor, m, dnu_lanes.data(), s.dnu_lanes.outerStride());
+    dnu.middleCols(c0, W) = dnu_lanes.transpose();
+  } else {
+    dnu_lanes = dnu.middleCols(c0, W).transpose();
+  }
+  double* da = s.da.data();
+  const Eigen::Index da_stride = s.da.outerStride();
+  if (kb > 0)
+    baseLanes<W>(model, task, ws, c0, s, du0, dqdd, da);
+  else
+    for (int e = 0; e < 6 * W; ++e) da[e] = 0.0;  // a fixed base: δẌ₀ = 0
+  for (int i = 1; i <= N; ++i) {
+    Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
+    const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
+    for (Eigen::Index c = from; c < to; ++c) dq[c - c0] = s.du(i, c);
+    const int first = task.firstColumn(i), ki = task.activeColumns(i);
+    for (int r = first; r < ki; ++r) dq += ws.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
+    const double* parent = da + model.parent(i) * da_stride;
+    const Vec6& IAS = ws.IAS[at(i)];
+    for (int e = 0; e < 6; ++e) dq -= IAS[e] * Eigen::Map<const Lanes>(parent + e * W);
+    dq *= ws.inverse_D[at(i)];
+    dqdd.template block<1, W>(kb + i - 1, c0) = dq.transpose();
+    const Vec6& S = ws.S[at(i)];
+    double* child = da + i * da_stride;
+    for (int e = 0; e < 6; ++e) Eigen::Map<Lanes>(child + e * W) = Eigen::Map<const Lanes>(parent + e * W) + S[e] * dq;
   }
 }
 }  // namespace
 
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
-                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> du_base,
-                       Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
-                       Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da) {
+                       UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
   // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
   // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
   // Column c is zero except on the path from its joint's body s_c to the
@@ -418,11 +494,11 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   const int N = model.dof();
   const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(joints.size());
-  const bool floating = model.hasFloatingBase();
-  const int kb = model.baseVelocitySize();
+  auto du = s.du.leftCols(k);
+  auto dU = s.dU.topLeftCorner(m, k);
+  auto dF = s.dF.leftCols(k);
   dU.setZero();
-  dF.setZero();
-  du.setZero();
+  dF.setZero();              // du is written where it is read: on each body's run of columns
   Eigen::Index c_begin = k;  // the first column with its joint's body ≥ i: falls with i
   for (int i = N; i >= 1; --i) {
     while (c_begin > 0 && bodyOfJoint(joints[static_cast<std::size_t>(c_begin - 1)]) >= i) --c_begin;
@@ -432,6 +508,8 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
                                    : std::lower_bound(joints.begin(), joints.end(), end, [](int j, int b) {
                                        return bodyOfJoint(j) < b;
                                      }) - joints.begin();
+    s.run_begin[i] = c_begin;
+    s.run_end[i] = c_end;
     const Vec6& S = ws.S[at(i)];
     const Vec6& IAS = ws.IAS[at(i)];
     const double inverse_D = ws.inverse_D[at(i)];
@@ -444,8 +522,14 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
       dF.col(c) += IAS * du_D;                                          // lines 17–18
     }
   }
-  if (floating) baseUnitTorques(model, ws, m, dF, du_base, dU);  // every column's δF^a has reached body 0
-  dU.topRows(m) *= -1.0;     // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+  if (model.hasFloatingBase())  // every column's δF^a has reached body 0
+    baseUnitTorques(model, ws, dF, s.du_base.leftCols(k));
+  // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
+  // outward pass's lanes, a block of columns at a time, with the base's share
+  // of δU added there; else here, all at once.
+  const bool solve_in_lanes = !task.hasRelative() && !ws.balance_factorisation.by_eigen;
+  if (model.hasFloatingBase() && !solve_in_lanes) baseShareOfU(model, ws, m, s.du_base.leftCols(k), dU);
+  dU *= -1.0;                // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
     auto dU_rows = ws.dU_rows.topLeftCorner(rows, k);
@@ -454,32 +538,26 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
     auto dnu_rows = ws.dnu_rows.topLeftCorner(rows, k);
     balanceApplyColumns(ws.balance_factorisation, dU_rows, dnu_rows, ws.balance_factorisation.work.head(rows));
     expandToColumns(task, dnu_rows, dnu.topRows(m));
-  } else {
-    balanceApplyColumns(ws.balance_factorisation, dU.topRows(m), dnu.topRows(m), ws.balance_factorisation.work.head(m));
+  } else if (!solve_in_lanes) {
+    balanceApplyColumns(ws.balance_factorisation, dU, dnu.topRows(m), ws.balance_factorisation.work.head(m));
   }
-  // Lines 28–29 for the differences: δẌ per body, one column at a time (the
-  // bodies' δẌ hang from their parents'; da holds one column's; δẌ₀ = 0 on
-  // a fixed base, S₀ δq̈₀ on a floating one, the world's acceleration fixed).
-  da.col(0).setZero();
-  for (Eigen::Index c = 0; c < k; ++c) {
-    if (floating) {
-      VectorXmax6 dq_base = du_base.col(c).head(kb);
-      dq_base.noalias() += ws.SA_base.topLeftCorner(kb, m) * dnu.col(c).head(m);
-      baseSolveInPlace(model, ws, dq_base);
-      if (model.baseType() == BaseType::Free)
-        da.col(0) = dq_base;  // S₀ = 1
-      else
-        da.col(0) = ws.S_base * dq_base;
-      publishBaseAcceleration(model, ws, dq_base, dqdd.col(c).head(kb));
-    }
-    for (int i = 1; i <= N; ++i) {
-      const int first = task.firstColumn(i), ki = task.activeColumns(i);
-      double constraint = 0.0;
-      for (int r = first; r < ki; ++r) constraint += ws.SA(r, i) * dnu(r, c);
-      const auto parent_da = da.col(model.parent(i));
-      const double dq = (du(i, c) - ws.IAS[at(i)].dot(parent_da) + constraint) * ws.inverse_D[at(i)];
-      dqdd(kb + i - 1, c) = dq;
-      da.col(i) = parent_da + ws.S[at(i)] * dq;
+  // Lines 28–29 for the differences: the widest blocks of columns first, so
+  // that few lanes idle (29 stuck joints: 8 + 8 + 8 + 4 + 1).
+  constexpr int kLanes = UnitTorqueScratch::kLanes;
+  for (Eigen::Index c0 = 0; c0 < k;) {
+    const Eigen::Index left = k - c0;
+    if (left >= kLanes) {
+      outwardLanes<kLanes>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      c0 += kLanes;
+    } else if (left >= 4) {
+      outwardLanes<4>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      c0 += 4;
+    } else if (left >= 2) {
+      outwardLanes<2>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      c0 += 2;
+    } else {
+      outwardLanes<1>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      c0 += 1;
     }
   }
 }

@@ -43,17 +43,40 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
 // Line 29 alone: Ẍ (into ws.a) from a known q̈.
 void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd);
 
+// Scratch of unitTorqueColumns, sized once for up to `dof` columns.
+struct UnitTorqueScratch {
+  // The outward pass takes the columns this many at a time, side by side:
+  // four SSE2 pairs per operation (29 columns: 8 + 8 + 8 + 4 + 1).
+  static constexpr int kLanes = 8;
+  UnitTorqueScratch(int dof, int bodies, int capacity)
+      : du(bodies, dof),
+        du_base(6, dof),
+        dU(capacity, dof),
+        dF(6, dof),
+        da(6 * kLanes, bodies),
+        dnu_lanes(kLanes, capacity),
+        run_begin(bodies),
+        run_end(bodies) {}
+  Eigen::MatrixXd du;         // bodies × k: δu_i per unit torque
+  Eigen::MatrixXd du_base;    // 6 × k: δu₀ of a floating base per unit torque
+  Eigen::MatrixXd dU;         // capacity × k: δU₀ per unit torque
+  Matrix6X dF;                // 6 × k: δF^A carried inward per unit torque
+  Eigen::MatrixXd da;         // column i: body i's δẌ for up to kLanes columns (kLanes × 6, column-major)
+  Eigen::MatrixXd dnu_lanes;  // kLanes × capacity: δν of those columns, one row per column
+  // Body i's run of columns [run_begin[i], run_end[i]): those whose joint's
+  // body lies in i's subtree, the only ones with δu_i ≠ 0 (du is set there only).
+  Eigen::Matrix<Eigen::Index, Eigen::Dynamic, 1> run_begin, run_end;
+};
+
 // k extra right-hand sides through the same sweeps, all at once: column c is
 // a unit torque at joint joints[c] (ascending), everything else zero. Gives
 // δν (dnu: solver columns × k) and δq̈ = ∂q̈/∂τ_joint (dqdd: nv × k, a
-// floating base's rows first); du (bodies × k), du_base (6 × k), dF (6 × k),
-// da (6 × bodies) and dU (solver columns × k) are scratch. Needs inwardSweep
-// and balance first. O((N + m²)·k): the sensitivity K_Θ of the friction
-// extension, as matrix–row products over the k columns rather than k sweeps.
+// floating base's rows first). Needs inwardSweep and balance first.
+// O((N + m²)·k): the sensitivity K_Θ of the friction extension. The inward
+// pass visits only each column's path to the base; the balance solve and the
+// outward pass take up to kLanes columns side by side.
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
-                       Eigen::Ref<Eigen::MatrixXd> du, Eigen::Ref<Eigen::MatrixXd> du_base,
-                       Eigen::Ref<Eigen::MatrixXd> dU, Eigen::Ref<Eigen::MatrixXd> dnu,
-                       Eigen::Ref<Eigen::MatrixXd> dqdd, Eigen::Ref<Matrix6X> dF, Eigen::Ref<Matrix6X> da);
+                       UnitTorqueScratch& scratch, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd);
 
 // The joints whose q lies outside their limits, into the solution (a warning).
 void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out);

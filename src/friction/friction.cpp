@@ -145,8 +145,7 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   outwardAccelerations(model, task, ws, fs.qdd0);
   fs.nu0.head(m) = ws.nu.head(m);
   if (k > 0)
-    unitTorqueColumns(model, task, ws, stuck, fs.du.leftCols(k), fs.du_base.leftCols(k), fs.dU.topLeftCorner(m, k),
-                      fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k), fs.dF.leftCols(k), fs.da);
+    unitTorqueColumns(model, task, ws, stuck, fs.unit_torques, fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k));
   return {};
 }
 
@@ -377,8 +376,8 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   stuckSetAndKineticFriction(model, q, qd, tau, options, fs, fr);
   const auto k = static_cast<Eigen::Index>(fr.stuck.size());
   if (Status s = sweepsWithSensitivities(model, task, q, qd, fr.stuck, ws, fs); !s) return s;
-  fr.dqdd_dmu.setZero();
-  for (Eigen::Index a = 0; a < k; ++a)  // μ_j enters as the torque −μ_j
+  if (k < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
+  for (Eigen::Index a = 0; a < k; ++a)         // μ_j enters as the torque −μ_j
     fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);
   const int iv = model.baseVelocitySize();
 

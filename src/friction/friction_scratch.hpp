@@ -20,13 +20,9 @@ struct FrictionScratch {
         hi(dof),
         qdd0(nv),
         nu0(capacity),
-        du(bodies, dof),
-        du_base(6, dof),
-        dU(capacity, dof),
+        unit_torques(dof, bodies, capacity),
         dnu(capacity, dof),
         dqdd(nv, dof),
-        dF(6, dof),
-        da(6, bodies),
         K(dof, dof),
         qdd0_stuck(dof),
         curvature_terms(dof),
@@ -47,15 +43,11 @@ struct FrictionScratch {
   Eigen::VectorXd lo, hi;                       // Λ on Θ₀ (±∞ where a limit stop pushes)
 
   // ∂q̈/∂μ in the same sweeps
-  Eigen::VectorXd qdd0;     // q̈(μ = 0)
-  Eigen::VectorXd nu0;      // ν(μ = 0), per solver column
-  Eigen::MatrixXd du;       // bodies × k: δu_i per unit torque (sweep scratch)
-  Eigen::MatrixXd du_base;  // k_base × k: δu₀ of a floating base per unit torque (sweep scratch)
-  Eigen::MatrixXd dU;       // capacity × k: δU₀ per unit torque
-  Eigen::MatrixXd dnu;      // capacity × k: δν per unit torque
-  Eigen::MatrixXd dqdd;     // nv × k: δq̈ per unit torque (a floating base's rows first)
-  Matrix6X dF;              // 6 × k: δF^A per unit torque (sweep scratch)
-  Matrix6X da;              // 6 × bodies: δẌ of one unit torque (sweep scratch)
+  Eigen::VectorXd qdd0;            // q̈(μ = 0)
+  Eigen::VectorXd nu0;             // ν(μ = 0), per solver column
+  UnitTorqueScratch unit_torques;  // the sweeps' scratch
+  Eigen::MatrixXd dnu;             // capacity × k: δν per unit torque
+  Eigen::MatrixXd dqdd;            // nv × k: δq̈ per unit torque (a floating base's rows first)
 
   // The maximiser: min ½ μᵀ K_ΘΘ μ − μᵀ q̈_Θ(0) over Λ
   Eigen::MatrixXd K;                // K_ΘΘ = rows Θ of −∂q̈/∂μ

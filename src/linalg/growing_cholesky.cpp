@@ -136,6 +136,40 @@ Eigen::Index pivotedCholesky(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen:
   return r;
 }
 
+// Householder QR of the factored columns L (n × r, lower trapezoidal): each
+// reflector H_j = I − 2 v vᵀ (‖v‖ = 1) is kept in column j of A, rows j…n−1.
+void householderOfFactor(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Index r) {
+  const Eigen::Index n = A.rows();
+  for (Eigen::Index j = 0; j < r; ++j) {
+    auto column = A.col(j);
+    column.head(j).setZero();               // L is lower trapezoidal (above: scratch)
+    for (Eigen::Index h = 0; h < j; ++h) {  // the earlier reflectors act on column j
+      const double* v = &A(h, h);
+      subtractScaled(2.0 * dotSegment(v, &column[h], n - h), v, &column[h], n - h);
+    }
+    const double norm = column.tail(n - j).norm();
+    const double alpha = column[j] >= 0.0 ? norm : -norm;
+    column[j] += alpha;                                        // v = x + sign(x_j)‖x‖ e_j, then normalised
+    const double v_norm = std::sqrt(2.0 * alpha * column[j]);  // ‖v‖² = 2α(x_j + α)
+    column.tail(n - j) *= v_norm > 0.0 ? 1.0 / v_norm : 0.0;
+  }
+}
+
+// N = Q [0; I] from the reflectors householderOfFactor left in A: the unit
+// columns e_{r+e} with H_{r−1}, …, H₀ applied.
+void complementByReflectors(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Index r, Eigen::Ref<Eigen::MatrixXd> N) {
+  const Eigen::Index n = A.rows();
+  for (Eigen::Index e = 0; e < n - r; ++e) {
+    double* d = &N(0, e);
+    for (Eigen::Index i = 0; i < n; ++i) d[i] = 0.0;
+    d[r + e] = 1.0;
+    for (Eigen::Index h = r - 1; h >= 0; --h) {
+      const double* v = A.data() + h + h * A.outerStride();
+      subtractScaled(2.0 * dotSegment(v, d + h, n - h), v, d + h, n - h);
+    }
+  }
+}
+
 // The complement of the factored columns L = [L₁₁; L₂₁] (n × r, pivoted
 // order) is null(Lᵀ): the columns [−L₁₁⁻ᵀ L₂₁ᵀ; I]. Column e of N gets the
 // one that moves the remaining index r + e: back substitution with L₁₁ᵀ,
@@ -184,8 +218,21 @@ Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::R
   // that way, 63,300 this way (callgrind, floating_fric_as_m12_kall/humanoid).
   const Eigen::Index nullity = n - r;
   if (nullity == 0) return 0;
-  complementOfFactor(A, r, N);
-  orthonormaliseTwice(N, nullity);
+  // Few factored columns and many null directions (a 7-joint arm holding a
+  // 6-D pose: r = 1, nullity 6) favour the QR, whose reflectors cost
+  // O(n·r²) and give orthonormal columns in O(n·r·nullity); the triangular
+  // solve then Gram–Schmidt costs O(r²·nullity + n·nullity²), which that
+  // case makes 6× dearer (Panda, all 7 joints stuck, 6 rows: nearNullSpace
+  // 1,800 instructions per solve by QR, 4,100 by Gram–Schmidt; callgrind,
+  // fric_as_ee6_kall/panda). Both span the same subspace; the leading terms
+  // decide.
+  if (n * r * (r + nullity) <= nullity * (r * r + 2 * n * nullity)) {
+    householderOfFactor(A, r);
+    complementByReflectors(A, r, N);
+  } else {
+    complementOfFactor(A, r, N);
+    orthonormaliseTwice(N, nullity);
+  }
   // Rows back in the original order: the pivot exchanges undone, last first.
   for (Eigen::Index t = r - 1; t >= 0; --t)
     if (pivot_row[t] != t) N.row(t).head(nullity).swap(N.row(pivot_row[t]).head(nullity));

@@ -46,7 +46,8 @@ class GrowingCholesky {
 // Schur-complement diagonal is at most `floor`. Writes an orthonormal basis of
 // the remaining directions into the first columns of N (n × n capacity) and
 // returns their number n − r: the orthogonal complement of the r factored
-// columns (a triangular solve with them, then Gram–Schmidt twice). Each has
+// columns (Householder QR of them, or a triangular solve with them then
+// Gram–Schmidt twice, whichever costs less for r and n − r). Each has
 // curvature dᵀ A d ≤ (n − r)·floor:
 // for d ⟂ range(L), dᵀAd = d₂ᵀ S d₂ with the Schur complement S positive
 // semi-definite and trace S ≤ (n − r)·floor. Only A's lower triangle is read;

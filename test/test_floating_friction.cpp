@@ -535,6 +535,27 @@ TEST_CASE("floating trees: the least-effort pick where contacts share the load, 
 
 namespace {
 
+// The held-on-limits task: joints 0 and 1 held still by joint rows, and two
+// feet (3 world rows each, contacts) on the links given.
+void holdTwoJointsOnTwoFeet(FloatingInput& input, const std::string& first_foot, const std::string& second_foot) {
+  for (const int j : {0, 1}) {
+    ConstraintInput hold;
+    hold.joint = j;
+    hold.A = Matrix6Xd::Zero(6, 1);
+    hold.b = Eigen::VectorXd::Zero(1);
+    input.constraints.push_back(hold);
+  }
+  for (const std::string& link : {first_foot, second_foot}) {
+    ConstraintInput foot;
+    foot.link = link;
+    foot.A = Matrix6Xd::Identity(6, 3);
+    foot.b = Eigen::VectorXd::Zero(3);
+    foot.axes = Axes::World;
+    foot.contact = true;
+    input.constraints.push_back(foot);
+  }
+}
+
 // A free-floating 4-joint chain whose base and last link touch the ground
 // (3 world rows each) and whose first two joints rest on a limit (j0 on its
 // lower, j1 on its upper), each held by a joint row q̈ = 0; every joint stuck.
@@ -584,22 +605,7 @@ FloatingProblem heldOnLimits() {
   p.input.v.head(6) << 0.062600654163641023, 0.20302263090680597, -0.025692398591943732, 0.20835363612850472,
       -0.27375996905286976, -0.12700140892318038;
   p.input.tau = Eigen::VectorXd::Zero(10);
-  for (const int j : {0, 1}) {
-    ConstraintInput hold;
-    hold.joint = j;
-    hold.A = Matrix6Xd::Zero(6, 1);
-    hold.b = Eigen::VectorXd::Zero(1);
-    p.input.constraints.push_back(hold);
-  }
-  for (const char* link : {"base", "l3"}) {
-    ConstraintInput foot;
-    foot.link = link;
-    foot.A = Matrix6Xd::Identity(6, 3);
-    foot.b = Eigen::VectorXd::Zero(3);
-    foot.axes = Axes::World;
-    foot.contact = true;
-    p.input.constraints.push_back(foot);
-  }
+  holdTwoJointsOnTwoFeet(p.input, "base", "l3");
   return p;
 }
 
@@ -628,22 +634,7 @@ FloatingProblem randomHeldOnLimits(std::mt19937_64& rng) {
   p.input.tau.setZero();
   p.input.q(7) = p.spec.joints[0].lower;
   p.input.q(8) = p.spec.joints[1].upper;
-  for (const int j : {0, 1}) {
-    ConstraintInput hold;
-    hold.joint = j;
-    hold.A = Matrix6Xd::Zero(6, 1);
-    hold.b = Eigen::VectorXd::Zero(1);
-    p.input.constraints.push_back(hold);
-  }
-  for (const std::string& link : {p.spec.links.front().name, p.spec.links.back().name}) {
-    ConstraintInput foot;
-    foot.link = link;
-    foot.A = Matrix6Xd::Identity(6, 3);
-    foot.b = Eigen::VectorXd::Zero(3);
-    foot.axes = Axes::World;
-    foot.contact = true;
-    p.input.constraints.push_back(foot);
-  }
+  holdTwoJointsOnTwoFeet(p.input, p.spec.links.front().name, p.spec.links.back().name);
   return p;
 }
 

@@ -288,16 +288,28 @@ FrictionReference bruteForceFriction(const FrictionSystem& system, const BruteFo
   return out;
 }
 
-FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
-                                     const BruteForceOptions& options) {
-  checkSetup(spec, input, setup);
-  const DynamicsInput in = withKinetic(input, setup);  // τ' = τ + τ_kinetic
-  const DenseResult dense = denseDynamics(spec, in);   // H, C, G, γ (independent of τ)
+namespace {
+
+// A friction system with the dense reference's H, C, G and γ (a DenseResult
+// or a FloatingResult: the same fields); the rest is the caller's.
+template <class Dense>
+FrictionSystem dynamicsOf(const Dense& dense) {
   FrictionSystem system;
   system.H = dense.H;
   system.C = dense.C;
   system.G = dense.G;
   system.gamma = dense.gamma;
+  return system;
+}
+
+}  // namespace
+
+FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,
+                                     const BruteForceOptions& options) {
+  checkSetup(spec, input, setup);
+  const DynamicsInput in = withKinetic(input, setup);  // τ' = τ + τ_kinetic
+  const DenseResult dense = denseDynamics(spec, in);   // H, C, G, γ (independent of τ)
+  FrictionSystem system = dynamicsOf(dense);
   system.tau = in.tau;
   system.gauss_at_rest = gaussFunction(spec, in, Eigen::VectorXd::Zero(spec.dof()));
   system.stuck = setup.stuck;
@@ -324,11 +336,7 @@ FrictionReference bruteForceFloatingFriction(const ChainSpec& spec, const Floati
   const Eigen::VectorXd kinetic = kineticTorque(setup, input.v.tail(n));
   in.tau.tail(n) += kinetic;  // τ' = τ + τ_kinetic
   const FloatingResult dense = floatingDynamics(spec, base, in);
-  FrictionSystem system;
-  system.H = dense.H;
-  system.C = dense.C;
-  system.G = dense.G;
-  system.gamma = dense.gamma;
+  FrictionSystem system = dynamicsOf(dense);
   system.tau = in.tau;
   system.gauss_at_rest = floatingGaussFunction(spec, base, in, Eigen::VectorXd::Zero(nb + n));
   for (const int j : setup.stuck) system.stuck.push_back(nb + j);  // the base is never stuck

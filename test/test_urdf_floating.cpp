@@ -326,3 +326,72 @@ TEST_CASE("a floating base's links are judged like moving ones", "[urdf][floatin
   REQUIRE_THROWS_WITH(loadUrdfString(urdf, withBase(BaseType::Free)),
                       Contains("link 'bad'") && Contains("<mass>") && Contains("negative"));
 }
+
+TEST_CASE("contacts on the humanoid loaded bolted down warn, naming the floating base (Task::warnings)",
+          "[urdf][floating]") {
+  // The humanoid's URDF has no root joint: loaded as it is, its base (BODY,
+  // 27 kg, welded to base_link) is bolted to the world, which then holds the
+  // robot up in place of its feet. Standing on both feet (two contacts, every
+  // joint held by its motor), the ground carries the whole weight only with a
+  // free base (Newton: Σ f_z = m g at rest).
+  const auto standing = [](const Model& m, std::vector<std::string> contacts) {
+    Task task(m);
+    for (const std::string& foot : contacts) task.addContact(foot, ConstraintMatrix::Identity(6, 6), Expressed::World);
+    for (int j = 0; j < m.dof(); ++j) task.addJointConstraint(j);
+    return task;
+  };
+  const Model bolted = loadUrdfFile(kModels + "/simple_humanoid.urdf");
+  const Model free = loadUrdfFile(kModels + "/simple_humanoid.urdf", withBase(BaseType::Free));
+  REQUIRE_FALSE(bolted.hasFloatingBase());
+  REQUIRE(bolted.inertia(0).mass == 27.0);
+
+  const Task on_feet = standing(bolted, {"l_ankle", "r_ankle"});
+  REQUIRE(on_feet.warnings().size() == 1);  // once per task, not per contact
+  const ModelWarning& w = on_feet.warnings()[0];
+  CHECK(w.code == WarningCode::FixedBaseContact);
+  CHECK(std::string(toString(w.code)) == "fixed_base_contact");
+  CHECK_THAT(w.message, Contains("contact on frame 'l_ankle' of a fixed-base model whose base carries 27 kg "
+                                 "(link 'base_link' and the links welded to it)"));
+  for (const char* fix : {"UrdfOptions::base = BaseType::Free", "ModelBuilder::setBase",
+                          "CLI \"base\": {\"type\": \"free\"}", "Python base=\"free\""})
+    CHECK_THAT(w.message, Contains(fix));
+  CHECK(standing(free, {"l_ankle", "r_ankle"}).warnings().empty());
+  CHECK(standing(bolted, {}).warnings().empty());  // joint rows alone: an arm holding a pose
+  Task reached(bolted);                            // a hand's constraint that is not a contact
+  reached.addConstraint("l_wrist", ConstraintMatrix::Identity(6, 3));
+  CHECK(reached.warnings().empty());
+  // An arm whose base link carries no mass may touch a table without a warning.
+  const Model panda = loadUrdfFile(kModels + "/panda.urdf");
+  REQUIRE(panda.inertia(0).mass == 0.0);
+  Task table(panda);
+  table.addContact("panda_link8", ConstraintMatrix::Identity(6, 3), Expressed::World);
+  CHECK(table.warnings().empty());
+
+  // What the warning is about: the ground's vertical force on the two feet.
+  const auto groundForce = [&](const Model& m) {
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(m.nq());
+    if (m.hasFloatingBase()) q.head<7>() << 0, 0, 1, 1, 0, 0, 0;
+    const int base = m.baseConfigurationSize();
+    for (const auto& [joint, value] : std::vector<std::pair<std::string, double>>{{"LLEG_HIP_P", -0.12},
+                                                                                  {"RLEG_HIP_P", -0.12},
+                                                                                  {"LLEG_KNEE", 0.06},
+                                                                                  {"RLEG_KNEE", 0.06},
+                                                                                  {"LLEG_ANKLE_P", 0.06},
+                                                                                  {"RLEG_ANKLE_P", 0.06}})
+      q[base + m.jointIndex(joint)] = value;
+    const Task task = standing(m, {"l_ankle", "r_ankle"});
+    Workspace ws(m, task);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(m.nv());
+    const Status s = solveHybridDynamics(m, task, q, zero, zero, ws);
+    INFO(s.message);
+    REQUIRE(s);
+    return ws.solution.nu[2] + ws.solution.nu[8];  // f_z of each foot (world axes, linear rows first)
+  };
+  const double weight = totalMass(free) * 9.81;
+  const double bolted_force = groundForce(bolted), free_force = groundForce(free);
+  std::printf(
+      "humanoid on both feet, the ground's vertical force: bolted down %.3g N, free base %.6g N (weight %.6g N)\n",
+      bolted_force, free_force, weight);
+  CHECK(std::abs(free_force - weight) < 1e-9 * weight);
+  CHECK(std::abs(bolted_force) < 0.01 * weight);  // the world holds it: the silent wrong answer warned about
+}

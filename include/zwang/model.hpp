@@ -111,9 +111,10 @@ inline Transform Joint::transform(double q) const {
   return X;
 }
 
-/// Something in the model data that is physically doubtful but usable: the
-/// model loads and the dynamics uses the data as given (docs/errors.md,
-/// "Model warnings"). UrdfOptions::strict turns every warning into a ModelError.
+/// Something in the model data (or in a task on it) that is physically doubtful
+/// but usable: the model loads and the dynamics uses the data as given
+/// (docs/errors.md, "Model warnings"). UrdfOptions::strict turns every warning
+/// of the model into a ModelError.
 enum class WarningCode {
   PointMass,           ///< a moving link with mass but zero rotational inertia
   PlaceholderInertia,  ///< rotational inertia too small for the mass (a body denser than osmium)
@@ -126,6 +127,8 @@ enum class WarningCode {
   /// a mimic joint was locked (UrdfOptions::mimic = MimicJoints::Lock); a note, strict mode lets it pass
   MimicLocked,
   Urdfdom,  ///< urdfdom's own warning, passed on once
+  /// a contact on a fixed-base model whose base carries mass (Task::warnings): a robot meant to stand bolted down
+  FixedBaseContact,
 };
 /// "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.
 const char* toString(WarningCode code);

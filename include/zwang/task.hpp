@@ -99,6 +99,10 @@ class Task {
   /// on the ground, a hand against a wall. It moves the robot like
   /// addConstraint's, its ν is that contact force, and it is left out of
   /// Solution::tau_constraint and tau_control (the motors do not give it).
+  /// On a fixed-base model whose base (body 0) carries mass the first contact
+  /// records a FixedBaseContact warning (warnings()): the world holds that base
+  /// up, so a robot standing on its contacts, loaded without a floating base,
+  /// would be solved bolted down.
   int addContact(int frame, const ConstraintMatrix& A, Expressed expressed = Expressed::Local);
   /// The same, with the frame given by name (ModelError for an unknown name).
   int addContact(const std::string& frame, const ConstraintMatrix& A, Expressed expressed = Expressed::Local);
@@ -129,6 +133,10 @@ class Task {
   int balanceRows() const { return constraintRows() + mimic_rows_; }
   /// Number of wrenches added.
   int wrenchCount() const { return static_cast<int>(wrenches_.size()); }
+  /// What is doubtful about the task on its model (each once, in the order
+  /// found): FixedBaseContact (addContact). The front ends print them as they
+  /// print Model::warnings().
+  const std::vector<ModelWarning>& warnings() const { return warnings_; }
 
   // --- read by the solver -------------------------------------------------
   /// The constraints on one frame, as the solver reads them. A relative
@@ -195,6 +203,8 @@ class Task {
   std::vector<std::string> frame_names_;  // copied, so the Task does not dangle
   std::vector<std::string> joint_names_;  // likewise
   std::vector<int> frame_bodies_;
+  double fixed_base_mass_;  // body 0's mass when the base is fixed (the world holds it), else 0
+  std::vector<ModelWarning> warnings_;
   std::vector<ConstraintGroup> groups_;
   std::vector<int> subtree_end_;  // per body, copied from the model
   std::vector<int> solver_row_;

@@ -237,8 +237,8 @@ Problem readProblem(const std::string& file) {
   const JsonReader in(file);
   if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
   in.object(doc, "",
-            {"model", "root", "tip", "strict", "attach_beyond_tip", "lock_mimic", "gravity", "q", "qd", "tau",
-             "rotor_inertia", "breakaway", "wrenches", "constraints", "friction", "balance", "base"});
+            {"model", "root", "tip", "strict", "attach_beyond_tip", "lock_mimic", "follow_leaders", "gravity", "q",
+             "qd", "tau", "rotor_inertia", "breakaway", "wrenches", "constraints", "friction", "balance", "base"});
 
   Problem p;
   p.file = file;
@@ -254,6 +254,7 @@ Problem readProblem(const std::string& file) {
   if (doc.contains("attach_beyond_tip"))
     p.attach_beyond_tip = in.boolean(doc["attach_beyond_tip"], "attach_beyond_tip");
   if (doc.contains("lock_mimic")) p.lock_mimic = in.boolean(doc["lock_mimic"], "lock_mimic");
+  if (doc.contains("follow_leaders")) p.follow_leaders = in.boolean(doc["follow_leaders"], "follow_leaders");
   if (doc.contains("gravity")) p.gravity = Vec3(in.numbers(doc["gravity"], "gravity", 3, "gx, gy, gz"));
   for (const char* key : {"q", "qd", "tau"})
     if (doc.contains(key)) {
@@ -302,6 +303,10 @@ BoundProblem bindProblem(const Problem& p) {
     in.fail("base", std::string("missing: the URDF's root joint gives the robot a ") + toString(model.baseType()) +
                         " base, whose state the problem must give: \"base\": {\"type\": \"" +
                         toString(model.baseType()) + "\", …} (docs/cli.md, \"Floating base\")");
+  // An option that would change nothing is refused, as "breakaway" without "friction" is.
+  if (p.follow_leaders && model.mimicJoints().empty())
+    in.fail("follow_leaders", std::string("has no effect: the model has no mimic joints") +
+                                  (p.lock_mimic ? " (\"lock_mimic\": true welded them)" : ""));
   const int n = model.dof();
   const std::string per_joint = "one per moving joint: " + jointList(model);
   auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key) {
@@ -346,6 +351,7 @@ BoundProblem bindProblem(const Problem& p) {
   b.q = stack(p.base.q, p.q);
   b.qd = stack(p.base.v, p.qd);
   b.tau = stack(p.base.force, p.tau);
+  if (p.follow_leaders) m.followLeaders(b.q, b.qd);  // the followers' entries of "q" and "qd" are replaced
   b.task = std::make_unique<Task>(m);
   Task& task = *b.task;
   if (p.gravity) task.gravity = *p.gravity;

@@ -52,6 +52,7 @@ struct Problem {
   bool strict = false;             // "strict": refuse the model's warnings
   bool attach_beyond_tip = false;  // "attach_beyond_tip": weld the links beyond the tip as a payload
   bool lock_mimic = false;         // "lock_mimic": weld the mimic joints (MimicJoints::Lock)
+  bool follow_leaders = false;  // "follow_leaders": each mimic joint's q, qd from its leader's (Model::followLeaders)
   std::optional<Vec3> gravity;
   std::optional<Eigen::VectorXd> q, qd, tau, rotor_inertia, breakaway;
   std::vector<WrenchSpec> wrenches;

@@ -39,6 +39,8 @@ int commandSolve(int argc, char** argv) {
   const Problem problem = readProblem(args.positional[0]);
   BoundProblem bound = bindProblem(problem);
   printWarnings(bound.model);
+  for (const ModelWarning& w : bound.task->warnings())  // the task's, e.g. contacts on a bolted-down base
+    std::fprintf(stderr, "zwang: warning: %s: %s\n", problem.file.c_str(), printable(w.message, 4000).c_str());
   warnOutsideLimits(problem.file, bound.model, bound.q);
   Workspace ws(bound.model, *bound.task);
   const Status status =

@@ -62,14 +62,14 @@ Status checkMimicState(const Model& model, const VectorRef& q_all, const VectorR
     const double q_law = law.multiplier * q[law.leader] + law.offset;
     if (std::abs(q[m] - q_law) > 1e-9 * (1.0 + std::abs(q[m]) + std::abs(q_law) + std::abs(law.offset)))
       return Status::error(StatusCode::MimicMismatch,
-                           "joint '%s' mimics '%s' (q = %g·q_leader + %g): q is %.17g, its leader puts it at %.17g "
-                           "(Model::followLeaders, in Python follow_leaders, sets it)",
+                           "joint '%s' mimics '%s' (q = %g·q_leader + %g): q is %.17g, the law gives %.17g "
+                           "(set by Model::followLeaders, Python follow_leaders, CLI \"follow_leaders\": true)",
                            joint.name.c_str(), leader, law.multiplier, law.offset, q[m], q_law);
     const double qd_law = law.multiplier * qd[law.leader];
     if (std::abs(qd[m] - qd_law) > 1e-9 * (1.0 + std::abs(qd[m]) + std::abs(qd_law)))
       return Status::error(StatusCode::MimicMismatch,
-                           "joint '%s' mimics '%s' (multiplier %g): qd is %.17g, its leader gives %.17g "
-                           "(Model::followLeaders, in Python follow_leaders, sets it)",
+                           "joint '%s' mimics '%s' (multiplier %g): qd is %.17g, the law gives %.17g "
+                           "(set by Model::followLeaders, Python follow_leaders, CLI \"follow_leaders\": true)",
                            joint.name.c_str(), leader, law.multiplier, qd[m], qd_law);
   }
   return {};

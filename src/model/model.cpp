@@ -69,6 +69,7 @@ const char* toString(WarningCode code) {
     case WarningCode::PayloadAttached: return "payload_attached";
     case WarningCode::MimicLocked: return "mimic_locked";
     case WarningCode::Urdfdom: return "urdfdom";
+    case WarningCode::FixedBaseContact: return "fixed_base_contact";
   }
   return "unknown";
 }

@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 namespace zwang {
 
-Task::Task(const Model& model) : dof_(model.dof()), frames_(static_cast<int>(model.frames().size())) {
+Task::Task(const Model& model)
+    : dof_(model.dof()),
+      frames_(static_cast<int>(model.frames().size())),
+      fixed_base_mass_(model.hasFloatingBase() ? 0.0 : model.inertia(0).mass) {
   for (const Frame& f : model.frames()) {
     frame_names_.push_back(f.name);
     frame_bodies_.push_back(f.body);
@@ -138,11 +142,33 @@ int Task::addJointConstraint(const std::string& joint) {
   return addJointConstraint(static_cast<int>(it - joint_names_.begin()));
 }
 
+namespace {
+// A contact on a bolted-down base with mass: the humanoid or the quadruped
+// loaded without its floating base. The world then holds the robot up, and the
+// contacts carry next to nothing: a silent wrong answer if it was meant to stand.
+ModelWarning fixedBaseContact(const std::string& frame, const std::string& base_link, double mass) {
+  char figures[40];
+  std::snprintf(figures, sizeof figures, "%g kg", mass);
+  return {WarningCode::FixedBaseContact,
+          "contact on frame '" + frame + "' of a fixed-base model whose base carries " + figures + " (link '" +
+              base_link +
+              "' and the links welded to it): the base is bolted to the world, which then holds the robot up in "
+              "place of the contacts. A robot that stands or leans on its contacts needs a floating base: "
+              "UrdfOptions::base = BaseType::Free or ModelBuilder::setBase (CLI \"base\": {\"type\": \"free\"}, "
+              "Python base=\"free\")"};
+}
+}  // namespace
+
 int Task::addContact(int frame, const ConstraintMatrix& A, Expressed expressed) {
   const int first = addConstraint(frame, A, expressed);
   for (ConstraintGroup& g : groups_)
     if (!g.mimic_row && g.joint < 0 && g.first_row == first) g.contact = true;
   reorder();
+  const bool warned = std::any_of(warnings_.begin(), warnings_.end(),
+                                  [](const ModelWarning& w) { return w.code == WarningCode::FixedBaseContact; });
+  if (fixed_base_mass_ > 0.0 && !warned)
+    warnings_.push_back(fixedBaseContact(frame_names_[static_cast<std::size_t>(frame)],
+                                         frame_names_[static_cast<std::size_t>(body_frames_[0])], fixed_base_mass_));
   return first;
 }
 

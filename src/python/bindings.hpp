@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "zwang/zwang.hpp"
@@ -132,6 +133,9 @@ struct Result {
   bool with_friction = false;
   bool infeasible = false;
   std::string message;  // the Status message of an infeasible solve
+  // Every warning of this solve as (code, message), also those already issued
+  // as a zwang.ModelWarning by an earlier solve; empty (no allocation) when none.
+  std::vector<std::pair<std::string, std::string>> warnings;
 
   const Solution& solution() const;  // raises StaleResultError when the workspace moved on
   const FrictionResult& friction() const;

@@ -86,7 +86,9 @@ PYBIND11_MODULE(zwang, m) {
   e.model_warning = newException(m, "ModelWarning", py::make_tuple(py::handle(PyExc_UserWarning)),
                                  "Doubtful but usable model data (a point mass, a placeholder inertia or limit, "
                                  "mass beyond the tip, ...), issued once per warning by load_urdf. "
-                                 "load_urdf(..., strict=True) raises ModelError instead.");
+                                 "load_urdf(..., strict=True) raises ModelError instead. solve() issues a q "
+                                 "outside a joint's limits and contacts on a fixed base with mass once per model, "
+                                 "code and joint (Result.warnings has every occurrence).");
 
   py::register_exception_translator([](std::exception_ptr p) {
     try {

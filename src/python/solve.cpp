@@ -18,6 +18,10 @@ std::uint64_t g_next_serial = 1;  // guarded by the GIL
 
 const Vec3 kDefaultGravity(0.0, 0.0, -9.81);
 
+// The code of a solve's q outside a joint's limits in Result.warnings (the
+// task's warnings have their WarningCode's name).
+const char* const kOutsideLimits = "outside_limits";
+
 [[noreturn]] void raiseModelError(const std::string& where, const std::exception& e) {
   raise(exceptions().model_error, where + ": " + e.what());
 }
@@ -211,22 +215,55 @@ Eigen::VectorXd optionalOverride(const char* name, py::handle value) {
 
 py::object overrideArray(const Eigen::VectorXd& v) { return v.size() ? py::object(vectorCopy(v)) : py::none(); }
 
-// A configuration outside the joint limits is solved as given; say so (a
-// zwang.ModelWarning; Python's filters show each distinct message once). Kept
+// The warnings already issued per model: a condition that holds solve after
+// solve (a joint outside its limits while q drifts) is issued once per (model,
+// code, joint), with its first value, not once per solve (Result.warnings has
+// every occurrence). Expired models are dropped, so a new model at a freed
+// address starts afresh.
+struct IssuedWarnings {
+  std::weak_ptr<const Model> model;
+  std::vector<std::pair<std::string, int>> keys;  // (code, joint; -1 for the task's)
+};
+std::vector<IssuedWarnings> g_issued;  // guarded by the GIL
+
+bool firstTime(const std::shared_ptr<Model>& model, const std::string& code, int joint) {
+  g_issued.erase(
+      std::remove_if(g_issued.begin(), g_issued.end(), [](const IssuedWarnings& w) { return w.model.expired(); }),
+      g_issued.end());
+  auto it =
+      std::find_if(g_issued.begin(), g_issued.end(), [&](const IssuedWarnings& w) { return w.model.lock() == model; });
+  if (it == g_issued.end()) it = g_issued.insert(g_issued.end(), {model, {}});
+  const std::pair<std::string, int> key{code, joint};
+  if (std::find(it->keys.begin(), it->keys.end(), key) != it->keys.end()) return false;
+  it->keys.push_back(key);
+  return true;
+}
+
+// One warning of a solve: into the Result, and issued as a zwang.ModelWarning
+// the first time for this model, code and joint.
+void warnOnce(const std::shared_ptr<Model>& model, Result& r, const std::string& code, int joint,
+              const std::string& text) {
+  r.warnings.emplace_back(code, text);
+  if (!firstTime(model, code, joint)) return;
+  const std::string once = text + (joint >= 0 ? " (warned once per model and joint" : " (warned once per model") +
+                           "; Result.warnings has it at every solve)";
+  if (PyErr_WarnEx(exceptions().model_warning.ptr(), once.c_str(), 1) != 0) throw py::error_already_set();
+}
+
+// A configuration outside the joint limits is solved as given; say so. Kept
 // out of the C++ solve, which must not allocate.
 // q[k] names the entry of the full q (a floating base's coordinates first).
-void warnOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q) {
-  const int base = model.baseConfigurationSize();
-  for (int j = 0; j < model.dof(); ++j) {
-    const Joint& joint = model.joint(j);
+void warnOutsideLimits(const std::shared_ptr<Model>& model, const Eigen::Ref<const Eigen::VectorXd>& q, Result& r) {
+  const int base = model->baseConfigurationSize();
+  for (int j = 0; j < model->dof(); ++j) {
+    const Joint& joint = model->joint(j);
     const double qj = q[base + j];
     if (qj >= joint.lower && qj <= joint.upper) continue;
     char figures[120];
     std::snprintf(figures, sizeof figures, "%g puts joint '", qj);
     char limits[80];
     std::snprintf(limits, sizeof limits, "' outside its limits [%g, %g]", joint.lower, joint.upper);
-    const std::string text = "q[" + std::to_string(base + j) + "] = " + figures + joint.name + limits;
-    if (PyErr_WarnEx(exceptions().model_warning.ptr(), text.c_str(), 1) != 0) throw py::error_already_set();
+    warnOnce(model, r, kOutsideLimits, j, "q[" + std::to_string(base + j) + "] = " + figures + joint.name + limits);
   }
 }
 
@@ -574,6 +611,15 @@ void bindSolve(py::module_& m) {
     return vectorCopy(frameAccelerationOf(r, frameArg(*r.model, frame), expressedArg("expressed", expressed, true)));
           },
           py::arg("frame"), py::arg("expressed") = "world", "true classical acceleration [p̈; ω̇] of a frame's origin")
+      .def_property_readonly(
+          "warnings",
+          [](const Result& r) {
+    py::list out;
+    for (const auto& [code, message] : r.warnings) out.append(py::make_tuple(code, message));
+    return out;
+          },
+          "list of (code, message): every warning of this solve ('outside_limits', 'fixed_base_contact'), also\n"
+          "those a zwang.ModelWarning said already (each is issued once per model, code and joint)")
       .def_property_readonly("infeasible", [](const Result& r) { return r.infeasible; })
       .def_property_readonly("message", [](const Result& r) { return r.message; })
       .def_property_readonly("with_friction", [](const Result& r) { return r.with_friction; })
@@ -644,6 +690,7 @@ void bindSolve(py::module_& m) {
     copy.with_friction = r.with_friction;
     copy.infeasible = r.infeasible;
     copy.message = r.message;
+    copy.warnings = r.warnings;
     copy.data_base = py::capsule(new std::shared_ptr<ResultData>(data),
                                  [](void* p) { delete static_cast<std::shared_ptr<ResultData>*>(p); });
     copy.data = std::move(data);
@@ -670,8 +717,9 @@ void bindSolve(py::module_& m) {
                                   : solveHybridDynamics(*model, task, qv, qdv, tauv, *pw.ws);
     const bool infeasible = status.code == StatusCode::Infeasible;
     if (!status && !infeasible) raiseStatus(status, "solve");
-    warnOutsideLimits(*model, qv);
     Result r;
+    for (const ModelWarning& w : task.warnings()) warnOnce(model, r, toString(w.code), -1, w.message);
+    warnOutsideLimits(model, qv, r);
     r.model = std::move(model);
     r.owner = std::move(ws_obj);
     r.live = &pw;
@@ -694,7 +742,9 @@ void bindSolve(py::module_& m) {
       "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
       "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
       "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
-      "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions).");
+      "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions). A q outside a\n"
+      "joint's limits, or contacts on a fixed base with mass, give a zwang.ModelWarning once per model, code and\n"
+      "joint; Result.warnings lists every one of this solve.");
 
   // ---- the C++ cost of a solve, for measuring the Python-call overhead -----
   m.def(

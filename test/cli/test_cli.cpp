@@ -320,6 +320,68 @@ TEST_CASE("A relative constraint (\"relative_to\"): the tool and Task::addRelati
   for (std::size_t k = 3; k < 6; ++k) CHECK(left[k] == Approx(right[k]).margin(1e-12));
 }
 
+TEST_CASE("Mimic joints from the tool: \"follow_leaders\" fills the followers' q and qd (Baxter)", "[golden]") {
+  // Baxter's whole tree with its mimic fingers modelled: each r_finger joint
+  // follows its l_finger joint with multiplier -1 (the URDF's <mimic>). The
+  // problem gives the followers 0; "follow_leaders" replaces that by the law.
+  const Run r = run({"solve", problem("baxter_follow_leaders.json")});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(occurrences(r.err, "zwang: warning: ") == 4);  // the URDF's placeholder and point-mass data
+  const Json s = parse(r.out);
+  REQUIRE(s["joints"].size() == 19);
+  CHECK(s["joints"][9] == "l_gripper_r_finger_joint");
+  CHECK(s["joints"][18] == "r_gripper_r_finger_joint");
+  CHECK(s["status"]["consistent"] == true);
+
+  // The library, the followers set by hand from the URDF's law q_f = -1·q_l.
+  const Json p = problemFile("baxter_follow_leaders.json");
+  const zwang::Model model = zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/baxter.urdf");
+  REQUIRE(model.mimicJoints() == std::vector<int>{9, 18});
+  Eigen::VectorXd q = vectorOf(p["q"]), qd = vectorOf(p["qd"]);
+  for (const int follower : {9, 18}) {
+    q[follower] = -q[follower - 1];
+    qd[follower] = -qd[follower - 1];
+  }
+  CHECK(q[9] == -0.01);
+  CHECK(qd[18] == -0.02);
+  zwang::Task task(model);
+  task.addRelativeConstraint("left_gripper", "right_gripper", directionsOf(p["constraints"][0]));
+  task.wrench(task.addWrench("right_gripper", zwang::Expressed::World)) << 0, 0, -30, 0, 0, 0;
+  zwang::Workspace ws(model, task);
+  REQUIRE(zwang::solveHybridDynamics(model, task, q, qd, Eigen::VectorXd::Zero(19), ws));
+  sameAs(s["qdd"], ws.solution.qdd);  // the tool prints every double exactly: equal, bit for bit
+  sameAs(s["tau_control"], ws.solution.tau_control);
+  for (const std::size_t follower : {9u, 18u})
+    CHECK(s["qdd"][follower].get<double>() == Approx(-s["qdd"][follower - 1].get<double>()).margin(1e-12));
+
+  // Without the option the followers' 0 is off the law: exit 1, naming the option.
+  const std::string dir = cli_test::scratchDir();
+  Json without = p;
+  without["model"] = std::string(ZWANG_MODELS_DIR) + "/baxter.urdf";
+  without.erase("follow_leaders");
+  cli_test::writeText(dir + "/baxter_without.json", without.dump());
+  const Run off = run({"solve", dir + "/baxter_without.json"});
+  INFO("stderr: " << off.err);
+  CHECK(off.exit_code == 1);
+  CHECK(off.out.empty());
+  CHECK(contains(off.err,
+                 ": solve: joint 'l_gripper_r_finger_joint' mimics 'l_gripper_l_finger_joint' (q = "
+                 "-1·q_leader + 0): q is 0, the law gives -0.01"));
+  CHECK(contains(off.err, "(set by Model::followLeaders, Python follow_leaders, CLI \"follow_leaders\": true)"));
+
+  // With the mimic joints welded there is nothing to follow: refused.
+  Json locked = without;
+  locked["lock_mimic"] = true;
+  locked["follow_leaders"] = true;
+  cli_test::writeText(dir + "/baxter_locked.json", locked.dump());
+  const Run refused = run({"solve", dir + "/baxter_locked.json"});
+  checkOneLineError(refused, 1);
+  CHECK(contains(refused.err,
+                 ": follow_leaders: has no effect: the model has no mimic joints (\"lock_mimic\": "
+                 "true welded them)"));
+}
+
 // ---------------------------------------------------------------------------
 // Floating bases: "base" (docs/cli.md, "Floating base").
 
@@ -566,6 +628,7 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_joint_row_key.json", {": constraints[0].directions: unknown key (allowed here: joint, acceleration)"}},
       {"err_contact_relative.json",
        {": constraints[0].contact: is true with \"relative_to\"", "a contact is a link against the environment"}},
+      {"err_follow_leaders_no_mimic.json", {": follow_leaders: has no effect: the model has no mimic joints"}},
   };
   for (const Case& c : cases) {
     SECTION(c.file) {
@@ -1325,6 +1388,27 @@ int countOf(const std::string& text, const std::string& part) {
 }
 
 }  // namespace
+
+TEST_CASE("A robot standing on contacts with a fixed base: solved, with a warning naming \"base\"", "[warnings]") {
+  // The humanoid without "base" is bolted down by its 27 kg BODY: the solve
+  // runs (exit 0) and says once, on stderr, that standing needs a free base.
+  const Run bolted = run({"solve", problem("humanoid_bolted.json")});
+  INFO("stderr: " << bolted.err);
+  REQUIRE(bolted.exit_code == 0);
+  CHECK(occurrences(bolted.err, "zwang: warning: ") == 1);
+  CHECK(contains(bolted.err, "zwang: warning: " + problem("humanoid_bolted.json") +
+                                 ": contact on frame 'l_ankle' of a fixed-base model whose base carries 27 kg"));
+  CHECK(contains(bolted.err, "CLI \"base\": {\"type\": \"free\"}"));
+  CHECK(parse(bolted.out)["nu"].size() == 12);
+  // The same problem with a free base: no warning.
+  Json p = problemFile("humanoid_bolted.json");
+  p["model"] = std::string(ZWANG_MODELS_DIR) + "/simple_humanoid.urdf";
+  p["base"] = {{"type", "free"}, {"position", {0, 0, 1}}};
+  const std::string file = cli_test::scratchDir() + "/humanoid_free.json";
+  cli_test::writeText(file, p.dump());
+  const Json free = solve(file);  // stderr empty
+  CHECK(free["nu"].size() == 12);
+}
 
 TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8", "[warnings]") {
   const std::string dir = cli_test::scratchDir();

@@ -1,11 +1,13 @@
 """Doubtful URDF data: zwang.ModelWarning per finding, Model.warnings, strict=True refuses;
-attach_beyond_tip; q outside the limits at solve time."""
+attach_beyond_tip; q outside the limits at solve time, warned once per model and joint (Result.warnings has
+every occurrence); contacts on a fixed base with mass."""
 import warnings
 
 import numpy as np
 import pytest
 
 import zwang
+from conftest import MODELS
 
 ARM = """<robot name="doubtful"><link name="base"/>
   <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
@@ -80,3 +82,77 @@ def test_q_outside_the_limits_warns_at_solve_time():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         zwang.solve(model, ws, np.array([0.5]))
+
+
+def model_warnings(record):
+    return [str(w.message) for w in record if issubclass(w.category, zwang.ModelWarning)]
+
+
+def test_a_repeated_condition_warns_once_with_its_first_value():
+    # q drifting outside the limits for 200 control cycles: one ModelWarning, even with the
+    # "always" filter (the dedupe is zwang's, per model and joint); Result.warnings has every one.
+    model = zwang.load_urdf_string(arm())
+    ws = model.workspace()
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        for k in range(200):
+            q = 1.5 + 0.001 * k
+            res = zwang.solve(model, ws, np.array([q]))
+            assert res.warnings == [("outside_limits", f"q[0] = {q:g} puts joint 'j1' outside its limits [-1, 1]")]
+        inside = zwang.solve(model, ws, np.array([0.5]))
+        assert inside.warnings == []
+    issued = model_warnings(record)
+    assert len(issued) == 1
+    assert issued[0].startswith("q[0] = 1.5 puts joint 'j1' outside its limits [-1, 1]")
+    assert "Result.warnings" in issued[0]
+    # Another joint, another model: each warned once in its turn.
+    two = zwang.load_urdf_string(arm(extra=FINGER))
+    ws2 = two.workspace()
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        for _ in range(3):
+            zwang.solve(two, ws2, np.array([1.5, 0.0]))
+            zwang.solve(two, ws2, np.array([1.5, 0.2]))
+        zwang.solve(model, ws, np.array([2.0]))  # the first model's joint: said already
+    issued = model_warnings(record)
+    assert len(issued) == 2
+    assert issued[0].startswith("q[0] = 1.5 puts joint 'j1'")
+    assert issued[1].startswith("q[1] = 0.2 puts joint 'finger_joint'")
+
+
+def test_every_occurrence_is_in_result_warnings_and_its_copy():
+    model = zwang.load_urdf_string(arm(extra=FINGER))
+    ws = model.workspace()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = zwang.solve(model, ws, np.array([-2.0, 0.5]))
+    expected = [("outside_limits", "q[0] = -2 puts joint 'j1' outside its limits [-1, 1]"),
+                ("outside_limits", "q[1] = 0.5 puts joint 'finger_joint' outside its limits [0, 0.1]")]
+    assert res.warnings == expected
+    kept = res.copy()
+    zwang.solve(model, ws, np.array([0.0, 0.0]))
+    assert kept.warnings == expected
+
+
+def test_contacts_on_a_bolted_down_humanoid_warn_once_naming_the_free_base():
+    humanoid = zwang.load_urdf(MODELS / "simple_humanoid.urdf")  # no root joint: a fixed base (BODY, 27 kg)
+    assert humanoid.base_type == "fixed" and humanoid.base_mass == 27.0
+    feet = [zwang.Constraint(foot, np.eye(6), expressed="world", contact=True) for foot in ("l_ankle", "r_ankle")]
+    q = np.zeros(humanoid.nq)
+    q[[16, 23]] = 0.1  # shoulder rolls inside their limits (>= 0.0087)
+    ws = humanoid.workspace(12)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        for _ in range(3):
+            res = zwang.solve(humanoid, ws, q, constraints=feet)
+    issued = model_warnings(record)
+    assert len(issued) == 1
+    assert issued[0].startswith("contact on frame 'l_ankle' of a fixed-base model whose base carries 27 kg")
+    assert 'Python base="free"' in issued[0]
+    assert [code for code, _ in res.warnings] == ["fixed_base_contact"]
+    free = zwang.load_urdf(MODELS / "simple_humanoid.urdf", base="free")
+    qf = np.r_[0, 0, 1, 1, 0, 0, 0, q]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = zwang.solve(free, free.workspace(12), qf, constraints=feet)
+    assert res.warnings == []

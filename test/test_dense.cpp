@@ -116,3 +116,46 @@ TEST_CASE("RNEA, CRBA, Jacobians and poses match the dense reference") {
   CHECK(jac_err.value < 1e-10);
   CHECK(pose_err.value < 1e-10);
 }
+
+TEST_CASE("constraint columns of any length: a column scaled by c scales its row and divides its nu by c") {
+  // docs/conventions.md, "Constraints": the columns need not be unit. Column
+  // c·a with set point c·b is the same constraint as a with b: the same q̈ and
+  // τ_c, and ν along c·a is ν/c. Checked on random chains against the
+  // unscaled solve and against the dense KKT solution of the unscaled task.
+  std::mt19937_64 rng(20261126);
+  std::uniform_real_distribution<double> log_scale(-3.0, 3.0);  // c from 1e-3 to 1e3
+  MaxError qdd_err, tauc_err, nu_err;
+  int accepted = 0, attempts = 0;
+  while (accepted < 200) {
+    ++attempts;
+    REQUIRE(attempts < 2000);
+    const ChainSpec spec = randomChain(rng);
+    const DynamicsInput in = randomProblem(rng, spec);
+    if (in.constraintRows() == 0) continue;
+    const DenseResult ref = denseDynamics(spec, in);
+    if (!wellPosed(ref, in)) continue;
+    ++accepted;
+    DynamicsInput scaled = in;
+    Eigen::VectorXd c(in.constraintRows());
+    int row = 0;
+    for (ConstraintInput& k : scaled.constraints)
+      for (Eigen::Index j = 0; j < k.A.cols(); ++j, ++row) {
+        c[row] = std::pow(10.0, log_scale(rng));
+        k.A.col(j) *= c[row];
+        k.b[j] *= c[row];
+      }
+    const Model model = modelFromSpec(spec);
+    const Task task = taskFromInput(model, scaled);
+    Workspace ws(model, task);
+    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    const Solution& s = ws.solution;
+    qdd_err.add(relativeError(s.qdd, ref.qdd));
+    tauc_err.add(relativeError(s.tau_constraint, ref.tau_c));
+    nu_err.add(relativeError(s.nu.head(row).cwiseProduct(c), ref.nu.head(row)));
+  }
+  std::printf("columns scaled by 1e-3..1e3, %d chains: max rel. error qdd %.2e, tau_c %.2e, c*nu %.2e\n", accepted,
+              qdd_err.value, tauc_err.value, nu_err.value);
+  CHECK(qdd_err.value < 1e-9);
+  CHECK(tauc_err.value < 1e-9);
+  CHECK(nu_err.value < 1e-9);
+}

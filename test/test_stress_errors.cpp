@@ -15,6 +15,7 @@
 
 using namespace zwang;
 using Catch::Contains;
+using Catch::Equals;
 using zwang::testing::oneDofArmModel;
 
 namespace {
@@ -266,8 +267,13 @@ TEST_CASE("errors: ModelBuilder and model lookups", "[errors]") {
 TEST_CASE("errors: Task construction", "[errors]") {
   const Model model = panda();
   Task task(model);
-  CHECK_THAT(modelError([&] { task.addConstraint("hand", ConstraintMatrix::Identity(6, 1)); }),
-             Contains("task: the model has no frame 'hand'"));
+  std::string frames;  // every candidate, in the model's order
+  for (const Frame& f : model.frames()) frames += (frames.empty() ? "'" : ", '") + f.name + "'";
+  const std::string unknown = "task: the model has no frame 'hand' (frames: " + frames + ")";
+  CHECK(frames.find("'panda_link0', 'panda_link1'") != std::string::npos);
+  CHECK_THAT(modelError([&] { task.addConstraint("hand", ConstraintMatrix::Identity(6, 1)); }), Equals(unknown));
+  CHECK_THAT(modelError([&] { task.addContact("hand", ConstraintMatrix::Identity(6, 1)); }), Equals(unknown));
+  CHECK_THAT(modelError([&] { task.addWrench("hand"); }), Equals(unknown));
   CHECK_THAT(modelError([&] { task.addConstraint(99, ConstraintMatrix::Identity(6, 1)); }),
              Contains("task: frame index 99 out of range"));
   CHECK_THAT(modelError([&] { task.addConstraint("tool0", ConstraintMatrix(6, 0)); }),

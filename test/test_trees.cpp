@@ -275,10 +275,9 @@ TEST_CASE("trees: bad relative constraints are refused with the reason", "[trees
   };
   CHECK(message([&] { task.addRelativeConstraint(link, link, A); }) ==
         "task: a relative constraint on frame '" + link + "' needs another frame to refer to, not itself");
-  CHECK(message([&] { task.addRelativeConstraint(link, "no_such_link", A); }) ==
-        "task: the model has no frame 'no_such_link'");
-  CHECK(message([&] { task.addRelativeConstraint("no_such_link", link, A); }) ==
-        "task: the model has no frame 'no_such_link'");
+  const std::string unknown = "task: the model has no frame 'no_such_link' (frames: '" + model.frames()[0].name + "', ";
+  CHECK(message([&] { task.addRelativeConstraint(link, "no_such_link", A); }).rfind(unknown, 0) == 0);
+  CHECK(message([&] { task.addRelativeConstraint("no_such_link", link, A); }).rfind(unknown, 0) == 0);
   CHECK(message([&] { task.addRelativeConstraint(1, 99999, A); }) == "task: reference frame index 99999 out of range");
   CHECK(task.constraintRows() == 0);  // nothing half-added
   // And a good one works, relative to the base as well as to another link.

@@ -495,8 +495,28 @@ TEST_CASE("mimic joints: nothing left to move, or no finite position to lock at"
   missing.replace(missing.find("<mimic joint=\"m1\"/>"), std::string("<mimic joint=\"m1\"/>").size(),
                   "<mimic joint=\"nope\"/>");
   REQUIRE_THROWS_WITH(loadUrdfString(missing),
-                      Contains("<string>: joint 'm2' (q = 1·q_nope + 0) mimics joint 'nope', which the URDF does not "
-                               "have"));
+                      Catch::Equals("<string>: joint 'm2' (q = 1·q_nope + 0) mimics joint 'nope', which the URDF "
+                                    "does not have: set UrdfOptions::mimic = MimicJoints::Lock to weld it at q = 0 "
+                                    "(its position when 'nope' is at rest)"));
+  UrdfOptions cli;  // the names the CLI and Python give the lock option
+  cli.names.lock_mimic = "--lock-mimic";
+  REQUIRE_THROWS_WITH(loadUrdfString(missing, cli), Contains("which the URDF does not have: set --lock-mimic to weld"));
+  cli.names.lock_mimic = "lock_mimic=True";
+  REQUIRE_THROWS_WITH(loadUrdfString(missing, cli), Contains("which the URDF does not have: set lock_mimic=True to "));
+  std::string lone = missing;  // m1 independent: what the message suggests loads
+  lone.erase(lone.find("<mimic joint=\"m2\" multiplier=\"1e300\"/>"),
+             std::string("<mimic joint=\"m2\" multiplier=\"1e300\"/>").size());
+  REQUIRE_THROWS_WITH(loadUrdfString(lone), Contains("mimics joint 'nope', which the URDF does not have: set"));
+  CHECK(loadUrdfString(lone, lockMimic()).dof() == 1);
+  std::string fixed_leader = mimics;  // a leader that does not move
+  fixed_leader.replace(fixed_leader.find("<mimic joint=\"m1\"/>"), std::string("<mimic joint=\"m1\"/>").size(),
+                       "<mimic joint=\"w\" offset=\"0.2\"/>");
+  fixed_leader.insert(fixed_leader.find("</robot>"),
+                      R"(<joint name="w" type="fixed"><parent link="base"/><child link="c"/></joint><link name="c"/>)");
+  REQUIRE_THROWS_WITH(loadUrdfString(fixed_leader),
+                      Catch::Equals("<string>: joint 'm2' (q = 1·q_w + 0.2) mimics joint 'w', which is not a moving "
+                                    "joint (a fixed, floating or planar joint): set UrdfOptions::mimic = "
+                                    "MimicJoints::Lock to weld it at q = 0.2 (its position when 'w' is at rest)"));
   UrdfOptions chain = lockMimic();
   chain.tip = "b";
   REQUIRE_THROWS_WITH(loadUrdfString(mimics, chain),

@@ -441,3 +441,162 @@ TEST_CASE("Baxter: each arm loads with the warnings its data calls for and solve
                              "'r_gripper_l_finger_joint', which is not in the chain from 'base' to "
                              "'r_gripper_r_finger_tip'"));
 }
+
+TEST_CASE("urdfdom errors about visuals only load with a warning naming the link; dynamics errors are refused",
+          "[urdf][warnings][errors]") {
+  using Catch::Equals;
+  // l1 as in arm(), with `appearance` inside the link; `top` before the links.
+  const auto withLink = [](const std::string& appearance, const std::string& top = "") {
+    std::string xml = arm("1", diagonal("0.1", "0.1", "0.1"));
+    xml.insert(xml.find("</inertial>") + std::string("</inertial>").size(), appearance);
+    xml.insert(xml.find("<link name=\"base\"/>"), top);
+    return xml;
+  };
+  const Model plain = loadUrdfString(arm("1", diagonal("0.1", "0.1", "0.1")));
+  const auto sameDynamics = [&plain](const Model& m) {
+    REQUIRE(m.dof() == 1);
+    CHECK(m.inertia(1).mass == plain.inertia(1).mass);
+    CHECK(m.inertia(1).h == plain.inertia(1).h);
+    CHECK(m.inertia(1).Ibar == plain.inertia(1).Ibar);
+    CHECK(m.joint(0).upper == plain.joint(0).upper);
+  };
+  const std::string box = R"(<geometry><box size="0.1 0.1 0.1"/></geometry>)";
+
+  SECTION("a visual material without a name (Unitree H1-2)") {
+    const std::string xml = withLink("<visual>" + box + R"(<material><color rgba="1 0 0 1"/></material></visual>)");
+    const Model m = loadUrdfString(xml);
+    sameDynamics(m);
+    REQUIRE(codes(m) == Codes{WarningCode::Urdfdom});
+    CHECK_THAT(m.warnings()[0].message,
+               Equals("<string>: link 'l1': urdfdom cannot read its <visual> or <collision> elements (Visual material "
+                      "must contain a name attribute; Could not parse visual element for Link [l1]); they do not "
+                      "enter the dynamics: loaded without them"));
+    REQUIRE_THROWS_WITH(loadUrdfString(xml, strict()),
+                        Equals("<string>: refused in strict mode (1 warning): link 'l1': urdfdom cannot read its "
+                               "<visual> or <collision> elements (Visual material must contain a name attribute; "
+                               "Could not parse visual element for Link [l1]); they do not enter the dynamics: loaded "
+                               "without them"));
+  }
+  SECTION("a visual without geometry (Drake's Atlas), a collision with a bad box") {
+    const Model m = loadUrdfString(withLink(R"(<visual><origin xyz="0 0 0.1"/></visual>)"));
+    sameDynamics(m);
+    REQUIRE(codes(m) == Codes{WarningCode::Urdfdom});
+    CHECK_THAT(m.warnings()[0].message,
+               Equals("<string>: link 'l1': urdfdom cannot read its <visual> or <collision> elements (Could not parse "
+                      "visual element for Link [l1]); they do not enter the dynamics: loaded without them"));
+    const Model c = loadUrdfString(withLink(R"(<collision><geometry><box size="1 1"/></geometry></collision>)"));
+    sameDynamics(c);
+    REQUIRE(codes(c) == Codes{WarningCode::Urdfdom});
+    CHECK_THAT(c.warnings()[0].message,
+               Equals("<string>: link 'l1': urdfdom cannot read its <visual> or <collision> elements (Parser found 2 "
+                      "elements but 3 expected while parsing vector [1 1]; Could not parse collision element for "
+                      "Link [l1]); they do not enter the dynamics: loaded without them"));
+  }
+  SECTION("a top-level material without a colour") {
+    const Model m = loadUrdfString(withLink("", R"(<material name="blue"/>)"));
+    sameDynamics(m);
+    REQUIRE(codes(m) == Codes{WarningCode::Urdfdom});
+    CHECK_THAT(m.warnings()[0].message,
+               Equals("<string>: <material> 'blue': urdfdom cannot read it (Material [blue] color has no rgba; "
+                      "Material [blue] not defined in file); materials do not enter the dynamics: loaded without it"));
+  }
+  SECTION("with an error beyond the visuals, urdfdom's reasons for that error fail the load") {
+    std::string xml = withLink("<visual>" + box + R"(<material><color rgba="1 0 0 1"/></material></visual>)");
+    xml.replace(xml.find("<limit "), xml.find("/>", xml.find("<limit ")) + 2 - xml.find("<limit "), "");
+    REQUIRE_THROWS_WITH(loadUrdfString(xml), Equals("<string>: urdfdom rejected the URDF: Joint [j1] is of type "
+                                                    "REVOLUTE but it does not specify limits; joint xml is not "
+                                                    "initialized correctly"));
+  }
+  SECTION("an <inertial> urdfdom would zero is refused, naming the link") {
+    const std::string tail =
+        ": urdfdom would silently read all six moments as zero (give ixx, ixy, ixz, iyy, iyz and "
+        "izz, 0 where the moment is zero)";
+    REQUIRE_THROWS_WITH(loadUrdfString(arm("1", R"(ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0")")),
+                        Equals("<string>: link 'l1': <inertial> <inertia> has no izz attribute" + tail));
+    REQUIRE_THROWS_WITH(loadUrdfString(arm("1", R"(ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1")")),
+                        Equals("<string>: link 'l1': <inertial> <inertia> has no ixx attribute" + tail));
+    std::string no_inertia = arm("1", diagonal("0.1", "0.1", "0.1"));
+    no_inertia.erase(no_inertia.find("<inertia "),
+                     no_inertia.find("/>", no_inertia.find("<inertia ")) + 2 - no_inertia.find("<inertia "));
+    REQUIRE_THROWS_WITH(loadUrdfString(no_inertia),
+                        Equals("<string>: link 'l1': <inertial> has no <inertia> element: urdfdom would silently read "
+                               "all six moments as zero (write <inertia ixx=\"…\" ixy=\"…\" ixz=\"…\" iyy=\"…\" "
+                               "iyz=\"…\" izz=\"…\"/>)"));
+    std::string no_mass = arm("1", diagonal("0.1", "0.1", "0.1"));
+    no_mass.erase(no_mass.find("<mass value=\"1\"/>"), std::string("<mass value=\"1\"/>").size());
+    REQUIRE_THROWS_WITH(loadUrdfString(no_mass),
+                        Equals("<string>: link 'l1': <inertial> has no <mass> element: urdfdom would silently read "
+                               "the link's mass and inertia as zero (write <mass value=\"…\"/>)"));
+    std::string no_value = arm("1", diagonal("0.1", "0.1", "0.1"));
+    no_value.replace(no_value.find("<mass value=\"1\"/>"), std::string("<mass value=\"1\"/>").size(), "<mass/>");
+    REQUIRE_THROWS_WITH(loadUrdfString(no_value),
+                        Equals("<string>: link 'l1': <inertial> has no value attribute in its <mass>: urdfdom would "
+                               "silently read the link's mass and inertia as zero (write <mass value=\"…\"/>)"));
+  }
+}
+
+TEST_CASE("negative effort and velocity limits (-1: unlimited) are no limits, with a warning", "[urdf][warnings]") {
+  using Catch::Equals;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const std::string both =
+      arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", "", R"(lower="-2" upper="2" effort="-1" velocity="-1")");
+  const Model m = loadUrdfString(both);
+  REQUIRE(codes(m) == Codes{WarningCode::PlaceholderLimits});
+  CHECK_THAT(m.warnings()[0].message,
+             Equals("<string>: joint 'j1': <limit> effort -1 and velocity -1 are negative: read as no effort and no "
+                    "velocity limit (how some files write \"unlimited\")"));
+  CHECK(m.joint(0).effort_limit == inf);
+  CHECK(m.joint(0).velocity_limit == inf);
+  CHECK(m.joint(0).lower == -2.0);  // the position limits are real ones: kept
+  CHECK(m.joint(0).upper == 2.0);
+  REQUIRE_THROWS_WITH(loadUrdfString(both, strict()), Contains("strict mode") && Contains("effort -1 and velocity -1"));
+
+  const Model effort = loadUrdfString(
+      arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", "", R"(lower="-2" upper="2" effort="-10" velocity="3")"));
+  REQUIRE(codes(effort) == Codes{WarningCode::PlaceholderLimits});
+  CHECK_THAT(effort.warnings()[0].message,
+             Equals("<string>: joint 'j1': <limit> effort -10 is negative: read as no effort limit (how some files "
+                    "write \"unlimited\")"));
+  CHECK(effort.joint(0).effort_limit == inf);
+  CHECK(effort.joint(0).velocity_limit == 3.0);
+
+  const Model velocity = loadUrdfString(
+      arm("1", diagonal("0.1", "0.1", "0.1"), "0.5 0 0", "", R"(lower="-2" upper="2" effort="10" velocity="-2")"));
+  CHECK_THAT(velocity.warnings()[0].message,
+             Equals("<string>: joint 'j1': <limit> velocity -2 is negative: read as no velocity limit (how some files "
+                    "write \"unlimited\")"));
+  CHECK(velocity.joint(0).effort_limit == 10.0);
+  CHECK(velocity.joint(0).velocity_limit == inf);
+}
+
+TEST_CASE("a file with no <inertial> at all says so once", "[urdf][errors]") {
+  using Catch::Equals;
+  // A kinematics-only two-joint arm, as vendors ship for visualisation.
+  const std::string xml = R"(<robot name="kin"><link name="base"/>
+    <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+      <limit lower="-2" upper="2" effort="10" velocity="3"/></joint>
+    <link name="l1"><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+    <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.5 0 0"/><axis xyz="0 0 1"/>
+      <limit lower="-2" upper="2" effort="10" velocity="3"/></joint>
+    <link name="l2"/></robot>)";
+  const std::string message =
+      "<string>: the URDF has no <inertial> element on any link: it describes the kinematics only (no masses, no "
+      "inertias), and dynamics need them; use a description of the robot with its inertial data";
+  REQUIRE_THROWS_WITH(loadUrdfString(xml), Equals(message));
+  UrdfOptions chain;
+  chain.tip = "l1";
+  REQUIRE_THROWS_WITH(loadUrdfString(xml, chain), Equals(message));
+  UrdfOptions free;
+  free.base = BaseType::Free;
+  REQUIRE_THROWS_WITH(loadUrdfString(xml, free), Equals(message));
+  // Rotor inertias alone give each joint of a fixed base something to move: it loads.
+  UrdfOptions rotors;
+  rotors.rotor_inertia = {{"j1", 0.1}, {"j2", 0.1}};
+  CHECK(loadUrdfString(xml, rotors).dof() == 2);
+  // One link with inertial data: the massless leaf is named as before.
+  std::string one = xml;
+  one.replace(
+      one.find("<link name=\"l1\">"), std::string("<link name=\"l1\">").size(),
+      R"(<link name="l1"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>)");
+  REQUIRE_THROWS_WITH(loadUrdfString(one), Contains("link 'l2': zero mass on a moving body"));
+}

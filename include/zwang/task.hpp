@@ -27,6 +27,8 @@ namespace zwang {
 enum class Expressed { Local, World, Aligned = World, Reference };
 
 /// A: 6×m, one unit constraint force [l; r] (linear part first) per column.
+/// A column need not have unit length: scaled by c, its row reads c·(aᵀẌ) = b
+/// and its ν comes out divided by c (docs/conventions.md, "Constraints").
 using ConstraintMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
 /// Options of the balance ν = 𝓛⁺ r of Algorithm 1's line 25 (docs/solver.md,

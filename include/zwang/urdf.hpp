@@ -120,6 +120,16 @@ struct UrdfOptions {
 /// Placeholder limits: `<limit lower="x" upper="x" effort="0" velocity="0"/>`
 /// (what CAD exporters write when they know no limits) means "no limits":
 /// position, effort and velocity limits are all infinite (PlaceholderLimits).
+/// A negative effort or velocity limit (-1: "unlimited" in some files) is no
+/// such limit (PlaceholderLimits).
+///
+/// urdfdom's errors fail the load, except those about what only draws the
+/// robot: when the file reads without its links' `<visual>` and `<collision>`
+/// elements and its top-level `<material>`s, it loads without them, with an
+/// Urdfdom warning naming each link or material urdfdom cannot read. An
+/// `<inertial>` urdfdom would read as zeros (no `<mass>`, no `<inertia>` or one
+/// of its six attributes missing) is a ModelError naming the link; a file with
+/// no `<inertial>` at all is one ModelError saying so.
 Model loadUrdfFile(const std::string& path, const UrdfOptions& options = {});
 /// The same from URDF text in memory; messages name the source "<string>".
 Model loadUrdfString(const std::string& xml, const UrdfOptions& options = {});

@@ -77,12 +77,13 @@ class Builder {
   bool parse_error(std::size_t position, const std::string&, const nlohmann::detail::exception& e) {
     // nlohmann: "[json.exception.parse_error.101] parse error at line 1, column 2: syntax error ..." or
     // "[json.exception.out_of_range.406] number overflow parsing '1e400'". Keep what follows the
-    // location, and say where ourselves: the JSON path of the value being read, line and column.
+    // location, and say where ourselves: line and column (and for an overflow the value's JSON path).
     std::string what = e.what();
     if (const auto bracket = what.find("] "); bracket != std::string::npos) what = what.substr(bracket + 2);
     if (what.rfind("parse error", 0) == 0)
       if (const auto colon = what.find(": "); colon != std::string::npos) what = what.substr(colon + 2);
-    if (e.id == 406) {  // number overflow
+    const bool overflow = e.id == 406;  // number overflow: a fault of the value being read
+    if (overflow) {
       const auto quote = what.find('\'');
       what = "the number " + (quote == std::string::npos ? std::string("") : printable(what.substr(quote), 40)) +
              " is out of range (not finite as a double)";
@@ -95,7 +96,9 @@ class Builder {
       }
     const std::string location =
         "line " + std::to_string(line) + ", column " + std::to_string(position - std::min(position, line_start));
-    return stop(where(), location + ": " + what);
+    // A syntax error is a fault of the text, not of a value: the key last read
+    // may be long complete (`{"model": "a.urdf" "q": …}`), so no JSON path.
+    return stop(overflow ? where() : "", location + ": " + what);
   }
   explicit Builder(const std::string& text) : text_(text) {}
 

@@ -212,12 +212,6 @@ std::string jointList(const Model& model) {
   return list;
 }
 
-std::string frameList(const Model& model) {
-  std::string list;
-  for (const Frame& frame : model.frames()) list += (list.empty() ? "" : ", ") + frame.name;
-  return list;
-}
-
 // The joint of a joint row, named in the error with the model's joints when unknown.
 int jointRowIndex(const JsonReader& in, const Model& model, const ConstraintSpec& c) {
   const std::string path = childPath(c.path, "joint");
@@ -245,6 +239,7 @@ Problem readProblem(const std::string& file) {
   if (!doc.contains("model")) in.fail("model", "missing (the URDF file, relative to the problem file)");
   const std::string model = in.string(doc["model"], "model");
   if (model.empty()) in.fail("model", "is empty");
+  p.model = model;
   const std::filesystem::path model_path(model);
   p.model_path = model_path.is_absolute() ? model : (std::filesystem::path(file).parent_path() / model_path).string();
 
@@ -297,6 +292,10 @@ BoundProblem bindProblem(const Problem& p) {
   try {
     model = loadUrdfFile(p.model_path, urdf);
   } catch (const ModelError& e) {
+    // A relative "model" the loader could not open: say what it was resolved to and why.
+    std::error_code ec;
+    if (!std::filesystem::path(p.model).is_absolute() && !std::filesystem::is_regular_file(p.model_path, ec))
+      in.fail("model", "\"" + printable(p.model, 200) + "\", relative to the problem file, is " + e.what());
     in.fail("model", e.what());
   }
   if (model.hasFloatingBase() && !p.base.present)
@@ -358,10 +357,12 @@ BoundProblem bindProblem(const Problem& p) {
   task.balance = p.balance;
 
   auto frameIndex = [&](const std::string& name, const std::string& path, const char* key = "frame") {
-    if (!m.hasFrame(name))
-      in.fail(childPath(path, key),
-              "unknown frame \"" + printable(name, 60) + "\" (the model's frames: " + frameList(m) + ")");
-    const int f = m.frameIndex(name);
+    int f = -1;
+    try {
+      f = m.frameIndex(name);
+    } catch (const ModelError& e) {  // the library's message, with the model's frames
+      in.fail(childPath(path, key), e.what());
+    }
     bool seen = false;
     for (const int g : b.reported_frames) seen = seen || g == f;
     if (!seen) b.reported_frames.push_back(f);

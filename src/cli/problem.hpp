@@ -47,6 +47,7 @@ struct BaseSpec {
 // The problem as written, checked for everything that does not need the model.
 struct Problem {
   std::string file;        // the problem file, as given on the command line
+  std::string model;       // "model", as written
   std::string model_path;  // resolved against the problem file's directory
   std::string root, tip;
   bool strict = false;             // "strict": refuse the model's warnings

@@ -68,9 +68,14 @@ bool Task::mimicLawsMatch(const Model& model) const {
 }
 
 namespace {
+// An unknown name is reported with the candidates, as Model::frameIndex does.
 int lookup(const std::vector<std::string>& names, const std::string& name) {
   const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end()) throw ModelError("task: the model has no frame '" + name + "'");
+  if (it == names.end()) {
+    std::string known;
+    for (const std::string& n : names) known += (known.empty() ? "'" : ", '") + n + "'";
+    throw ModelError("task: the model has no frame '" + name + "' (frames: " + known + ")");
+  }
   return static_cast<int>(it - names.begin());
 }
 }  // namespace

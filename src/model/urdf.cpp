@@ -7,10 +7,13 @@
 //     limits, dynamics) so that a NaN, an infinity or a word where a number
 //     belongs is reported with the link or joint and the attribute at fault
 //     rather than as urdfdom's generic "could not parse" lines.
-//  2. urdfdom builds the link/joint tree. Its console_bridge error messages
-//     are captured and turned into the exception text. urdfdom sometimes logs
-//     an error and still returns a model (e.g. an unreadable <mass> leaves a
-//     zero inertial behind), so any logged error is a failure.
+//  2. urdfdom builds the link/joint tree. Its console_bridge messages are
+//     captured. urdfdom sometimes logs an error and still returns a model
+//     (an unreadable <mass> or <inertia> leaves zeros behind, which pass 1
+//     refuses first, naming the link; an unreadable <visual>): an error is a
+//     failure, unless the file reads without its <visual>, <collision> and
+//     <material> elements, which never enter the dynamics; then it loads
+//     without them, with a warning naming each link or material at fault.
 //  3. TinyXML again for what urdfdom drops: <transmission> elements with
 //     Drake's rotor-inertia tags.
 //
@@ -152,12 +155,32 @@ std::string nameOf(const TiXmlElement* element) {
   return name ? name : "";
 }
 
+// An <inertial> that urdfdom cannot read whole: it logs an error and keeps
+// the link with its mass or moments silently zeroed, so refuse it here,
+// naming the link.
+void checkInertialComplete(const Reporter& report, const std::string& who, const TiXmlElement* inertial) {
+  const TiXmlElement* mass = inertial->FirstChildElement("mass");
+  if (mass == nullptr || mass->Attribute("value") == nullptr)
+    report.fail(who + "<inertial> has no " + (mass ? "value attribute in its <mass>" : "<mass> element") +
+                ": urdfdom would silently read the link's mass and inertia as zero (write <mass value=\"…\"/>)");
+  const TiXmlElement* inertia = inertial->FirstChildElement("inertia");
+  if (inertia == nullptr)
+    report.fail(who + "<inertial> has no <inertia> element: urdfdom would silently read all six moments as zero " +
+                "(write <inertia ixx=\"…\" ixy=\"…\" ixz=\"…\" iyy=\"…\" iyz=\"…\" izz=\"…\"/>)");
+  for (const char* attr : {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"})
+    if (inertia->Attribute(attr) == nullptr)
+      report.fail(who + "<inertial> <inertia> has no " + attr +
+                  " attribute: urdfdom would silently read all six moments as zero (give ixx, ixy, ixz, iyy, iyz "
+                  "and izz, 0 where the moment is zero)");
+}
+
 // Every number of every link and joint zwang reads, anywhere in the file.
 void checkAllNumbers(const Reporter& report, const TiXmlElement* robot) {
   for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
     const TiXmlElement* inertial = link->FirstChildElement("inertial");
     if (inertial == nullptr) continue;
     const std::string who = "link '" + nameOf(link) + "': ";
+    checkInertialComplete(report, who, inertial);
     const TiXmlElement* origin = inertial->FirstChildElement("origin");
     checkNumbers(report, who + "<inertial> <origin>", origin, "xyz", 3);
     checkNumbers(report, who + "<inertial> <origin>", origin, "rpy", 3);
@@ -218,48 +241,137 @@ CaptureHandler& captureHandler() {
   return *handler;
 }
 
-// urdfdom's model; its logged warnings are appended to `warnings`.
-urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const std::string& xml,
-                                               std::vector<ModelWarning>& warnings) {
-  std::vector<std::string> errors, logged_warnings;
+// One run of urdfdom over `xml`: its model (possibly null) and what it logged.
+struct UrdfdomRun {
   urdf::ModelInterfaceSharedPtr model;
-  {
-    const std::lock_guard<std::mutex> lock(captureMutex());
-    CaptureHandler& handler = captureHandler();
-    console_bridge::OutputHandler* const previous = console_bridge::getOutputHandler();
-    const console_bridge::LogLevel previous_level = console_bridge::getLogLevel();
-    handler.forward = previous;
-    handler.forward_level = previous_level;
-    handler.errors = &errors;
-    handler.warnings = &logged_warnings;
-    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_WARN);  // warnings reach the handler
-    console_bridge::useOutputHandler(&handler);
-    struct Restore {
-      CaptureHandler& handler;
-      console_bridge::OutputHandler* previous;
-      console_bridge::LogLevel level;
-      ~Restore() {
-        console_bridge::useOutputHandler(previous);
-        console_bridge::setLogLevel(level);
-        handler.errors = nullptr;
-        handler.warnings = nullptr;
-      }
-    } restore{handler, previous, previous_level};
-    try {
-      model = urdf::parseURDF(xml);
-    } catch (const std::exception& e) {
-      errors.push_back(e.what());
-      model.reset();
+  std::vector<std::string> errors;
+  std::vector<std::string> warnings;
+};
+
+UrdfdomRun runUrdfdom(const std::string& xml) {
+  UrdfdomRun run;
+  const std::lock_guard<std::mutex> lock(captureMutex());
+  CaptureHandler& handler = captureHandler();
+  console_bridge::OutputHandler* const previous = console_bridge::getOutputHandler();
+  const console_bridge::LogLevel previous_level = console_bridge::getLogLevel();
+  handler.forward = previous;
+  handler.forward_level = previous_level;
+  handler.errors = &run.errors;
+  handler.warnings = &run.warnings;
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_WARN);  // warnings reach the handler
+  console_bridge::useOutputHandler(&handler);
+  struct Restore {
+    CaptureHandler& handler;
+    console_bridge::OutputHandler* previous;
+    console_bridge::LogLevel level;
+    ~Restore() {
+      console_bridge::useOutputHandler(previous);
+      console_bridge::setLogLevel(level);
+      handler.errors = nullptr;
+      handler.warnings = nullptr;
     }
+  } restore{handler, previous, previous_level};
+  try {
+    run.model = urdf::parseURDF(xml);
+  } catch (const std::exception& e) {
+    run.errors.push_back(e.what());
+    run.model.reset();
   }
-  if (!errors.empty()) {
-    std::string joined;
-    for (const std::string& e : errors) joined += (joined.empty() ? "" : "; ") + e;
-    report.fail("urdfdom rejected the URDF: " + joined);
+  return run;
+}
+
+std::string joined(const std::vector<std::string>& texts) {
+  std::string all;
+  for (const std::string& t : texts) all += (all.empty() ? "" : "; ") + t;
+  return all;
+}
+
+// `element` (a copy) as the whole of a <robot>, with an empty link after it
+// when `with_link` (urdfdom wants one), as text for urdfdom (NUL-padded as in load()).
+std::string probeText(const TiXmlElement& element, bool with_link) {
+  TiXmlElement robot("robot");
+  robot.SetAttribute("name", "probe");
+  robot.InsertEndChild(element);
+  if (with_link) {
+    TiXmlElement link("link");
+    link.SetAttribute("name", "probe");
+    robot.InsertEndChild(link);
   }
-  if (!model) report.fail("urdfdom could not parse the URDF (it gave no reason)");
-  for (const std::string& text : logged_warnings) warnings.push_back({WarningCode::Urdfdom, "urdfdom: " + text});
-  return model;
+  TiXmlDocument doc;
+  doc.InsertEndChild(robot);
+  TiXmlPrinter printer;
+  doc.Accept(&printer);
+  return printer.Str() + std::string(8, '\0');
+}
+
+// The file without what only draws the robot: each link's <visual> and
+// <collision>, the top-level <material>s.
+std::string withoutAppearance(const TiXmlElement* robot) {
+  TiXmlElement bare(*robot);
+  for (TiXmlElement* link = bare.FirstChildElement("link"); link; link = link->NextSiblingElement("link"))
+    for (const char* tag : {"visual", "collision"})
+      while (TiXmlElement* child = link->FirstChildElement(tag)) link->RemoveChild(child);
+  while (TiXmlElement* material = bare.FirstChildElement("material")) bare.RemoveChild(material);
+  TiXmlDocument doc;
+  doc.InsertEndChild(bare);
+  TiXmlPrinter printer;
+  doc.Accept(&printer);
+  return printer.Str() + std::string(8, '\0');
+}
+
+// One Urdfdom warning per link or top-level <material> urdfdom cannot read
+// alone (links and materials are parsed independently of each other), or one
+// for all when none of them fails alone.
+void appearanceWarnings(const TiXmlElement* robot, const std::vector<std::string>& errors,
+                        std::vector<ModelWarning>& warnings) {
+  const std::string loaded = "; they do not enter the dynamics: loaded without them";
+  bool named = false;
+  for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link")) {
+    if (!link->FirstChildElement("visual") && !link->FirstChildElement("collision")) continue;
+    const UrdfdomRun alone = runUrdfdom(probeText(*link, false));
+    if (alone.errors.empty()) continue;
+    warnings.push_back({WarningCode::Urdfdom, "link '" + nameOf(link) +
+                                                  "': urdfdom cannot read its <visual> or <collision> elements (" +
+                                                  joined(alone.errors) + ")" + loaded});
+    named = true;
+  }
+  for (const TiXmlElement* material = robot->FirstChildElement("material"); material;
+       material = material->NextSiblingElement("material")) {
+    const UrdfdomRun alone = runUrdfdom(probeText(*material, true));
+    if (alone.errors.empty()) continue;
+    const char* name = material->Attribute("name");
+    warnings.push_back(
+        {WarningCode::Urdfdom, (name ? "<material> '" + std::string(name) + "'" : "a <material> without a name") +
+                                   ": urdfdom cannot read it (" + joined(alone.errors) +
+                                   "); materials do not enter the dynamics: loaded without it"});
+    named = true;
+  }
+  if (!named)
+    warnings.push_back({WarningCode::Urdfdom, "urdfdom: " + joined(errors) +
+                                                  "; the file reads without its <visual>, <collision> and <material> "
+                                                  "elements" +
+                                                  loaded});
+}
+
+// urdfdom's model; its logged warnings are appended to `warnings`. urdfdom
+// logs an error and still returns a model for an unreadable <visual>,
+// <collision> or <material> (a material without a name, a visual without
+// geometry): Pinocchio and ROS load such files. When the file reads without
+// those elements, it is loaded so, with a warning per link or material at
+// fault; any other error fails the load.
+urdf::ModelInterfaceSharedPtr parseWithUrdfdom(const Reporter& report, const TiXmlElement* robot,
+                                               const std::string& xml, std::vector<ModelWarning>& warnings) {
+  const UrdfdomRun run = runUrdfdom(xml);
+  for (const std::string& text : run.warnings) warnings.push_back({WarningCode::Urdfdom, "urdfdom: " + text});
+  if (run.errors.empty()) {
+    if (!run.model) report.fail("urdfdom could not parse the URDF (it gave no reason)");
+    return run.model;
+  }
+  const UrdfdomRun bare = runUrdfdom(withoutAppearance(robot));
+  if (!bare.errors.empty() || !bare.model)
+    report.fail("urdfdom rejected the URDF: " + joined(bare.errors.empty() ? run.errors : bare.errors));
+  appearanceWarnings(robot, run.errors, warnings);
+  return bare.model;
 }
 
 // ---------------------------------------------------------------------------
@@ -373,6 +485,8 @@ const char* typeName(int type) {
 // <limit> into `joint`, every field checked. Placeholder limits (lower ==
 // upper, effort == velocity == 0: a CAD exporter's "unknown") would lock the
 // joint and give it no torque; they are read as "no limits", with a warning.
+// A negative effort or velocity (-1: "unlimited" in some vendors' files) is
+// read as no limit, with a warning: neither enters the dynamics.
 void readLimits(const Reporter& report, const urdf::Joint& uj, Joint& joint, std::vector<ModelWarning>& warnings) {
   const std::string who = "joint '" + uj.name + "'";
   const urdf::JointLimits& lim = *uj.limits;
@@ -382,16 +496,26 @@ void readLimits(const Reporter& report, const urdf::Joint& uj, Joint& joint, std
   } fields[] = {{"lower", lim.lower}, {"upper", lim.upper}, {"effort", lim.effort}, {"velocity", lim.velocity}};
   for (const auto& f : fields)
     if (!std::isfinite(f.value)) report.fail(who + ": <limit> " + f.name + " is not finite");
-  if (lim.effort < 0.0) report.fail(who + ": <limit> effort " + fmt(lim.effort) + " is negative");
-  if (lim.velocity < 0.0) report.fail(who + ": <limit> velocity " + fmt(lim.velocity) + " is negative");
+  if (lim.effort < 0.0 || lim.velocity < 0.0) {
+    const bool both = lim.effort < 0.0 && lim.velocity < 0.0;
+    const std::string given = both               ? "effort " + fmt(lim.effort) + " and velocity " + fmt(lim.velocity)
+                              : lim.effort < 0.0 ? "effort " + fmt(lim.effort)
+                                                 : "velocity " + fmt(lim.velocity);
+    const std::string read = both               ? "no effort and no velocity limit"
+                             : lim.effort < 0.0 ? "no effort limit"
+                                                : "no velocity limit";
+    warnings.push_back({WarningCode::PlaceholderLimits, who + ": <limit> " + given + (both ? " are" : " is") +
+                                                            " negative: read as " + read +
+                                                            " (how some files write \"unlimited\")"});
+  }
   if (lim.lower == lim.upper && lim.effort == 0.0 && lim.velocity == 0.0) {
     warnings.push_back({WarningCode::PlaceholderLimits,
                         who + ": placeholder <limit lower=\"" + fmt(lim.lower) + "\" upper=\"" + fmt(lim.upper) +
                             "\" effort=\"0\" velocity=\"0\"/> read as no limits (position, effort and velocity)"});
     return;  // Joint's defaults are infinite
   }
-  joint.effort_limit = lim.effort;
-  joint.velocity_limit = lim.velocity;
+  if (lim.effort >= 0.0) joint.effort_limit = lim.effort;  // else Joint's default, infinite
+  if (lim.velocity >= 0.0) joint.velocity_limit = lim.velocity;
   if (joint.type == JointType::Continuous) return;  // a continuous joint has no position limits
   if (lim.lower > lim.upper)
     report.fail(who + ": <limit> lower " + fmt(lim.lower) + " is greater than upper " + fmt(lim.upper));
@@ -660,9 +784,13 @@ void addMimicLaws(const Reporter& report, const urdf::ModelInterface& urdf_model
     const std::string& leader = uj.mimic->joint_name;
     const std::string who = "joint '" + name + "' (" + mimicLaw(uj) + ") mimics joint '" + leader + "'";
     const urdf::JointConstSharedPtr leader_joint = urdf_model.getJoint(leader);
-    if (!leader_joint) report.fail(who + ", which the URDF does not have");
+    const auto lock = [&] {  // only on the error path: the position may not be finite
+      return ": set " + options.names.lock_mimic + " to weld it at q = " + fmt(mimicLockPosition(report, uj, options)) +
+             " (its position when '" + leader + "' is at rest)";
+    };
+    if (!leader_joint) report.fail(who + ", which the URDF does not have" + lock());
     if (!isMoving(*leader_joint))
-      report.fail(who + ", which is not a moving joint (a fixed, floating or planar joint)");
+      report.fail(who + ", which is not a moving joint (a fixed, floating or planar joint)" + lock());
     if (std::find(moving.begin(), moving.end(), leader) == moving.end())
       report.fail(who + ", which is not in " + what + ": load a tree or chain that holds both, or set " +
                   options.names.lock_mimic);
@@ -1039,11 +1167,29 @@ void refuseWarnings(const Reporter& report, const Model& model) {
                 "): " + all);
 }
 
+// A file without any <inertial> (a kinematics-only description) has no
+// masses at all: say so once, rather than "zero mass" on its first leaf
+// (ModelBuilder::build), unless rotor inertias alone give every joint of a
+// fixed base something to move.
+void requireInertialData(const Reporter& report, const TiXmlElement* robot, const std::vector<std::string>& moving,
+                         const std::map<std::string, double>& rotor, bool base_floats) {
+  for (const TiXmlElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link"))
+    if (link->FirstChildElement("inertial")) return;
+  const bool rotors_carry = !base_floats && std::all_of(moving.begin(), moving.end(), [&rotor](const std::string& j) {
+    const auto r = rotor.find(j);
+    return r != rotor.end() && r->second > 0.0;
+  });
+  if (rotors_carry) return;
+  report.fail(
+      "the URDF has no <inertial> element on any link: it describes the kinematics only (no masses, no inertias), "
+      "and dynamics need them; use a description of the robot with its inertial data");
+}
+
 // The chain from `root` to the tip (options.tip, or the unique leaf of a tree
 // that does not branch into moving joints).
-void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, const LinkPtr& root,
-               const std::map<std::string, double>& rotor, const UrdfOptions& options, ModelBuilder& builder,
-               Placement& placement) {
+void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, const TiXmlElement* robot,
+               const LinkPtr& root, const std::map<std::string, double>& rotor, const UrdfOptions& options,
+               ModelBuilder& builder, Placement& placement) {
   const std::vector<LinkPtr> chain = chainLinks(report, urdf_model, root, options.tip);
   const std::string tip_name = chain.back()->name;
   std::vector<std::string> moving;  // moving joints of the chain
@@ -1059,6 +1205,7 @@ void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, c
     report.fail("the chain from root link '" + root->name + "' to tip link '" + tip_name + "' has no moving joint" +
                 (locked ? " (its mimic joints are locked)" : ""));
   checkRotorNames(report, urdf_model, options, moving, "the chain from '" + root->name + "' to '" + tip_name + "'");
+  requireInertialData(report, robot, moving, rotor, placement.base_floats);
   addChain(report, builder, placement, chain, rotor, options);
   addMimicLaws(report, urdf_model, options, moving, "the chain from '" + root->name + "' to '" + tip_name + "'",
                builder);
@@ -1067,14 +1214,15 @@ void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, c
 }
 
 // The whole tree below `root` (no tip, and it branches into moving joints).
-void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, const LinkPtr& root,
-              const std::map<std::string, double>& rotor, const UrdfOptions& options, ModelBuilder& builder,
-              Placement& placement) {
+void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, const TiXmlElement* robot,
+              const LinkPtr& root, const std::map<std::string, double>& rotor, const UrdfOptions& options,
+              ModelBuilder& builder, Placement& placement) {
   std::vector<std::string> moving;
   addTree(report, builder, placement, root, rotor, options, moving);
   if (moving.empty() && !placement.base_floats)
     report.fail("the tree below root link '" + root->name + "' has no moving joint (its mimic joints are locked)");
   checkRotorNames(report, urdf_model, options, moving, "the tree below '" + root->name + "'");
+  requireInertialData(report, robot, moving, rotor, placement.base_floats);
   addMimicLaws(report, urdf_model, options, moving, "the tree below '" + root->name + "'", builder);
   checkLockedPositions(report, options, {}, placement.locked_mimic, false);
 }
@@ -1091,7 +1239,7 @@ Model load(const Reporter& report, const std::string& text, const UrdfOptions& o
   checkAllNumbers(report, robot);  // every number finite, anywhere
 
   Placement placement;
-  const urdf::ModelInterfaceSharedPtr urdf_model = parseWithUrdfdom(report, xml, placement.warnings);
+  const urdf::ModelInterfaceSharedPtr urdf_model = parseWithUrdfdom(report, robot, xml, placement.warnings);
   if (!urdf_model->getRoot()) report.fail("the URDF has no root link");
   if (options.base == BaseType::Fixed) requireMovingJoint(report, *urdf_model);  // a floating body needs none
   const std::map<std::string, double> rotor = rotorInertias(report, robot, *urdf_model, options);
@@ -1106,9 +1254,9 @@ Model load(const Reporter& report, const std::string& text, const UrdfOptions& o
   if (placement.base_floats) report.builder([&] { builder.setBase(base.type, base.plane); });
   addRootLinkInertia(report, builder, *root, placement.base_floats);
   if (options.tip.empty() && branchesIntoMovingJoints(root))
-    loadTree(report, *urdf_model, root, rotor, options, builder, placement);
+    loadTree(report, *urdf_model, robot, root, rotor, options, builder, placement);
   else
-    loadChain(report, *urdf_model, root, rotor, options, builder, placement);
+    loadChain(report, *urdf_model, robot, root, rotor, options, builder, placement);
   for (const ModelWarning& w : placement.warnings) builder.addWarning(w.code, w.message);
   builder.prefixWarnings(report.source() + ": ");
   Model model;

@@ -26,13 +26,14 @@ const char* const kOutsideLimits = "outside_limits";
   raise(exceptions().model_error, where + ": " + e.what());
 }
 
-// Unknown frame names are reported with the model's frames.
+// Unknown frame names are reported with the model's frames (Model::frameIndex's message).
 void checkFrame(const Model& model, const std::string& where, const std::string& frame) {
   if (model.hasFrame(frame)) return;
-  std::string known;
-  for (const Frame& f : model.frames()) known += (known.empty() ? "" : ", ") + f.name;
-  raise(exceptions().model_error,
-        where + ": unknown frame '" + frame + "' (model '" + model.name() + "' has the frames: " + known + ")");
+  try {
+    (void)model.frameIndex(frame);
+  } catch (const ModelError& e) {
+    raiseModelError(where, e);
+  }
 }
 
 PyWorkspace& workspaceArg(const std::shared_ptr<Model>& model, py::handle ws_obj) {

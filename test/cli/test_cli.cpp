@@ -588,7 +588,8 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_q_length.json", {": q: has 2 entries, expected 1", "joint1"}},
       {"err_nonfinite.json", {": wrenches[0].force[1]: ", "1e400", "out of range"}},
       {"err_huge.json", {": gravity[2]: ", "-1e+300", "too large"}},
-      {"err_unknown_frame.json", {": wrenches[1].frame: unknown frame \"hand\"", "base, link1, tip"}},
+      {"err_unknown_frame.json",
+       {": wrenches[1].frame: model 'one_dof_arm' has no frame 'hand' (frames: 'base', 'link1', 'tip')\n"}},
       {"err_expressed_in.json", {": constraints[0].expressed_in: unknown value \"global\"", "aligned"}},
       {"err_wrench_aligned.json", {": wrenches[0].expressed_in: unknown value \"aligned\"", "\"local\" or \"world\""}},
       {"err_missing_model.json", {": model: ", "no_such_robot.urdf", "cannot open"}},
@@ -604,7 +605,7 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_balance_rank.json", {": balance.rank_tolerance: must be >= 0 and below singular_threshold (0.0001)"}},
       {"err_balance_key.json", {": balance.max_damping: unknown key"}},
       {"err_relative_unknown.json",
-       {": constraints[0].relative_to: unknown frame \"box\" (the model's frames: world, torso, chest,"}},
+       {": constraints[0].relative_to: model 'two_arms' has no frame 'box' (frames: 'world', 'torso', 'chest',"}},
       {"err_relative_self.json",
        {": constraints[0].relative_to: is the constrained frame itself (\"left_hand\")", "another frame"}},
       {"err_reference_absolute.json",
@@ -682,6 +683,56 @@ TEST_CASE("Errors outside the problem's content", "[errors]") {
     checkOneLineError(r, 1);
     CHECK(contains(r.err, "one_dof_arm.urdf"));
     CHECK(contains(r.err, "--models"));
+  }
+}
+
+TEST_CASE("Messages: the model path as resolved, syntax errors at the file, the lock option by its CLI names",
+          "[errors]") {
+  const std::string dir = cli_test::scratchDir();
+  SECTION("a missing model names the path it was resolved to, relative to the problem file") {
+    const Run r = run({"solve", problem("err_missing_model.json")});
+    checkOneLineError(r, 1);
+    CHECK(r.err == "zwang: " + problem("err_missing_model.json") +
+                       ": model: \"no_such_robot.urdf\", relative to the problem file, is " + kProblems +
+                       "/no_such_robot.urdf: cannot open the file (No such file or directory)\n");
+    // An absolute path is named as given.
+    const std::string file = dir + "/absolute_model.json";
+    cli_test::writeText(file, "{\"model\": \"" + dir + "/no_such_robot.urdf\"}");
+    const Run a = run({"solve", file});
+    checkOneLineError(a, 1);
+    CHECK(a.err == "zwang: " + file + ": model: " + dir +
+                       "/no_such_robot.urdf: cannot open the file (No such file or directory)\n");
+  }
+  SECTION("a syntax error after the model's value is the file's, not \"model\"'s") {
+    const std::string file = dir + "/syntax_after_model.json";
+    cli_test::writeText(file, "{\"model\": \"arm.urdf\" \"q\": [0]}");
+    const Run r = run({"solve", file});
+    checkOneLineError(r, 1);
+    CHECK(r.err == "zwang: " + file +
+                       ": line 1, column 24: syntax error while parsing object - unexpected string literal; "
+                       "expected '}'\n");
+  }
+  SECTION("a mimic joint whose leader is missing: the lock option as the CLI spells it") {
+    const std::string urdf = dir + "/mimic_no_leader.urdf";
+    cli_test::writeText(urdf, R"(<robot name="m"><link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="m2" type="revolute"><parent link="base"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="gone" offset="0.1"/></joint>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+</robot>)");
+    const Run info = run({"info", urdf});
+    checkOneLineError(info, 1);
+    CHECK(info.err == "zwang: " + urdf +
+                          ": joint 'm2' (q = 1·q_gone + 0.1) mimics joint 'gone', which the URDF does not have: set "
+                          "--lock-mimic to weld it at q = 0.1 (its position when 'gone' is at rest)\n");
+    CHECK(run({"info", urdf, "--lock-mimic"}).exit_code == 0);
+    const std::string file = dir + "/mimic_no_leader.json";
+    cli_test::writeText(file, R"({"model": "mimic_no_leader.urdf"})");
+    const Run solve = run({"solve", file});
+    checkOneLineError(solve, 1);
+    CHECK(contains(solve.err, "which the URDF does not have: set \"lock_mimic\": true to weld it at q = 0.1"));
   }
 }
 

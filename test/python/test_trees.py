@@ -120,5 +120,24 @@ def test_relative_constraint_two_hands_hold_a_box(baxter):
         zwang.Constraint("left_gripper", np.eye(6), relative_to="left_gripper")
     with pytest.raises(TypeError, match="relative_to: expected a frame name"):
         zwang.Constraint("left_gripper", np.eye(6), relative_to=3)
-    with pytest.raises(zwang.ModelError, match=r"constraints\[0\].relative_to: unknown frame 'box'"):
+    with pytest.raises(zwang.ModelError, match=r"constraints\[0\].relative_to: model '\w+' has no frame 'box' \(frames: "):
         zwang.solve(baxter, ws, q, constraints=[zwang.Constraint("left_gripper", np.eye(6), relative_to="box")])
+
+
+def test_mimic_leader_missing_names_lock_mimic():
+    urdf = """<robot name="m"><link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="m2" type="revolute"><parent link="base"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><mimic joint="gone" offset="0.1"/></joint>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+</robot>"""
+    with pytest.raises(zwang.ModelError) as error:
+        zwang.load_urdf_string(urdf)
+    assert str(error.value) == (
+        "<string>: joint 'm2' (q = 1·q_gone + 0.1) mimics joint 'gone', which the URDF does not have: "
+        "set lock_mimic=True to weld it at q = 0.1 (its position when 'gone' is at rest)"
+    )
+    with pytest.warns(zwang.ModelWarning, match="locked at q = 0.1"):
+        assert zwang.load_urdf_string(urdf, lock_mimic=True).dof == 1

@@ -21,6 +21,7 @@
 #include <string>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include "support/dense_reference.hpp"
 #include "support/friction_reference.hpp"
@@ -491,6 +492,11 @@ TEST_CASE("mimic trees: q̈, ν and τ_control match the dense KKT reference (30
     CHECK(eg < 1e-9);
     CHECK(ed < 1e-9);
     CHECK(s.balance.consistent);
+    // wellPosed: the dense G (the task's rows and one per mimic joint) has
+    // full row rank, so the task's rows keep theirs on the coupled robot.
+    CHECK(s.balance.rows == in.constraintRows());
+    CHECK(s.balance.rank == in.constraintRows());
+    CHECK(s.balance.nu_unique);
     for (const MimicLaw& law : laws) CHECK(s.tau_control(law.joint) == 0.0);
     e_qdd = std::max(e_qdd, eq);
     e_nu = std::max(e_nu, en);
@@ -537,6 +543,91 @@ TEST_CASE("mimic trees: q̈, ν and τ_control match the dense KKT reference (30
   CHECK(negative > 150);
   CHECK(relative_rows > 200);
   CHECK(with_rows > 200);
+}
+
+// The balance report counts the task's rows, not the internal mimic rows
+// (issue #24, item 9: Baxter with 12 task rows reported 14 rows and rank 14,
+// with none 2 and 2). Baxter (models/baxter.urdf) with its two mimic fingers
+// modelled, each gripper's right finger following its left with a = −1:
+//  * no task: 0 rows, rank 0;
+//  * both grippers held in 6-D: 12 rows; the grippers ride on the arms before
+//    the fingers, so the mimic rows share no joint with them and the rank on
+//    the coupled robot is that of the two frames' stacked Jacobian (12 × 19,
+//    its SVD), 12 at this pose (each gripper on its own 7-joint arm);
+//  * a joint row on the left gripper's left finger (q̈ = 1) and one on its
+//    right finger: 2 rows on one degree of freedom of the coupled gripper,
+//    rank 1. With q̈_right = −1 = a·1 both are met and only their split of the
+//    torque is open (ν not unique, consistent); with q̈_right = +1 no motion
+//    meets both (ν not unique, not consistent).
+TEST_CASE("balance report: rows and rank are the task's, not the mimic rows (Baxter's mimic fingers)", "[mimic]") {
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/baxter.urdf");
+  REQUIRE(model.mimicJoints().size() == 2);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.dof()), qd = Eigen::VectorXd::Zero(model.dof());
+  const char* left_arm[] = {"left_s0", "left_s1", "left_e0", "left_e1", "left_w0", "left_w1", "left_w2"};
+  const char* right_arm[] = {"right_s0", "right_s1", "right_e0", "right_e1", "right_w0", "right_w1", "right_w2"};
+  // The pose of test/cli/problems/baxter_mimic_grippers.json: the arms mirrored, elbows and wrists bent.
+  const double left_pose[] = {-0.3, -0.5, -0.2, 1.2, 0.3, 0.8, -0.1},
+               right_pose[] = {0.3, -0.5, 0.2, 1.2, -0.3, 0.8, 0.1};
+  for (int k = 0; k < 7; ++k) {
+    q[model.jointIndex(left_arm[k])] = left_pose[k];
+    q[model.jointIndex(right_arm[k])] = right_pose[k];
+  }
+  const int finger_l = model.jointIndex("l_gripper_l_finger_joint"),
+            finger_r = model.jointIndex("l_gripper_r_finger_joint");
+  q[finger_l] = 0.01;
+  model.followLeaders(q, qd);
+  const Eigen::VectorXd tau = Eigen::VectorXd::Zero(model.dof());
+  Workspace ws(model, 12);
+
+  const Task none(model);
+  REQUIRE(none.mimicRows() == 2);
+  REQUIRE(solveHybridDynamics(model, none, q, qd, tau, ws));
+  CHECK(ws.solution.balance.rows == 0);
+  CHECK(ws.solution.balance.rank == 0);
+  CHECK(ws.solution.balance.nu_unique);
+  CHECK(ws.solution.balance.consistent);
+
+  Task grippers(model);
+  Eigen::MatrixXd J(12, model.nv());
+  const char* frames[] = {"left_gripper", "right_gripper"};
+  for (int k = 0; k < 2; ++k) {
+    grippers.addConstraint(frames[k], ConstraintMatrix::Identity(6, 6), Expressed::World);
+    Eigen::MatrixXd Jk(6, model.nv());
+    REQUIRE(frameJacobian(model, ws, q, model.frameIndex(frames[k]), Expressed::World, Jk));
+    CHECK(Jk.col(finger_l).isZero(0.0));  // the frames ride before the fingers
+    CHECK(Jk.col(finger_r).isZero(0.0));
+    J.middleRows(6 * k, 6) = Jk;
+  }
+  const Eigen::VectorXd sv = J.jacobiSvd().singularValues();
+  const int jacobian_rank = static_cast<int>((sv.array() > 1e-9 * sv[0]).count());  // Jacobian entries ~1 m
+  std::printf("Baxter, both grippers held: the Jacobian's singular values %.3g … %.3g, rank %d\n", sv[0],
+              sv[sv.size() - 1], jacobian_rank);
+  REQUIRE(jacobian_rank == 12);
+  REQUIRE(solveHybridDynamics(model, grippers, q, qd, tau, ws));
+  CHECK(ws.solution.balance.rows == 12);
+  CHECK(ws.solution.balance.rank == 12);
+  CHECK(ws.solution.balance.nu_unique);
+  CHECK(ws.solution.balance.consistent);
+
+  for (const double right : {-1.0, 1.0}) {
+    Task fingers(model);
+    fingers.addJointConstraint(finger_l);
+    fingers.addJointConstraint(finger_r);
+    fingers.targets() << 1.0, right;
+    INFO("qdd_left = 1, qdd_right = " << right);
+    REQUIRE(solveHybridDynamics(model, fingers, q, qd, tau, ws));
+    const BalanceReport& report = ws.solution.balance;
+    CHECK(report.rows == 2);
+    CHECK(report.rank == 1);
+    CHECK(report.singular);
+    CHECK_FALSE(report.nu_unique);
+    CHECK(report.consistent == (right == -1.0));
+    if (right == -1.0) {  // met: the fingers move as asked, and the law holds
+      CHECK(ws.solution.qdd[finger_l] == Approx(1.0).epsilon(1e-9));
+      CHECK(ws.solution.qdd[finger_r] == Approx(-1.0).epsilon(1e-9));
+      CHECK(report.residual < 1e-9);
+    }
+  }
 }
 
 // ===========================================================================

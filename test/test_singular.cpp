@@ -178,6 +178,8 @@ TEST_CASE("a repeated constraint row: rank deficient but consistent, met exactly
                               Eigen::Vector2d::Zero(), ws));
   CHECK(ws.solution.balance.singular);
   CHECK(ws.solution.balance.rank == 1);
+  CHECK_FALSE(ws.solution.balance.nu_unique);
+  CHECK(ws.solution.balance.consistent);
   CHECK(ws.solution.qdd.sum() == Approx(1.5).epsilon(1e-6));
   CHECK(ws.solution.nu[0] == Approx(ws.solution.nu[1]).epsilon(1e-9));
 }
@@ -198,6 +200,53 @@ TEST_CASE("a constraint on the fixed base changes nothing and is reported singul
   CHECK(ws.solution.balance.rank == 0);
   CHECK(ws.solution.nu.norm() == 0.0);
   CHECK((ws.solution.qdd - free_qdd).norm() < 1e-12);
+}
+
+// A standing humanoid (models/simple_humanoid.urdf, free base, 29 joints, nv =
+// 35): both ankles on the ground in 6-D (12 contact rows) and every joint held
+// by its motor (29 joint rows), the problem of docs/evaluation.md, section 4.
+// The joint rows fix every joint; either foot alone then fixes the base, so
+// the rank is nv = 35 of 41 rows, and the 6 rows beyond it are the ground's
+// split between the feet: an internal force between them moves nothing. At
+// rest with every target 0, q̈ = 0 meets every row: ν is not unique but the
+// task is met — statically indeterminate, not a failure. Asking the left ankle
+// alone for an acceleration keeps the rows and the rank, but with every joint
+// held the robot is one rigid body at rest, and the right ankle's zero then
+// fixes the left one's: no motion meets both, the lost rank leaves rows unmet.
+TEST_CASE(
+    "a standing humanoid: the weight split between the feet is indeterminate but met; a rank loss that "
+    "leaves rows unmet is not") {
+  UrdfOptions options;
+  options.base = BaseType::Free;
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/simple_humanoid.urdf", options);
+  REQUIRE(model.dof() == 29);
+  REQUIRE(model.nv() == 35);
+  Task task(model);
+  for (const char* foot : {"l_ankle", "r_ankle"})
+    task.addContact(foot, ConstraintMatrix::Identity(6, 6), Expressed::World);
+  for (int j = 0; j < model.dof(); ++j) task.addJointConstraint(j);
+  Workspace ws(model, task);
+  Eigen::VectorXd q(model.nq());
+  REQUIRE(neutralConfiguration(model, q));
+  const Eigen::VectorXd qd = Eigen::VectorXd::Zero(model.nv()), tau = Eigen::VectorXd::Zero(model.nv());
+  for (const double left : {0.0, 0.5}) {
+    INFO("left ankle's first row asked for " << left);
+    task.targets().setZero();
+    task.targets()[0] = left;
+    REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+    const BalanceReport& report = ws.solution.balance;
+    CHECK(report.rows == 41);
+    CHECK(report.rank == 35);
+    CHECK(report.singular);
+    CHECK_FALSE(report.nu_unique);
+    if (left == 0.0) {
+      CHECK(report.consistent);
+      CHECK(ws.solution.qdd.cwiseAbs().maxCoeff() < 1e-9);
+    } else {
+      CHECK_FALSE(report.consistent);
+      CHECK(report.residual > 1e-3);  // far above rounding: a row is not met
+    }
+  }
 }
 
 TEST_CASE("balance report: Frobenius condition number of the equilibrated 𝓛 against the dense G H⁻¹ Gᵀ") {

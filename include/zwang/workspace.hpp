@@ -24,11 +24,24 @@ struct FrictionScratch;
 
 /// How the balance of line 25 went (docs/solver.md, "Singular tasks"). The
 /// eigenvalues meant here are those of the equilibrated 𝓛̃ (see BalanceOptions).
+/// `rows` and `rank` are the task's: the internal rows of mimic joints
+/// (Task::mimicRows) are not counted; `condition`, `damping` and `singular`
+/// are those of the whole balance, mimic rows included.
 struct BalanceReport {
-  int rows = 0;  ///< m, the number of constraint rows
-  int rank = 0;  ///< m minus the directions of exact rank loss (σ̃ ≤ rank_tolerance)
+  int rows = 0;  ///< the task's constraint rows (Task::constraintRows)
+  /// The rank of the task's rows on the robot as its mimic joints couple it:
+  /// `rows` minus the directions of exact rank loss (σ̃ ≤ rank_tolerance).
+  int rank = 0;
+  /// ν is the only one that gives this motion: rank = rows. False when the
+  /// rows are dependent, so other constraint forces give the same motion (a
+  /// row repeated, the weight split between two feet on the ground: a
+  /// statically indeterminate task), and the least-norm ν is returned. With
+  /// `consistent` every row is met all the same, which is no failure; without
+  /// it the lost rank left rows unmet (least squares).
+  bool nu_unique = true;
   /// Frobenius condition number ‖𝓛̃‖_F ‖𝓛̃⁻¹‖_F of the equilibrated matrix
-  /// (infinite when 𝓛 is singular): at least σ̃_max/σ̃_min and at most m times it.
+  /// (infinite when 𝓛 is singular): at least σ̃_max/σ̃_min and at most m times
+  /// it, m the balance's rows.
   double condition = 1.0;
   /// How far the most damped near-singular direction is from being solved
   /// exactly, in [0, 1): 1 − (σ̃ − rank_tolerance)/(singular_threshold −
@@ -36,12 +49,12 @@ struct BalanceReport {
   /// exact rank loss.
   double damping = 0.0;
   bool singular = false;  ///< some σ̃ below singular_threshold: a direction was dropped or damped
-  /// ‖Aᵀ Ẍ − b‖₂ over the task's rows, in the rows' own units (m/s², rad/s²),
-  /// measured on the final accelerations.
+  /// ‖Aᵀ Ẍ − b‖₂ over the task's rows and the mimic joints' couplings, in the
+  /// rows' own units (m/s², rad/s²), measured on the final accelerations.
   double residual = 0.0;
   /// Every row met to within residual_tolerance of its terms' size. False for
-  /// an inconsistent task (met in the least-squares sense only) and for a
-  /// damped direction that had to give.
+  /// an inconsistent task (met in the least-squares sense only: `nu_unique`
+  /// false too) and for a damped direction that had to give.
   bool consistent = true;
 };
 

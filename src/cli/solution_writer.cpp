@@ -86,7 +86,9 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
                        {"kkt_residual", f.kkt_residual}};
   }
   out["status"] = {{"singular", s.balance.singular},
+                   {"rows", s.balance.rows},
                    {"rank", s.balance.rank},
+                   {"nu_unique", s.balance.nu_unique},
                    {"residual", s.balance.residual},
                    {"consistent", s.balance.consistent},
                    {"infeasible", status.code == StatusCode::Infeasible}};

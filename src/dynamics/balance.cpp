@@ -228,9 +228,10 @@ BalanceReport factorByEigen(Eigen::Ref<Eigen::MatrixXd> L, BalanceFactorisation&
     report.singular = true;
     const double t = rampPosition(s, options);
     f.gain[k] = t / options.singular_threshold;
-    if (t == 0.0)
+    if (t == 0.0) {
       --report.rank;
-    else
+      report.nu_unique = false;  // 𝓛 has a null space: ν plus any of it gives the same motion
+    } else
       report.damping = std::max(report.damping, 1.0 - t);
   }
   // The near-null directions E v_k (𝓛 E v = E⁻¹ 𝓛̃ v = σ̃ E⁻¹ v), smallest σ̃

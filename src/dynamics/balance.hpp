@@ -17,8 +17,9 @@ namespace zwang::internal {
 //  * otherwise the eigenpairs of 𝓛̃, each direction exact, damped or dropped
 //    by its eigenvalue (BalanceOptions), and the projections that make the
 //    solution the minimum-norm least-squares one in the rows' own units.
-// Fills the report's rows, rank, condition, damping and singular fields (the
-// residual comes later, from the accelerations). No allocation: `f` was sized
+// Fills the report's rows, rank, nu_unique, condition, damping and
+// singular fields for the m rows of `L` (the caller counts out the mimic rows;
+// the residual comes later, from the accelerations). No allocation: `f` was sized
 // by the Workspace for the task's capacity.
 BalanceReport solveBalance(Eigen::Ref<Eigen::MatrixXd> L, const Eigen::Ref<const Eigen::VectorXd>& r,
                            Eigen::Ref<Eigen::VectorXd> nu, BalanceFactorisation& f, const BalanceOptions& options);

@@ -355,9 +355,16 @@ void balance(const Task& task, Workspace& ws) {
     ws.rhs.head(m).noalias() -= ws.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
   }
   Eigen::VectorXd& nu = condensed ? ws.nu_rows : ws.nu;
-  ws.solution.balance =
-      solveBalance(L.topLeftCorner(m, m), ws.rhs.head(m), nu.head(m), ws.balance_factorisation, task.balance);
+  BalanceReport& report = ws.solution.balance;
+  report = solveBalance(L.topLeftCorner(m, m), ws.rhs.head(m), nu.head(m), ws.balance_factorisation, task.balance);
   if (condensed) expandToColumns(task, ws.nu_rows.head(m), ws.nu);
+  // The report counts the task's rows. The mimic rows are independent of each
+  // other whatever the task (each alone moves its own mimic joint; a leader is
+  // never a mimic joint), so every direction the balance lost lies in the
+  // task's rows, and their rank on the coupled robot is the balance's less the
+  // mimic rows.
+  report.rows = task.constraintRows();
+  report.rank = std::max(0, report.rank - task.mimicRows());  // ≥ 0 even should rounding lose a mimic row
 }
 
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd_all) {

@@ -589,8 +589,17 @@ void bindSolve(py::module_& m) {
           "ν, constraint magnitudes in constraint order (a copy: its length follows the task)")
       .def_property_readonly(
           "gauss", [](const Result& r) { return r.solution().gauss; }, "Z(q̈)")
-      .def_property_readonly("rows", [](const Result& r) { return r.solution().balance.rows; })
-      .def_property_readonly("rank", [](const Result& r) { return r.solution().balance.rank; })
+      .def_property_readonly(
+          "rows", [](const Result& r) { return r.solution().balance.rows; },
+          "the task's constraint rows (a mimic joint's internal row is not one)")
+      .def_property_readonly(
+          "rank", [](const Result& r) { return r.solution().balance.rank; },
+          "the rank of the task's rows on the robot as its mimic joints couple it")
+      .def_property_readonly(
+          "nu_unique", [](const Result& r) { return r.solution().balance.nu_unique; },
+          "rank = rows: no other nu gives this motion. False for dependent rows (the least-norm nu is returned):\n"
+          "with consistent, every row is met all the same (statically indeterminate, e.g. the weight split\n"
+          "between two feet); without it, the lost rank left rows unmet")
       .def_property_readonly("condition", [](const Result& r) { return r.solution().balance.condition; })
       .def_property_readonly("damping", [](const Result& r) { return r.solution().balance.damping; })
       .def_property_readonly("singular", [](const Result& r) { return r.solution().balance.singular; })

@@ -382,6 +382,39 @@ TEST_CASE("Mimic joints from the tool: \"follow_leaders\" fills the followers' q
                  "true welded them)"));
 }
 
+TEST_CASE("Baxter with its mimic fingers modelled: status.rows and rank count the task's rows, not the mimic rows",
+          "[golden]") {
+  // Both grippers held in world axes: 12 rows, each gripper's 6 on its own
+  // 7-joint arm at a pose away from its singularities (test_mimic computes the
+  // stacked Jacobian's rank there: 12); the mimic fingers are beyond the frames.
+  // Baxter's four placeholder or point-mass links warn (as for baxter_hold_box.json), nothing else.
+  const auto solveBaxter = [](const std::string& file) {
+    const Run r = run({"solve", problem(file)});
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(occurrences(r.err, "zwang: warning: ") == 4);
+    return parse(r.out);
+  };
+  const Json g = solveBaxter("baxter_mimic_grippers.json");
+  CHECK(g["joints"].size() == 19);
+  CHECK(g["nu"].size() == 12);
+  CHECK(g["status"]["rows"] == 12);
+  CHECK(g["status"]["rank"] == 12);
+  CHECK(g["status"]["nu_unique"] == true);
+  CHECK(g["status"]["consistent"] == true);
+  // A joint row on each finger of one gripper: one degree of freedom of the
+  // coupled gripper, so rank 1 of 2; asked q̈ = 1 and −1 (the law, a = −1),
+  // both are met and only the split of the torque between them is open.
+  const Json f = solveBaxter("baxter_mimic_fingers.json");
+  CHECK(f["status"]["rows"] == 2);
+  CHECK(f["status"]["rank"] == 1);
+  CHECK(f["status"]["singular"] == true);
+  CHECK(f["status"]["nu_unique"] == false);
+  CHECK(f["status"]["consistent"] == true);
+  CHECK(numbers(f["qdd"])[8] == Approx(1.0).epsilon(1e-9));
+  CHECK(numbers(f["qdd"])[9] == Approx(-1.0).epsilon(1e-9));
+}
+
 // ---------------------------------------------------------------------------
 // Floating bases: "base" (docs/cli.md, "Floating base").
 
@@ -458,7 +491,11 @@ TEST_CASE(
     "library agree; the base needs no force",
     "[golden]") {
   const Json s = solve(problem("solo_stand.json"));
-  CHECK(s["status"]["rank"] == 18);  // 24 rows on nv = 18, dependent and consistent
+  // 24 rows on nv = 18, dependent and consistent: the ground's split between
+  // the four feet is open (ν not unique), every row is met.
+  CHECK(s["status"]["rows"] == 24);
+  CHECK(s["status"]["rank"] == 18);
+  CHECK(s["status"]["nu_unique"] == false);
   CHECK(s["status"]["consistent"] == true);
   CHECK(s["nu"].size() == 24);
   for (const Json& x : s["base"]["tau_control"]) CHECK(std::abs(x.get<double>()) < 1e-9);  // the ground holds it
@@ -557,12 +594,15 @@ TEST_CASE("A task the arm cannot meet: least squares, status.residual and consis
   CHECK(numbers(s["qdd"])[0] == Approx(0.5).epsilon(1e-12));
   CHECK(std::abs(numbers(s["nu"])[0]) < 1e-12);
   CHECK(s["status"]["singular"] == true);
+  CHECK(s["status"]["rows"] == 2);
   CHECK(s["status"]["rank"] == 1);
+  CHECK(s["status"]["nu_unique"] == false);  // the rank lost leaves a row unmet, unlike a standing robot's split
   CHECK(s["status"]["consistent"] == false);
   CHECK(s["status"]["residual"].get<double>() == Approx(2.0).epsilon(1e-12));
   // The regular golden problems report a met task.
   const Json hold = solve(problem("panda_hold.json"));
   CHECK(hold["status"]["consistent"] == true);
+  CHECK(hold["status"]["nu_unique"] == true);  // 6 independent rows on 7 joints
   CHECK(hold["status"]["residual"].get<double>() < 1e-12);
 }
 

@@ -154,6 +154,7 @@ def compare(problem, cli, res, infeasible, accelerations):
     same(res.nu, cli["nu"], "nu")
     assert res.gauss == cli["gauss"]
     assert res.singular == cli["status"]["singular"] and res.rank == cli["status"]["rank"]
+    assert res.rows == cli["status"]["rows"] and res.nu_unique == cli["status"]["nu_unique"]
     assert infeasible == cli["status"]["infeasible"]
     assert ("friction" in cli) == res.with_friction
     if res.with_friction:

@@ -261,8 +261,9 @@ def test_standing_on_contacts_with_joint_rows():
     assert repr(hold[0]) == "<zwang.Constraint on joint 'FL_HAA', 1 row>"
     ws = model.workspace(24)
     res = zwang.solve(model, ws, q, constraints=feet + hold)
-    # 24 rows on nv = 18: dependent but consistent (each fixes q̈ = 0); the balance keeps 18 and meets all
-    assert (res.rank, res.singular, res.consistent) == (18, True, True)
+    # 24 rows on nv = 18: dependent but consistent (each fixes q̈ = 0); the balance keeps 18 and meets all.
+    # The ground's split between the feet is open (nu not unique): statically indeterminate, not a failure.
+    assert (res.rows, res.rank, res.singular, res.nu_unique, res.consistent) == (24, 18, True, False, True)
     np.testing.assert_allclose(res.qdd, 0.0, atol=1e-10)  # 24 rows of size ~10 m/s², solved to ~1e-12
     ground = res.nu[:12].reshape(4, 3)  # world-axis forces on the feet
     assert abs(ground[:, 2].sum() - model.mass * 9.81 - model.base_mass * 9.81) < 1e-9  # they carry the weight
@@ -277,6 +278,12 @@ def test_standing_on_contacts_with_joint_rows():
     mixed = zwang.solve(model, model.workspace(24), q, constraints=plain_feet + hold)
     np.testing.assert_allclose(mixed.nu, res.nu, atol=1e-9)
     assert np.abs(mixed.tau_control[:6]).max() > 1.0  # the ground force now counts as the base's "motor"
+    # One foot asked to rise: with every joint held the robot is one rigid body at rest, and three feet
+    # that do not accelerate fix it, so no motion meets the fourth's row. The same rows and rank, but the
+    # rank lost now leaves rows unmet.
+    rise = zwang.Constraint("FL_FOOT", np.eye(6)[:, :3], b=[0.0, 0.0, 0.5], expressed="world", contact=True)
+    apart = zwang.solve(model, model.workspace(24), q, constraints=[rise] + feet[1:] + hold)
+    assert (apart.rows, apart.rank, apart.nu_unique, apart.consistent) == (24, 18, False, False)
 
 
 def test_contact_and_joint_row_errors():

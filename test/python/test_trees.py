@@ -80,6 +80,8 @@ def test_mimic_joints_modelled_or_locked(baxter):
     np.testing.assert_allclose(qdd[full.mimic_joints], -qdd[leaders], atol=1e-10 * (1 + np.abs(qdd).max()))
     assert np.array(res.tau_control)[full.mimic_joints].tolist() == [0.0, 0.0]  # the leaders' motors carry them
     np.testing.assert_allclose(np.array(res.tau_control)[leaders], 5.0 - 1.0, atol=1e-12)
+    # rows and rank are the task's: the two internal mimic rows are not counted (none here).
+    assert (res.rows, res.rank, res.nu_unique, res.consistent) == (0, 0, True, True)
 
     assert baxter.joint_names == BAXTER_JOINTS  # 19 moving joints in the file, 2 of them mimic: locked
     assert [code for code, _ in baxter.warnings].count("mimic_locked") == 2
@@ -89,6 +91,37 @@ def test_mimic_joints_modelled_or_locked(baxter):
     # The lock's note passes strict mode; Baxter's placeholder inertias do not.
     with pytest.raises(zwang.ModelError, match=r"strict mode \(4 warnings\)"):
         zwang.load_urdf(BAXTER, lock_mimic=True, strict=True)
+
+
+def test_balance_counts_the_task_rows_not_the_mimic_rows():
+    """Baxter with its mimic fingers modelled (one internal balance row each): both grippers held in world
+    axes are 12 rows, each gripper's 6 on its own 7-joint arm at a pose away from its singularities (rank 12,
+    the stacked Jacobian's, computed here); a joint row on each finger of one gripper is 2 rows on one degree
+    of freedom of the coupled gripper (rank 1): met when they ask for the law (qdd_r = -qdd_l), with only the
+    split of the torque between them open, and not met otherwise."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", zwang.ModelWarning)
+        full = zwang.load_urdf(BAXTER)
+    q = np.zeros(19)
+    q[1:8] = [-0.3, -0.5, -0.2, 1.2, 0.3, 0.8, -0.1]
+    q[10:17] = [0.3, -0.5, 0.2, 1.2, -0.3, 0.8, 0.1]
+    q, qd = full.follow_leaders(q, np.zeros(19))
+    ws = full.workspace(12)
+    grippers = [zwang.Constraint(f, np.eye(6), expressed="world") for f in ("left_gripper", "right_gripper")]
+    J = np.vstack([zwang.frame_jacobian(full, ws, q, f, expressed="world") for f in ("left_gripper", "right_gripper")])
+    assert np.linalg.matrix_rank(J) == 12
+    res = zwang.solve(full, ws, q, qd, constraints=grippers)
+    assert (res.rows, res.rank, res.nu_unique, res.consistent) == (12, 12, True, True)
+    assert len(res.nu) == 12
+    left, right = full.joint_names.index("l_gripper_l_finger_joint"), full.joint_names.index("l_gripper_r_finger_joint")
+    assert full.joints[right].mimic == (left, -1.0, 0.0)
+    for qdd_right, met in ((-1.0, True), (1.0, False)):
+        fingers = [zwang.Constraint.on_joint("l_gripper_l_finger_joint", 1.0),
+                   zwang.Constraint.on_joint("l_gripper_r_finger_joint", qdd_right)]
+        res = zwang.solve(full, ws, q, qd, constraints=fingers)
+        assert (res.rows, res.rank, res.singular, res.nu_unique, res.consistent) == (2, 1, True, False, met)
+        if met:
+            np.testing.assert_allclose(np.array(res.qdd)[[left, right]], [1.0, -1.0], rtol=1e-9)
 
 
 def test_relative_constraint_two_hands_hold_a_box(baxter):

@@ -48,6 +48,38 @@ HyperplaneScratch::HyperplaneScratch(int n) : breakpoints(2 * n), breakpoint_kin
 
 QpScratch::QpScratch(int n) : active_set(n), projected_gradient(n), least_distance(n), hyperplane(n) {}
 
+namespace {
+
+// lambdaMaxBound with the weight w_j given by weight(j) (no temporary vector).
+template <class Weight>
+double weightedLambdaMaxBound(const Eigen::Ref<const Eigen::MatrixXd>& P, const Weight& weight) {
+  double gershgorin = 0.0, trace = 0.0, largest = 0.0;
+  bool diagonal_non_negative = true;
+  for (Eigen::Index j = 0; j < P.cols(); ++j) {
+    double row_sum = 0.0;  // P symmetric: its contiguous column
+    for (Eigen::Index l = 0; l < P.rows(); ++l) {
+      const double entry = std::abs(weight(l) * P(l, j) * weight(j));
+      row_sum += entry;
+      largest = std::max(largest, entry);
+    }
+    gershgorin = std::max(gershgorin, row_sum);
+    const double diagonal = weight(j) * P(j, j) * weight(j);
+    diagonal_non_negative = diagonal_non_negative && diagonal >= 0.0;
+    trace += diagonal;
+  }
+  return diagonal_non_negative && trace >= largest ? std::min(gershgorin, trace) : gershgorin;
+}
+
+}  // namespace
+
+double lambdaMaxBound(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& w) {
+  return weightedLambdaMaxBound(P, [&w](Eigen::Index j) { return w[j]; });
+}
+
+double lambdaMaxBound(const Eigen::Ref<const Eigen::MatrixXd>& P) {
+  return weightedLambdaMaxBound(P, [](Eigen::Index) { return 1.0; });
+}
+
 double reachScale(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
                   const Eigen::Ref<const Eigen::VectorXd>& c, double lambda_max_bound, double curvature_scale) {
   double scale = 1.0;

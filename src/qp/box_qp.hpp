@@ -141,14 +141,28 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
 
 // The same problem by accelerated projected gradient (FISTA with adaptive
 // restart) in the metric of P's diagonal D (Jacobi preconditioning: the box
-// stays a box), step 1/L̃ with L̃ ≥ λ_max(D^-1/2 P D^-1/2) (Gershgorin or
-// trace bound); a linear variable (its column of P rounding of its terms,
-// where given) goes to its vertex first and stays, and a linear problem
-// (P = 0) is solved so. Unbounded and flat by the same rules as above.
+// stays a box), step 1/L̃ with L̃ ≥ λ_max(D^-1/2 P D^-1/2) (lambdaMaxBound);
+// a linear variable (P_jj rounding of its terms, where given) goes to its
+// vertex first, and to the other bound whenever the others' motion turns its
+// slope beyond the tolerance; a linear problem (P = 0) is solved so.
+// Unbounded and flat by the same rules as above.
 QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& c,
                                 const Eigen::Ref<const Eigen::VectorXd>& lo,
                                 const Eigen::Ref<const Eigen::VectorXd>& hi, Eigen::Ref<Eigen::VectorXd> x,
                                 QpScratch& s, int max_iterations, double tolerance, const TermSizes& terms = {});
+
+// An upper bound of λ_max(W P W), W = diag(w) (w = 1: of P itself), in O(k²):
+// Gershgorin's (the largest absolute row sum), which holds for any symmetric
+// matrix, or the trace where that is smaller and W P W can be positive
+// semi-definite. P as computed is so only to rounding, and on a singular
+// task far from it (K_ΘΘ behind a damped balance: a diagonal entry below
+// zero, an off-diagonal entry above the trace); the trace of such a matrix
+// bounds nothing and can be zero or negative, which would make P look like
+// zero. So the trace counts only when every diagonal entry is ≥ 0 and no
+// entry exceeds it (both necessary for semi-definiteness); the bound is then
+// never below the largest |entry|.
+double lambdaMaxBound(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen::Ref<const Eigen::VectorXd>& w);
+double lambdaMaxBound(const Eigen::Ref<const Eigen::MatrixXd>& P);
 
 // The scale of the reach rule above: max(1, largest finite |bound|,
 // ‖c‖∞ / max(lambda_max_bound, curvature_scale)).

@@ -365,9 +365,7 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   ActiveSetScratch& s = scratch.active_set;
   const Box box{P, c, lo, hi, tolerance, terms};
   for (int j = 0; j < k; ++j) s.row_sums[j] = P.col(j).cwiseAbs().sum();
-  // λ_max(P) ≤ the smaller of Gershgorin's bound and the trace.
-  const double reach =
-      kReach * reachScale(lo, hi, c, std::min(s.row_sums.head(k).maxCoeff(), P.diagonal().sum()), terms.curvature);
+  const double reach = kReach * reachScale(lo, hi, c, lambdaMaxBound(P), terms.curvature);
   if (!warmStart(box, x, s, reach, report)) {  // stage 1
     report.kkt_residual = boxQpKktResidual(P, c, lo, hi, x);
     return report;

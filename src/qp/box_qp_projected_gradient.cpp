@@ -5,17 +5,19 @@
 //  * steps in the metric of P's diagonal D (Jacobi preconditioning): the box
 //    stays a box, so the projection is still the clamp, and the step 1/L̃
 //    uses L̃ ≥ λ_max(D^-1/2 P D^-1/2), a Gershgorin or trace bound in O(k²)
-//    rather than an eigen-decomposition (jacobiMetric);
+//    rather than an eigen-decomposition (jacobiMetric, lambdaMaxBound);
 //  * one product with P per iteration: P y = (1 + β) P x − β P x_previous by
 //    linearity;
 //  * the stopping test is the KKT violation in the units of ∇φ
 //    (kktViolation), not a change in x;
-//  * a linear variable (its column of P zero to rounding of its terms, where
-//    the caller gives them: TermSizes) goes straight to the bound its
-//    gradient points to, or stays where that bound is infinite and the
-//    gradient within rounding (a flat direction, as in the active set)
-//    (linearVertex), and the iterations leave it there; a linear problem
-//    (P = 0 to rounding) is solved so entirely;
+//  * a linear variable (P_jj zero to rounding of its terms, where the caller
+//    gives them: TermSizes) goes straight to the bound its gradient points
+//    to, or stays where that bound is infinite and the gradient within
+//    rounding (a flat direction, as in the active set) (linearVertex); the
+//    iterations do not step it but send it to the other bound when their
+//    motion turns its gradient (followLinear: P is semi-definite only to
+//    rounding, so its column need not be); a linear problem (P = 0 to
+//    rounding) is solved so entirely;
 //  * a variable running off along an infinite bound is reported unbounded
 //    (the reach rule, kReach in src/qp/box_qp.hpp).
 #include <algorithm>
@@ -57,8 +59,10 @@ void clampToBox(const VectorRef& lo, const VectorRef& hi, Eigen::Ref<Eigen::Vect
 }
 
 // Is x_j a linear variable: its column of P rounding of the terms it was
-// computed from (P_jj at most kTermRounding of them, and with it, P being
-// positive semi-definite, the whole column), where the caller knows them?
+// computed from (P_jj at most kTermRounding of them), where the caller knows
+// them? The diagonal speaks for the column only where P is positive
+// semi-definite; behind a singular task's balance K_ΘΘ is so only roughly,
+// and its column may still couple x_j to the others (followLinear).
 bool linearVariable(const MatrixRef& P, const TermSizes& terms, Index j) {
   return terms.curvature_of.size() == P.rows() && P(j, j) <= kTermRounding * terms.curvature_of[j];
 }
@@ -107,13 +111,7 @@ double jacobiMetric(const MatrixRef& P, const TermSizes& terms, ProjectedGradien
   for (Index j = 0; j < k; ++j) inverse_d[j] = linearVariable(P, terms, j) ? 0.0 : 1.0 / std::max(P(j, j), d_floor);
   auto root_inverse_d = s.root_inverse_diagonal.head(k);
   root_inverse_d = inverse_d.cwiseSqrt();
-  double scaled_gershgorin = 0.0;
-  for (Index j = 0; j < k; ++j)
-    scaled_gershgorin = std::max(scaled_gershgorin, P.col(j).cwiseAbs().dot(root_inverse_d) * root_inverse_d[j]);
-  double scaled_trace = 0.0;  // (a diagonal that is rounding may come out negative)
-  for (Index j = 0; j < k; ++j) scaled_trace += std::max(0.0, P(j, j)) * inverse_d[j];
-  const double scaled_L = scaled_trace > 0.0 ? std::min(scaled_gershgorin, scaled_trace) : scaled_gershgorin;
-  return 1.0 / scaled_L;
+  return 1.0 / lambdaMaxBound(P, root_inverse_d);
 }
 
 // max_j kktViolation at x over the variables that move (stage 0 settled the
@@ -124,6 +122,39 @@ double kktAt(const Segment& Px, const VectorRef& c, const VectorRef& lo, const V
   for (Index j = 0; j < x.size(); ++j)
     if (inverse_d[j] > 0.0) r = std::max(r, kktViolation(Px[j] - c[j], x[j], lo[j], hi[j]));
   return r;
+}
+
+// Stage 3a, the linear variables again: stage 0 placed each by c_j alone,
+// which is right while its column of P is rounding. Where it is not (K_ΘΘ
+// behind a singular task's balance is positive semi-definite only roughly:
+// a diagonal entry at rounding or below zero beside real off-diagonal ones),
+// the others' motion turns ∇φ_j = (P x)_j − c_j; once it points into x_j's
+// room beyond the tolerance, x_j goes to the bound it now points to (P x
+// updated), as stage 0 would send it. Towards an infinite bound it is
+// unbounded, unless the slope is rounding of its terms (roundingSlope): flat,
+// x_j stays, as in stage 0. True when one moved (the iterations go on from
+// there); false otherwise (report.unbounded says whether one ran off).
+bool followLinear(const MatrixRef& P, const VectorRef& c, const VectorRef& lo, const VectorRef& hi,
+                  const TermSizes& terms, double tolerance, Eigen::Ref<Eigen::VectorXd> x, Iterates& v,
+                  QpReport& report) {
+  bool moved = false;
+  for (Index j = 0; j < x.size(); ++j) {
+    if (v.inverse_d[j] > 0.0 || lo[j] == hi[j]) continue;  // moves with the iterations, or cannot move
+    const double g = v.Px[j] - c[j];
+    const double violation = kktViolation(g, x[j], lo[j], hi[j]);
+    if (violation <= tolerance) continue;
+    const double bound = g < 0.0 ? hi[j] : lo[j];
+    if (!std::isfinite(bound)) {
+      if (violation <= tolerance + roundingSlope(terms, x, j)) continue;  // flat
+      report.unbounded = true;
+      report.unbounded_index = static_cast<int>(j);
+      return false;
+    }
+    v.Px += P.col(j) * (bound - x[j]);
+    x[j] = bound;
+    moved = true;
+  }
+  return moved;
 }
 
 // The variable farthest out (the one that ran away).
@@ -162,23 +193,26 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
   if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
   const Index k = x.size();
-  // Lipschitz constant of ∇φ: an upper bound of λ_max(P) in O(k²), the
-  // smaller of Gershgorin's (largest absolute row sum) and the trace (P is
-  // positive semi-definite), rather than an O(k³) eigen-decomposition.
-  double gershgorin = 0.0;
-  for (Index j = 0; j < k; ++j) gershgorin = std::max(gershgorin, P.row(j).cwiseAbs().sum());
-  const double L = std::max(0.0, std::min(gershgorin, P.diagonal().sum()));
+  // Lipschitz constant of ∇φ: an upper bound of λ_max(P) in O(k²) rather
+  // than an O(k³) eigen-decomposition, never below P's largest |entry|.
+  const double L = lambdaMaxBound(P);
   const bool all_linear = linear(P, c, L, terms);
+  ProjectedGradientScratch& s = scratch.projected_gradient;
+  Iterates v{s.inverse_diagonal.head(k), s.gradient.head(k), s.y.head(k),           s.x_previous.head(k),
+             s.x_change.head(k),         s.Px.head(k),       s.Px_previous.head(k), s.Py.head(k)};
   if (!linearVertex(P, c, lo, hi, all_linear, terms, tolerance, x, report) || all_linear) {  // stage 0
-    report.converged = !report.unbounded;
+    if (!report.unbounded) {  // every variable linear: each follows the others' coupling (stage 3a) until none moves
+      v.inverse_d.setZero();
+      v.Px.noalias() = P * x;
+      while (report.iterations < max_iterations && followLinear(P, c, lo, hi, terms, tolerance, x, v, report))
+        ++report.iterations;
+      report.converged = !report.unbounded && report.iterations < max_iterations;
+    }
     report.kkt_residual = report.unbounded ? kInf : boxQpKktResidual(P, c, lo, hi, x);
     return report;
   }
-  ProjectedGradientScratch& s = scratch.projected_gradient;
   const double step = jacobiMetric(P, terms, s);  // stage 1
   const double reach = kReach * reachScale(lo, hi, c, L, terms.curvature);
-  Iterates v{s.inverse_diagonal.head(k), s.gradient.head(k), s.y.head(k),           s.x_previous.head(k),
-             s.x_change.head(k),         s.Px.head(k),       s.Px_previous.head(k), s.Py.head(k)};
   v.y = x;
   v.x_previous = x;
   v.Px.noalias() = P * x;
@@ -195,6 +229,15 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
       break;
     }
     v.Px.noalias() = P * x;
+    if (followLinear(P, c, lo, hi, terms, tolerance, x, v, report)) {  // stage 3a: restart from there
+      t = 1.0;
+      v.y = x;
+      v.Py = v.Px;
+      v.x_previous = x;
+      v.Px_previous = v.Px;
+      continue;
+    }
+    if (report.unbounded) break;
     if (kktAt(v.Px, c, lo, hi, x, v.inverse_d) <= tolerance) {  // stage 3: optimal to the tolerance
       report.converged = true;
       ++report.iterations;  // count this gradient step

@@ -152,9 +152,16 @@ TEST_CASE("resized workspace results: the solves refuse them, naming the result"
   // H with the model's rows but too few columns: the CRBA would write past it.
   ws.H.resize(7, 3);
   const Status s = jointSpaceInertia(model, x.q, ws);
-  CHECK(s.code == StatusCode::ModelMismatch);
+  CHECK(s.code == StatusCode::SizeMismatch);
+  CHECK(std::string(s.message) == "workspace result H is 7x3, expected 7x7" + keep);
   ws.H.setZero(7, 7);
   CHECK(jointSpaceInertia(model, x.q, ws));
+  ws.tau.resize(2);
+  const Status t = inverseDynamics(model, task, x.q, x.qd, x.qd, ws);
+  CHECK(t.code == StatusCode::SizeMismatch);
+  CHECK(std::string(t.message) == "workspace result tau has 2 entries, expected nv = 7" + keep);
+  ws.tau.setZero(7);
+  CHECK(inverseDynamics(model, task, x.q, x.qd, x.qd, ws));
 }
 
 TEST_CASE("kinematics queries: what the workspace does not hold is NotComputed", "[accessors]") {

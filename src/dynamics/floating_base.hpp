@@ -128,7 +128,8 @@ inline Status checkVelocityVector(const Model& model, const char* name, const Ve
 inline bool workspaceFitsBase(const Model& model, const Workspace& ws) {
   return ws.tau.size() == model.nv() && ws.H.rows() == model.nv() && ws.H.cols() == model.nv();
 }
-// The ModelMismatch status for a workspace that does not fit (names both nv).
+// The ModelMismatch status for a workspace that does not fit (names both nv),
+// or SizeMismatch for a workspace that fits whose H or τ a user resized.
 Status workspaceBaseMismatch(const Model& model, const Workspace& ws);
 
 }  // namespace zwang::internal

@@ -24,22 +24,34 @@ namespace zwang {
 // pass checkConfiguration (nq() entries, finite, a free base's quaternion unit
 // to 1e-6); q̇ has nv() finite entries. On an error the output parameter is
 // left unchanged.
+//
+// framePose, frameVelocity and frameAcceleration read what the last call that
+// computes kinematics left in the workspace (Workspace::kinematics, whose
+// comment lists what each call leaves), for the same Model object. Asked for
+// more than that call computed, they return NotComputed naming what to call
+// first, e.g. "frameAcceleration: the workspace holds poses and velocities
+// only (the last call computed no accelerations); call solveHybridDynamics,
+// solveWithFriction or inverseDynamics first". They do not compare states:
+// the results are those of the q (q̇, q̈) of that last call.
 
 /// Poses (and velocities when qd is given) of every body into the workspace:
-/// q has nq() entries, qd nv() (or none: every body at rest).
+/// q has nq() entries, qd nv(). Without qd the workspace holds poses only
+/// (frameVelocity is then NotComputed; it does not read the state as at rest).
 Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd = Eigen::VectorXd()) noexcept;
 
-/// After forwardKinematics (or a solve): the frame's pose in the world.
+/// After forwardKinematics, frameJacobian, jointSpaceInertia, inverseDynamics
+/// or a solve: the frame's pose in the world.
 Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isometry3d& pose) noexcept;
-/// After forwardKinematics with qd (or a solve): the frame's velocity.
+/// After forwardKinematics with qd, inverseDynamics or a solve: the frame's velocity.
 Status frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed, Vec6& velocity) noexcept;
-/// After a solve or inverseDynamics: the frame's true classical acceleration
-/// (gravity's shift of the sweep removed).
+/// After a solve (solveHybridDynamics, solveWithFriction) or inverseDynamics:
+/// the frame's true classical acceleration (gravity's shift of the sweep removed).
 Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept;
 
-/// J (6 × nv()) with frameVelocity = J q̇. Runs forwardKinematics(q) itself.
+/// J (6 × nv()) with frameVelocity = J q̇. Runs forwardKinematics(q) itself:
+/// afterwards the workspace holds the poses at q only.
 /// A floating base's columns come first, in the user's velocity coordinates:
 /// d(frame velocity)/d v_base, for a free base v_B = [v; ω] in base axes, for
 /// a planar one [ẋ, ẏ, ψ̇] in the plane's axes; then one column per joint, zero

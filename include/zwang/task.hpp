@@ -114,7 +114,11 @@ class Task {
   /// The same, with the frame given by name (ModelError for an unknown name).
   int addWrench(const std::string& frame, Expressed expressed = Expressed::Local);
 
-  /// Set points b (true accelerations, gravity is handled inside). Set them freely.
+  /// Set points b (true accelerations, gravity is handled inside), one per
+  /// constraint row. Set their values freely (`targets() << …`, `setZero()`,
+  /// `segment(row, n) = …`); their size is the task's: a solve refuses b of
+  /// any other length (SizeMismatch "constraint targets b has 3 entries, the
+  /// task has 6 constraint rows"), and so does adding a constraint (ModelError).
   Eigen::VectorXd& targets() { return b_; }
   /// Set points b, read-only.
   const Eigen::VectorXd& targets() const { return b_; }
@@ -123,8 +127,9 @@ class Task {
   /// Wrench `index`, read-only.
   const Vec6& wrench(int index) const { return wrenches_.at(static_cast<std::size_t>(index)).value; }
 
-  /// Number of constraint rows m (the length of b and ν).
-  int constraintRows() const { return static_cast<int>(b_.size()); }
+  /// Number of constraint rows m (the length of b and ν), counted as the
+  /// constraints are added (not read from b, whose size a user could change).
+  int constraintRows() const { return rows_; }
   /// Internal rows the model's mimic joints add, q̈_m − a·q̈_leader = 0, one per
   /// mimic joint (Model::mimicJoints), after the user's rows in the balance.
   int mimicRows() const { return mimic_rows_; }
@@ -223,6 +228,8 @@ class Task {
   std::vector<int> mimic_joint_of_row_;
   std::vector<AppliedWrench> wrenches_;
   Eigen::VectorXd b_;
+  int rows_ = 0;  // the constraint rows added; b_ must keep this size
+  void growTargets(int rows);
   void addMimicRows(const Model& model);
   void reorder();
 };

@@ -108,6 +108,33 @@ struct Solution {
   // frameAcceleration() (kinematics.hpp), so a solve does not pay for it.
 };
 
+/// How far the kinematic results in a workspace go (Workspace::kinematics):
+/// each stage includes the ones before it.
+enum class KinematicsStage {
+  None,           ///< nothing: a fresh workspace, or the last call failed before computing any
+  Poses,          ///< poses (Xworld, S): framePose
+  Velocities,     ///< and velocities (v, c): frameVelocity
+  Accelerations,  ///< and accelerations (a): frameAcceleration
+};
+
+/// What the kinematic members of a workspace hold: the results of the last
+/// call that computes kinematics, as far as it got, for the model it was
+/// given. After each call:
+///   forwardKinematics(q)                     Poses
+///   forwardKinematics(q, qd)                 Velocities
+///   frameJacobian, jointSpaceInertia         Poses (their q; velocities are not computed)
+///   inverseDynamics                          Accelerations (of its q̈)
+///   solveHybridDynamics, solveWithFriction   Accelerations (of the solution; also when
+///                                            solveWithFriction returns Infeasible)
+/// A call that returns an error holds what it completed: None when it failed
+/// its input checks, Velocities when a solve stopped at Degenerate. The
+/// queries of kinematics.hpp return StatusCode::NotComputed for anything
+/// beyond the stage held, or for a model other than `model`.
+struct KinematicsHeld {
+  KinematicsStage stage = KinematicsStage::None;  ///< how far the results go
+  const Model* model = nullptr;                   ///< the model they were computed for (compared by address)
+};
+
 /// All scratch memory of the algorithms, and the results of the last call: see the file comment.
 class Workspace {
  public:
@@ -132,8 +159,16 @@ class Workspace {
   /// each side, and four per mimic row (each joint's body and its parent).
   int columnCapacity() const { return 2 * capacity_ + 4 * mimic_rows_; }
 
-  Solution solution;        ///< the results of the last solve
-  FrictionResult friction;  ///< filled by solveWithFriction
+  /// The results of the last solve. Read or overwrite the values; keep the
+  /// sizes (a solve refuses a result vector of another size: SizeMismatch).
+  Solution solution;
+  FrictionResult friction;  ///< filled by solveWithFriction (the same rule for its sizes)
+  /// What the kinematic members below (Xworld, S, v, c, a) hold (KinematicsHeld);
+  /// set by the calls that compute them, read by the queries of kinematics.hpp.
+  KinematicsHeld kinematics;
+
+  // Everything below is the algorithms' memory, sized once by the constructor:
+  // read it, but do not resize it (a solve does not check these sizes).
 
   // Every spatial quantity below is in BASE coordinates: world axes, referred
   // to the world origin (docs/solver.md, "Coordinates"). Algorithm 1's

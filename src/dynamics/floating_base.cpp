@@ -296,6 +296,16 @@ Status checkFloatingVelocityVector(const Model& model, const char* name, const V
 }
 
 Status workspaceBaseMismatch(const Model& model, const Workspace& ws) {
+  // One of the two of the right size: the workspace fits, the other was resized since.
+  if (ws.tau.size() == model.nv())
+    return Status::error(StatusCode::SizeMismatch,
+                         "workspace result H is %ldx%ld, expected %dx%d (a workspace's results must keep their sizes)",
+                         static_cast<long>(ws.H.rows()), static_cast<long>(ws.H.cols()), model.nv(), model.nv());
+  if (ws.H.rows() == model.nv() && ws.H.cols() == model.nv())
+    return Status::error(StatusCode::SizeMismatch,
+                         "workspace result tau has %ld entries, expected nv = %d (a workspace's results must keep "
+                         "their sizes)",
+                         static_cast<long>(ws.tau.size()), model.nv());
   return Status::error(StatusCode::ModelMismatch,
                        "workspace was made for a model with nv = %ld, this one has nv = %d (a %s base and %d joints)",
                        static_cast<long>(ws.tau.size()), model.nv(), toString(model.baseType()), model.dof());

@@ -126,9 +126,10 @@ inline Status checkVelocityVector(const Model& model, const char* name, const Ve
 // and τ are nv × nv and nv) must be refused before anything is written:
 // Workspace::dof() alone cannot tell a fixed arm from the same arm floating.
 inline bool workspaceFitsBase(const Model& model, const Workspace& ws) {
-  return ws.tau.size() == model.nv() && ws.H.rows() == model.nv();
+  return ws.tau.size() == model.nv() && ws.H.rows() == model.nv() && ws.H.cols() == model.nv();
 }
-// The ModelMismatch status for a workspace that does not fit (names both nv).
+// The ModelMismatch status for a workspace that does not fit (names both nv),
+// or SizeMismatch for a workspace that fits whose H or τ a user resized.
 Status workspaceBaseMismatch(const Model& model, const Workspace& ws);
 
 }  // namespace zwang::internal

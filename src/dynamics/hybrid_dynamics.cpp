@@ -11,6 +11,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
                            const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
                            Workspace& ws) noexcept {
   using namespace internal;
+  ws.kinematics.stage = KinematicsStage::None;  // until the sweeps below compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   Solution& out = ws.solution;
   jointsOutsideLimits(model, q, out);                              // a warning: solved as given
@@ -18,6 +19,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   if (Status s = inwardSweep(model, task, tau, ws); !s) return s;  // lines 11–22
   balance(task, ws);                                               // lines 23–25
   outwardAccelerations(model, task, ws, out.qdd);                  // lines 26–30
+  ws.kinematics.stage = KinematicsStage::Accelerations;
   if (model.hasFloatingBase()) out.base_acceleration_world = baseClassicalAcceleration(task, ws);
   taskResidual(task, ws);  // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);

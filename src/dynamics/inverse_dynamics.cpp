@@ -15,6 +15,7 @@ namespace zwang {
 Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q_all,
                        const Eigen::Ref<const Eigen::VectorXd>& qd_all,
                        const Eigen::Ref<const Eigen::VectorXd>& qdd_all, Workspace& ws) noexcept {
+  ws.kinematics.stage = KinematicsStage::None;  // until the outward stage computes them
   if (ws.dof() != model.dof() || task.modelDof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace or task was made for another model");
   if (!internal::workspaceFitsBase(model, ws)) return internal::workspaceBaseMismatch(model, ws);
@@ -50,6 +51,7 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
     a_previous = a;
     ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);
   }
+  ws.kinematics = {KinematicsStage::Accelerations, &model};
   internal::applyExternalWrenches(model, task, ws);  // a floating base's own wrenches too
   for (int i = floating ? 0 : 1; i <= N; ++i) ws.f[at(i)] = ws.I[at(i)] * ws.a[at(i)] + ws.Fbias[at(i)];
 
@@ -89,6 +91,7 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
   // Outward: poses, motion subspaces and inertias (no velocity: H depends on q only).
   if (kFloating) internal::baseKinematics(model, q_all.head(nqb), q_all.head(0), ws, true);
   internal::outwardKinematics(model, q_all.tail(N), Eigen::VectorXd(), ws, true);
+  ws.kinematics = {KinematicsStage::Poses, &model};  // the velocities are left at rest, not the state's
   // The base's columns in the user's coordinates (6 × k; none for a fixed base).
   Matrix6Xmax S_base;
   if (kFloating) internal::baseMotionColumns(model, ws, S_base);
@@ -121,6 +124,7 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
 }  // namespace
 
 Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) noexcept {
+  ws.kinematics.stage = KinematicsStage::None;  // until the outward stage computes the poses
   if (ws.dof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
                          model.dof());

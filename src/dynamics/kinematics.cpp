@@ -63,10 +63,35 @@ Status checkFrame(const Model& model, int frame) noexcept {
   return {};
 }
 
-// Both, for the accessors that read a workspace after forwardKinematics or a solve.
-Status checkFrameAndWorkspace(const Model& model, const Workspace& ws, int frame) noexcept {
+// What each stage is, and which calls compute it, for the messages below.
+const char* const kStageNames[] = {"nothing", "poses", "velocities", "accelerations"};
+const char* const kStageCalls[] = {"", "forwardKinematics or a solve", "forwardKinematics with qd, or a solve",
+                                   "solveHybridDynamics, solveWithFriction or inverseDynamics"};
+
+// Both, and that the workspace holds the `needed` results for this model
+// (Workspace::kinematics), for the queries that read a workspace after the
+// call that computed them.
+Status checkQuery(const Model& model, const Workspace& ws, int frame, KinematicsStage needed,
+                  const char* query) noexcept {
   if (Status s = checkFrame(model, frame); !s) return s;
-  return checkWorkspace(model, ws);
+  if (Status s = checkWorkspace(model, ws); !s) return s;
+  const auto need = static_cast<int>(needed);
+  if (ws.kinematics.stage == KinematicsStage::None)
+    return Status::error(StatusCode::NotComputed,
+                         "%s: the workspace holds no kinematics (none computed yet, or the last call failed); "
+                         "call %s first",
+                         query, kStageCalls[need]);
+  if (ws.kinematics.model != &model)
+    return Status::error(StatusCode::NotComputed,
+                         "%s: the workspace's kinematics were computed for another Model object; call %s with this "
+                         "model first",
+                         query, kStageCalls[need]);
+  if (ws.kinematics.stage < needed)
+    return Status::error(StatusCode::NotComputed,
+                         "%s: the workspace holds %s only (the last call computed no %s); call %s first", query,
+                         ws.kinematics.stage == KinematicsStage::Poses ? "poses" : "poses and velocities",
+                         kStageNames[need], kStageCalls[need]);
+  return {};
 }
 
 // A classical [linear of the frame origin; angular] 6-vector in world axes,
@@ -113,12 +138,16 @@ void jacobianColumns(const Model& model, const Workspace& ws, int frame, Express
 
 Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
+  ws.kinematics.stage = KinematicsStage::None;  // until computed below
   if (Status s = checkWorkspace(model, ws); !s) return s;
   if (Status s = internal::checkStateConfiguration(model, q); !s) return s;  // a free base's quaternion too
   if (qd.size() != 0)
     if (Status s = internal::checkVelocityVector(model, "qd", qd); !s) return s;
+  ws.kinematics.model = &model;
+  const KinematicsStage held = qd.size() != 0 ? KinematicsStage::Velocities : KinematicsStage::Poses;
   if (!model.hasFloatingBase()) {  // the joints' vectors are the whole state
     internal::outwardKinematics(model, q, qd, ws, false);
+    ws.kinematics.stage = held;
     return {};
   }
   // The base joint first (its pose and velocity are every body's start), then the joints.
@@ -126,11 +155,12 @@ Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<con
   const bool moving = qd.size() == model.nv();
   internal::baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, false);
   internal::outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, false);
+  ws.kinematics.stage = held;
   return {};
 }
 
 Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isometry3d& pose) noexcept {
-  if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
+  if (Status s = checkQuery(model, ws, frame, KinematicsStage::Poses, "framePose"); !s) return s;
   const Transform X = internal::framePlacementInBase(model, ws, frame);  // ᶠX_0
   pose.setIdentity();
   pose.linear() = X.E.transpose();
@@ -139,7 +169,7 @@ Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isom
 }
 
 Status frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed, Vec6& velocity) noexcept {
-  if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
+  if (Status s = checkQuery(model, ws, frame, KinematicsStage::Velocities, "frameVelocity"); !s) return s;
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   // Ẋ of the frame's body (a floating base's motion included), seen at the frame origin.
   velocity = express(X, expressed, velocityAtPoint(ws.v[static_cast<std::size_t>(model.frame(frame).body)], X.r));
@@ -148,7 +178,7 @@ Status frameVelocity(const Model& model, const Workspace& ws, int frame, Express
 
 Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept {
-  if (Status s = checkFrameAndWorkspace(model, ws, frame); !s) return s;
+  if (Status s = checkQuery(model, ws, frame, KinematicsStage::Accelerations, "frameAcceleration"); !s) return s;
   // ws.a holds the sweep's accelerations, true + [−g; 0] (= ws.a_world).
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   const auto b = static_cast<std::size_t>(model.frame(frame).body);
@@ -158,6 +188,7 @@ Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Exp
 
 Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q, int frame,
                      Expressed expressed, Eigen::Ref<Eigen::MatrixXd> J) noexcept {
+  ws.kinematics.stage = KinematicsStage::None;  // until forwardKinematics below computes the poses
   if (J.rows() != 6 || J.cols() != model.nv()) {
     if (!model.hasFloatingBase())
       return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",

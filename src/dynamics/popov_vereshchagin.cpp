@@ -74,6 +74,23 @@ Status checkMimicState(const Model& model, const VectorRef& q_all, const VectorR
   }
   return {};
 }
+
+// The results a solve writes in place: public vectors a user could resize
+// (or swap out), which the solve would then write past.
+Status checkSolutionSizes(const Model& model, const Solution& out) {
+  const struct {
+    const char* name;
+    Eigen::Index size;
+  } results[] = {
+      {"qdd", out.qdd.size()}, {"tau_constraint", out.tau_constraint.size()}, {"tau_control", out.tau_control.size()}};
+  for (const auto& r : results)
+    if (r.size != model.nv())
+      return Status::error(StatusCode::SizeMismatch,
+                           "workspace result solution.%s has %ld entries, expected nv = %d (a workspace's results "
+                           "must keep their sizes)",
+                           r.name, static_cast<long>(r.size), model.nv());
+  return {};
+}
 }  // namespace
 
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
@@ -93,6 +110,7 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
   if (!workspaceFitsBase(model, ws)) return workspaceBaseMismatch(model, ws);
   if (Status s = checkVelocityVector(model, "qd", qd); !s) return s;
   if (Status s = checkVelocityVector(model, "tau", tau); !s) return s;
+  if (Status s = checkSolutionSizes(model, ws.solution); !s) return s;
   if (task.balanceRows() > ws.balanceCapacity())  // a workspace made for a model with fewer mimic joints
     return Status::error(StatusCode::WorkspaceTooSmall,
                          "task has %d balance rows (%d constraint, %d mimic), the workspace was made for at most %d",
@@ -103,6 +121,11 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
                          task.mimicRows(), static_cast<int>(model.mimicJoints().size()));
   if (Status s = checkMimicState(model, q, qd); !s) return s;
   if (Status s = checkFinite("gravity", task.gravity); !s) return s;
+  if (task.targets().size() != task.constraintRows())  // Task::targets() is a resizable VectorXd&
+    return Status::error(StatusCode::SizeMismatch,
+                         "constraint targets b has %ld entries, the task has %d constraint rows (Task::targets() "
+                         "must keep its size)",
+                         static_cast<long>(task.targets().size()), task.constraintRows());
   if (Status s = checkFinite("constraint targets b", task.targets()); !s) return s;
   for (int w = 0; w < task.wrenchCount(); ++w)
     if (!task.wrench(w).allFinite())
@@ -214,6 +237,7 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
   const bool floating = model.hasFloatingBase();
   if (floating) baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, true);  // lines 3–6, base
   outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, true);                 // lines 3–6
+  ws.kinematics = {moving ? KinematicsStage::Velocities : KinematicsStage::Poses, &model};
   for (int i = floating ? 0 : 1; i <= n; ++i)
     ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);  // line 7, without F_ext
   applyExternalWrenches(model, task, ws);                                           // line 7: − F_ext

@@ -72,6 +72,34 @@ Status checkOptions(const Model& model, const FrictionOptions& o) {
   return {};
 }
 
+// The friction results a solve writes in place: public vectors a user could
+// resize (or swap out), which the solve would then write past (or, for the
+// stuck set, grow by allocating).
+Status checkFrictionResultSizes(const Model& model, const FrictionResult& fr) {
+  const int n = model.dof();
+  const struct {
+    const char* name;
+    const char* unit;
+    Eigen::Index size, expected;
+  } results[] = {{"mu", "entries", fr.mu.size(), n},
+                 {"tau_friction", "entries", fr.tau_friction.size(), n},
+                 {"state", "entries", static_cast<Eigen::Index>(fr.state.size()), n},
+                 {"dqdd_dmu", "rows", fr.dqdd_dmu.rows(), model.nv()},
+                 {"dqdd_dmu", "columns", fr.dqdd_dmu.cols(), n}};
+  for (const auto& r : results)
+    if (r.size != r.expected)
+      return Status::error(StatusCode::SizeMismatch,
+                           "workspace result friction.%s has %ld %s, expected %ld (a workspace's results must keep "
+                           "their sizes)",
+                           r.name, static_cast<long>(r.size), r.unit, static_cast<long>(r.expected));
+  if (fr.stuck.capacity() < static_cast<std::size_t>(n))
+    return Status::error(StatusCode::SizeMismatch,
+                         "workspace result friction.stuck has room for %ld joints, expected %d (a workspace's "
+                         "results must keep their sizes)",
+                         static_cast<long>(fr.stuck.capacity()), n);
+  return {};
+}
+
 // ---- The model of friction: f, f_c, b per joint; the stuck set Θ₀ and its
 // box Λ (a joint on a position limit gets an unbounded side: the stop pushes);
 // kinetic and viscous friction of the moving joints folded into τ.
@@ -365,8 +393,10 @@ Status limitInfeasible(const Model& model, const QpReport& report, const std::ve
 Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
                          Workspace& ws, const FrictionOptions& options) noexcept {
+  ws.kinematics.stage = KinematicsStage::None;  // until the sweeps compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   if (Status s = checkOptions(model, options); !s) return s;
+  if (Status s = checkFrictionResultSizes(model, ws.friction); !s) return s;
   const int m = task.solverColumns();
   FrictionScratch& fs = ws.frictionScratch();
   FrictionResult& fr = ws.friction;
@@ -407,6 +437,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   }
 
   motionAtMaximiser(model, task, k, ws, fs);
+  ws.kinematics.stage = KinematicsStage::Accelerations;  // those of q̈* (the sweep's were q̈(0)'s)
   if (model.hasFloatingBase()) out.base_acceleration_world = baseClassicalAcceleration(task, ws);
   taskResidual(task, ws);
   publishNu(task, ws);

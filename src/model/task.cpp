@@ -87,12 +87,22 @@ int Task::addConstraint(int frame, const ConstraintMatrix& A, Expressed expresse
     throw ModelError("task: constraint matrix on frame '" + frame_names_[static_cast<std::size_t>(frame)] +
                      "' is not finite");
   const int first = constraintRows();
+  growTargets(static_cast<int>(A.cols()));  // first: it may refuse, and the task stays as it was
   groups_.push_back(ConstraintGroup{frame, frame_bodies_[static_cast<std::size_t>(frame)], expressed, first,
                                     static_cast<int>(A.cols()), A});
-  b_.conservativeResize(first + A.cols());
-  b_.tail(A.cols()).setZero();
   reorder();
   return first;
+}
+
+void Task::growTargets(int rows) {
+  // A b whose size the user changed would leave rows without a defined set
+  // point (or shift them): refuse it here as the solve does.
+  if (b_.size() != rows_)
+    throw ModelError("task: constraint targets b has " + std::to_string(b_.size()) + " entries, the task has " +
+                     std::to_string(rows_) + " constraint rows (Task::targets() must keep its size)");
+  b_.conservativeResize(rows_ + rows);
+  b_.tail(rows).setZero();
+  rows_ += rows;
 }
 
 int Task::addConstraint(const std::string& frame, const ConstraintMatrix& A, Expressed expressed) {
@@ -127,6 +137,7 @@ int Task::addJointConstraint(int joint) {
     throw ModelError("task: joint index " + std::to_string(joint) + " out of range (the model has " +
                      std::to_string(dof_) + " joints)");
   const int row = constraintRows();
+  growTargets(1);  // first: it may refuse, and the task stays as it was
   for (const bool parent_side : {false, true}) {
     const int body = parent_side ? joint_bodies_parent_[static_cast<std::size_t>(joint)] : joint + 1;
     ConstraintGroup g{body_frames_[static_cast<std::size_t>(body)], body, Expressed::World, row, 1, ConstraintMatrix()};
@@ -135,8 +146,6 @@ int Task::addJointConstraint(int joint) {
     g.coefficient = 1.0;
     groups_.push_back(g);
   }
-  b_.conservativeResize(row + 1);
-  b_[row] = 0.0;
   reorder();
   return row;
 }

@@ -34,6 +34,7 @@ const char* codeName(StatusCode code) {
     case StatusCode::Infeasible: return "Infeasible";
     case StatusCode::MimicMismatch: return "MimicMismatch";
     case StatusCode::BadConfiguration: return "BadConfiguration";
+    case StatusCode::NotComputed: return "NotComputed";
   }
   return "Unknown";
 }

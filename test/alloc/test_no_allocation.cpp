@@ -241,8 +241,10 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
   Task task(model);
   task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
   task.addConstraint("panda_link4", ConstraintMatrix::Identity(6, 1));
-  Workspace ws(model, task), small(model, 3), foreign(other, 6);
+  Workspace ws(model, task), small(model, 3), foreign(other, 6), fresh(model, 0);
   const Task foreign_task(other);
+  Task resized = task;
+  resized.targets().resize(3);  // b no longer the task's 7 rows
   const Eigen::VectorXd ok7 = Eigen::VectorXd::Constant(7, 0.1), short3 = Eigen::VectorXd::Zero(3);
   Eigen::VectorXd nan7 = ok7;
   nan7[4] = std::nan("");
@@ -285,6 +287,10 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
     codes[n++] = frameAcceleration(model, ws, -1, Expressed::World, out).code;      // ModelMismatch (frame)
     codes[n++] = frameAcceleration(model, ws, frames, Expressed::Local, out).code;  // ModelMismatch (frame)
     codes[n++] = frameAcceleration(model, foreign, 1, Expressed::World, out).code;  // ModelMismatch (workspace)
+    codes[n++] = solveHybridDynamics(model, resized, ok7, ok7, ok7, ws).code;       // SizeMismatch (targets)
+    codes[n++] = framePose(model, fresh, 1, pose).code;                             // NotComputed
+    codes[n++] = frameVelocity(model, fresh, 1, Expressed::Local, out).code;        // NotComputed
+    codes[n++] = frameAcceleration(model, fresh, 1, Expressed::World, out).code;    // NotComputed
   });
   CHECK(count == 0);
   const StatusCode expected[] = {
@@ -294,7 +300,8 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
       StatusCode::ModelMismatch, StatusCode::SizeMismatch,  StatusCode::NonFinite,         StatusCode::ModelMismatch,
       StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,     StatusCode::ModelMismatch,
       StatusCode::ModelMismatch, StatusCode::ModelMismatch, StatusCode::ModelMismatch,     StatusCode::ModelMismatch,
-      StatusCode::ModelMismatch};
+      StatusCode::ModelMismatch, StatusCode::SizeMismatch,  StatusCode::NotComputed,       StatusCode::NotComputed,
+      StatusCode::NotComputed};
   REQUIRE(n == static_cast<int>(sizeof expected / sizeof expected[0]));
   for (int k = 0; k < n; ++k) {
     INFO("call " << k);

@@ -106,6 +106,27 @@ def test_unknown_frames_and_joints(panda, ws):
     assert solve(panda, ws).qdd.shape == (7,)
 
 
+def test_frame_pose_of_the_last_kinematics_needs_some(panda, ws):
+    # q=None reads what the workspace holds: nothing yet is NotComputed (the
+    # C++ Status, issue #24), not a meaningless pose.
+    with pytest.raises(zwang.SolveError) as e:
+        zwang.frame_pose(panda, ws, None, "tool0")
+    assert e.value.code == "NotComputed"
+    assert e.value.status_message.startswith("framePose: the workspace holds no kinematics")
+    # A call that fails computes nothing either.
+    zwang.forward_kinematics(panda, ws, READY)
+    with pytest.raises(zwang.SolveError):
+        zwang.forward_kinematics(panda, ws, np.full(7, np.nan))
+    with pytest.raises(zwang.SolveError, match="NotComputed|holds no kinematics"):
+        zwang.frame_pose(panda, ws, None, "tool0")
+    # After kinematics or a solve: the pose at that q.
+    zwang.forward_kinematics(panda, ws, READY)
+    expected = zwang.frame_pose(panda, panda.workspace(), READY, "tool0")
+    np.testing.assert_array_equal(zwang.frame_pose(panda, ws, None, "tool0"), expected)
+    solve(panda, ws)
+    np.testing.assert_array_equal(zwang.frame_pose(panda, ws, None, "tool0"), expected)
+
+
 def test_bad_constraints_wrenches_and_options(panda, ws):
     with pytest.raises(ValueError, match=r"6×m matrix"):
         zwang.Constraint("tool0", np.eye(5))

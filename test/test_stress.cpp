@@ -8,9 +8,9 @@
 // Every result must be finite (or a documented error status), the friction
 // maximiser must stop within its cap, and the results must satisfy their
 // optimality conditions, measured as relative residuals (backward errors):
-//   closure     ‖ID(q̈) − τ_ctrl − τ_friction‖∞ / (‖H‖∞‖q̈‖∞ + ‖C‖∞ + ‖τ_ctrl‖∞ + ‖τ_friction‖∞)
+//   closure     ‖ID(q̈) − τ_ctrl − τ_friction‖∞ / (‖H‖∞‖q̈‖∞ + ‖C‖∞ + ‖H‖∞‖q̇‖∞² + ‖τ_ctrl‖∞ + ‖τ_friction‖∞)
 //               (the free arm driven by the solver's torques accelerates with q̈);
-//   constraint  ‖G q̈ − γ‖∞ / (‖G‖∞‖q̈‖∞ + ‖γ‖∞), G and γ from the independent dense
+//   constraint  ‖G q̈ − γ‖∞ / (‖G‖∞(‖q̈‖∞ + ‖H⁻¹Gᵀν‖∞) + ‖γ‖∞), G and γ from the independent dense
 //               reference (only when the coupling matrix is regular: a singular task
 //               holds in the least-squares sense, test_singular);
 //   τ_c         ‖τ_c − Gᵀν‖∞ / (‖G‖∞‖ν‖∞ + ‖τ_c‖∞) (the constraint torques are the

@@ -8,9 +8,9 @@
 // Every result must be finite (or a documented error status), the friction
 // maximiser must stop within its cap, and the results must satisfy their
 // optimality conditions, measured as relative residuals (backward errors):
-//   closure     ‖ID(q̈) − τ_ctrl − τ_friction‖∞ / (‖H‖∞‖q̈‖∞ + ‖C‖∞ + ‖τ_ctrl‖∞ + ‖τ_friction‖∞)
+//   closure     ‖ID(q̈) − τ_ctrl − τ_friction‖∞ / (‖H‖∞‖q̈‖∞ + ‖C‖∞ + ‖H‖∞‖q̇‖∞² + ‖τ_ctrl‖∞ + ‖τ_friction‖∞)
 //               (the free arm driven by the solver's torques accelerates with q̈);
-//   constraint  ‖G q̈ − γ‖∞ / (‖G‖∞‖q̈‖∞ + ‖γ‖∞), G and γ from the independent dense
+//   constraint  ‖G q̈ − γ‖∞ / (‖G‖∞(‖q̈‖∞ + ‖H⁻¹Gᵀν‖∞) + ‖γ‖∞), G and γ from the independent dense
 //               reference (only when the coupling matrix is regular: a singular task
 //               holds in the least-squares sense, test_singular);
 //   τ_c         ‖τ_c − Gᵀν‖∞ / (‖G‖∞‖ν‖∞ + ‖τ_c‖∞) (the constraint torques are the
@@ -206,11 +206,20 @@ Residuals residuals(const Model& model, const Task& task, const DynamicsInput& i
   // (‖G‖∞‖ν‖∞ too: τ_control holds Gᵀν, whose rounding is ε‖G‖‖ν‖ even when
   // it cancels to a small torque, as on a damped singular task with large ν.)
   const double constraint_forces = task.constraintRows() > 0 ? inf(dense.G) * inf(s.nu) : 0.0;
-  r.closure = ratio(inf(Eigen::VectorXd(id - s.tau_control - tau_friction)),
-                    inf(H) * inf(s.qdd) + inf(C) + inf(s.tau_control) + inf(tau_friction) + constraint_forces);
+  // (‖H‖∞‖q̇‖∞² too: the velocity-product terms of C are of that size and cancel
+  // — a single joint spinning about its own axis has C = 0 from terms of 1e9 —
+  // so C and q̈ carry their rounding even when ‖C‖ is tiny.)
+  const double velocity_terms = inf(H) * inf(in.qd) * inf(in.qd);
+  r.closure =
+      ratio(inf(Eigen::VectorXd(id - s.tau_control - tau_friction)),
+            inf(H) * inf(s.qdd) + inf(C) + velocity_terms + inf(s.tau_control) + inf(tau_friction) + constraint_forces);
   if (task.constraintRows() > 0) {
-    r.constraint =
-        ratio(inf(Eigen::VectorXd(dense.G * s.qdd - dense.gamma)), inf(dense.G) * inf(s.qdd) + inf(dense.gamma));
+    // (‖G‖∞‖H⁻¹Gᵀν‖∞ too: q̈ is the free acceleration plus the constraint forces'
+    // H⁻¹Gᵀν, which cancel to the small q̈ a light joint is held to, against
+    // kinetic friction of up to 1e4 N·m, so G q̈ carries their rounding.)
+    const Eigen::VectorXd held = H.ldlt().solve(Eigen::VectorXd(dense.G.transpose() * s.nu));
+    r.constraint = ratio(inf(Eigen::VectorXd(dense.G * s.qdd - dense.gamma)),
+                         inf(dense.G) * (inf(s.qdd) + inf(held)) + inf(dense.gamma));
     const Eigen::MatrixXd Gt = dense.G.transpose();
     r.tau_c = ratio(inf(Eigen::VectorXd(s.tau_constraint - Gt * s.nu)), inf(Gt) * inf(s.nu) + inf(s.tau_constraint));
   }
@@ -281,7 +290,11 @@ void runStress(unsigned long long seed, const std::vector<Draw>& only = {}) {
       REQUIRE(finiteSolution(ws.solution));
       const bool singular = ws.solution.balance.singular;
       const double condition = ws.solution.balance.condition;
-      INFO("balance condition " << condition);
+      INFO("balance condition " << condition << ", rank " << ws.solution.balance.rank << ", damping "
+                                << ws.solution.balance.damping << "\nnu " << ws.solution.nu.transpose() << "\nqdd "
+                                << ws.solution.qdd.transpose() << "\ntau_control "
+                                << ws.solution.tau_control.transpose());
+      CHECK(!std::isnan(condition));  // ∞ when singular, never NaN
       if (kind == TaskKind::RepeatedRow || kind == TaskKind::OnBase || kind == TaskKind::NearSingular ||
           (kind == TaskKind::OverConstrained && n < 6))
         CHECK(singular);
@@ -450,6 +463,37 @@ TEST_CASE("numerical stress: the draws of seeds 2 to 60 whose projected-gradient
   }
 }
 
+TEST_CASE("numerical stress: the draws of seeds 34, 96 and 97 that reported a NaN condition or missed closure") {
+  // 34/80 (4 rows) and 97/118 (1 row on the base) constrain a 1-dof chain
+  // along directions its joint cannot move: every row was zeroed, every σ̃ = 0,
+  // and the condition √(Σσ̃² Σσ̃⁻²) was 0·∞ = NaN. They and 96/3 (no rows) also
+  // missed closure by 6e-5, 2.9e-3 and 4.5e-4: a joint spinning about its own
+  // axis has C = 0 from velocity terms of up to 7e9 N·m, which left the
+  // rounding of C (4.8e-7, 1.3e-23, 2.6e-26) over a denominator of ‖C‖ alone.
+  runStress(34, {{80, 0}});
+  runStress(96, {{3, 0}});
+  runStress(97, {{118, 0}});
+}
+
+TEST_CASE("numerical stress: the draws of seeds 14 to 119 whose constraint residual counted no cancelled forces") {
+  // Regular tasks (condition 1 .. 1e3) on light joints with kinetic friction:
+  // the constraint forces H⁻¹Gᵀν (up to 1.9e12 rad/s² on 1e-10 kg·m² at
+  // 119/78) cancel the free acceleration to the small q̈ the row holds, so
+  // G q̈ − γ carries ε of them (1.2e-4 there, 9e-17 of ‖G‖‖H⁻¹Gᵀν‖) and missed
+  // 1e-6 of ‖G‖‖q̈‖ + ‖γ‖ (1.6e-6 .. 2.4e-5) while closure held to 1e-9.
+  const struct {
+    unsigned long long seed;
+    std::vector<Draw> draws;
+  } failed[] = {
+      {14, {{123, 1}}}, {16, {{41, 4}}}, {17, {{4, 1}}},   {20, {{139, 1}}}, {38, {{101, 0}}}, {52, {{54, 5}}},
+      {60, {{85, 3}}},  {72, {{55, 2}}}, {90, {{140, 3}}}, {91, {{37, 5}}},  {119, {{78, 0}}},
+  };
+  for (const auto& f : failed) {
+    INFO("seed " << f.seed);
+    runStress(f.seed, f.draws);
+  }
+}
+
 TEST_CASE("numerical stress: non-finite and wrongly sized inputs come back as a status, never as NaN") {
   const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
   Task task(model);
@@ -551,4 +595,21 @@ TEST_CASE("a constraint row nothing can move gets nu = 0 (regression: it got 1e3
   CHECK(s.balance.singular);
   CHECK(s.nu.cwiseAbs().maxCoeff() <= 1e3);
   CHECK((ws.tau - s.tau_control).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + s.tau_control.cwiseAbs().maxCoeff()));
+}
+
+TEST_CASE("a task no joint can move reports an infinite condition, not NaN") {
+  // Every row zeroed (docs/solver.md: a row nothing can move gets ν = 0), so
+  // every σ̃ = 0: the condition was √(Σσ̃² Σσ̃⁻²) = √(0·∞) = NaN.
+  const Model model = heavyLightArm(0.0);
+  Task task(model);
+  task.addConstraint("base", ConstraintMatrix::Identity(6, 2), Expressed::World);
+  Workspace ws(model, task);
+  const Eigen::Vector2d q(0.3, 0.2), qd(1.0, 2.0), tau(1.0, 0.5);
+  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+  const BalanceReport& b = ws.solution.balance;
+  INFO("condition " << b.condition << ", rank " << b.rank);
+  CHECK(b.rank == 0);
+  CHECK(b.singular);
+  CHECK(std::isinf(b.condition));
+  CHECK(ws.solution.nu.cwiseAbs().maxCoeff() == 0.0);
 }

@@ -243,7 +243,10 @@ BalanceReport factorByEigen(Eigen::Ref<Eigen::MatrixXd> L, BalanceFactorisation&
     f.near_null_weight[f.near_null_count++] = 1.0 - rampPosition(sigma[k], options);
   }
   orthonormaliseColumns(f.near_null_basis.topLeftCorner(m, f.near_null_count), f.near_null_count);
-  report.condition = std::sqrt(sum_sigma2 * sum_inverse2);  // the fast path's κ̃_F, from the eigenvalues
+  // The fast path's κ̃_F, from the eigenvalues; ∞ on exact rank loss, also
+  // when every σ̃ is zero (every row immovable), where the product is 0·∞.
+  report.condition =
+      std::isinf(sum_inverse2) ? std::numeric_limits<double>::infinity() : std::sqrt(sum_sigma2 * sum_inverse2);
   return report;
 }
 

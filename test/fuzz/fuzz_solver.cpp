@@ -184,6 +184,7 @@ bool documented(StatusCode code) {
     case StatusCode::Infeasible:
     case StatusCode::MimicMismatch:
     case StatusCode::BadConfiguration: return true;
+    case StatusCode::NotComputed: return false;  // a query's code: no solve returns it
   }
   return false;
 }

@@ -1,17 +1,30 @@
 /// \file
-/// The robot model: a kinematic tree of 1-DOF joints with rigid bodies (a
-/// serial chain is the tree without branches), immutable once built and safe to
-/// share between threads. Scratch memory lives in a Workspace (workspace.hpp); a
-/// Model never changes during a solve.
+/// The robot model: a kinematic tree of joints of any type (revolute,
+/// continuous, prismatic, spherical, planar, free) with rigid bodies, immutable
+/// once built and safe to share between threads. Scratch memory lives in a
+/// Workspace (workspace.hpp); a Model never changes during a solve.
 ///
-/// Indexing: body 0 is the fixed base; joint j (0-based) moves body j+1
-/// relative to its parent body parent(j+1) (for a chain, body j). Bodies are in
-/// depth-first order: every body comes after its parent, and the bodies of a
-/// subtree are the contiguous range [b, subtreeEnd(b)). The sweeps rely on that
-/// range: the constraints a body feels are those on its subtree, a contiguous
-/// block of columns (Task::columnRange). Fixed URDF joints are merged into
-/// their parent body at load time, but every link stays addressable as a Frame
-/// attached to a body.
+/// Joints (docs/architecture.md, "Joint types"): joints() lists the joints
+/// below the root in depth-first order; a floating base is the root's joint
+/// (rootJoint(), a free or planar joint to the world). Each joint has nq()
+/// configuration and nv() velocity coordinates, at q_index and v_index in the
+/// model's q (nq() entries) and q̇, τ, q̈ (nv() entries), the root's first.
+///
+/// Bodies, as the sweeps see them: one per degree of freedom (DOF). Body 0 is
+/// the world (a fixed base: the root link and what is welded to it); body
+/// k + 1 moves relative to its parent by DOF k (entry k of v), a rotation
+/// about or a translation along one axis (dofs()). A joint of nv DOFs moves nv
+/// bodies in a row: the first nv − 1 are its intermediate bodies, with no
+/// inertia and no frame, the last is the child link. Eliminating a joint's
+/// DOFs one at a time in the sweeps is exactly the block step with its nv × nv
+/// D (the intermediate bodies carry nothing: the pivots are the LDLᵀ factor of
+/// D), so the sweeps never look at a joint's type. Bodies are in depth-first
+/// order: every body comes after its parent, and the bodies of a subtree are
+/// the contiguous range [b, subtreeEnd(b)). The sweeps rely on that range: the
+/// constraints a body feels are those on its subtree, a contiguous block of
+/// columns (Task::columnRange). Fixed URDF joints are merged into their parent
+/// body at load time, but every link stays addressable as a Frame attached to
+/// a body.
 #pragma once
 
 #include <cmath>
@@ -48,15 +61,36 @@ enum class BaseType { Fixed, Free, Planar };
 /// "fixed", "free" or "planar".
 const char* toString(BaseType type);
 
-/// The kinds of moving joint, as URDF names them.
-enum class JointType { Revolute, Continuous, Prismatic };
-/// The URDF name of a joint type: "revolute", "continuous" or "prismatic".
+/// The kinds of moving joint (docs/conventions.md, "Joint types"):
+///   Revolute, Continuous : q = angle about `axis` [rad], v = its rate (nq = nv = 1);
+///   Prismatic            : q = displacement along `axis` [m] (nq = nv = 1);
+///   Spherical            : q = [q_w, q_x, q_y, q_z], the unit quaternion of the
+///                          child's orientation in the joint frame (w first),
+///                          v = ω, the angular velocity in the child frame
+///                          (nq = 4, nv = 3; Pinocchio's JointModelSpherical and
+///                          MuJoCo's `ball` alike, up to Pinocchio's x y z w order);
+///   Planar               : q = [x, y, ψ], v = [ẋ, ẏ, ψ̇]: the child origin in the
+///                          joint frame's xy plane and the yaw about its z, rates
+///                          in the joint frame's axes (nq = nv = 3);
+///   Free                 : q = [x, y, z, q_w, q_x, q_y, q_z], the child origin in
+///                          the joint frame and its orientation's unit quaternion,
+///                          v = [v; ω], the origin's velocity and the angular
+///                          velocity in the child frame (nq = 7, nv = 6; as
+///                          Pinocchio's free-flyer; MuJoCo's `free` has v in world axes).
+enum class JointType { Revolute, Continuous, Prismatic, Spherical, Planar, Free };
+/// The name of a joint type: "revolute", "continuous", "prismatic" (as URDF
+/// names them), "spherical", "planar" or "free".
 const char* toString(JointType type);
+/// Entries of q for a joint of this type: 1, 1, 1, 4, 3, 7.
+int configurationSize(JointType type);
+/// Entries of v (q̇, τ, q̈) for a joint of this type: 1, 1, 1, 3, 3, 6.
+int velocitySize(JointType type);
 
 /// A joint that follows another (URDF `<mimic>`): q = multiplier·q_leader +
 /// offset, so q̇ = multiplier·q̇_leader and q̈ = multiplier·q̈_leader. The
 /// mechanism that couples them (gears, a linkage, a tendon) supplies the
 /// coupling torque; the leader's motor carries the rest (docs/solver.md, "Mimic joints").
+/// Both joints have one DOF.
 struct Mimic {
   int leader = -1;          ///< the joint followed (never itself a mimic joint once built); −1: independent
   double multiplier = 1.0;  ///< a in q = a·q_leader + b
@@ -65,14 +99,17 @@ struct Mimic {
   bool active() const { return leader >= 0; }
 };
 
-/// One moving joint of the tree: its axis and placement, drive (rotor inertia), friction and limits.
+/// One moving joint of the tree: its type, axis and placement, drive (rotor
+/// inertia), friction and limits. Rotor inertia and friction apply to each of
+/// its DOFs alike (MuJoCo's `armature` and `frictionloss`: a box per DOF);
+/// position limits only to one-DOF joints.
 struct Joint {
   std::string name;                      ///< unique among the model's joints
-  JointType type = JointType::Revolute;  ///< revolute, continuous (no position limits) or prismatic
-  Vec3 axis = Vec3::UnitZ();             ///< unit vector in the joint (= child body) frame
+  JointType type = JointType::Revolute;  ///< see JointType
+  Vec3 axis = Vec3::UnitZ();             ///< unit vector in the joint (= child body) frame (one-DOF joints)
   Transform placement;                   ///< ʲX_parent: parent body frame → joint frame at q = 0
-  double rotor_inertia = 0.0;            ///< d_j, reflected armature inertia [kg·m² or kg]
-  double breakaway_friction = 0.0;       ///< f_j ≥ 0, static friction bound
+  double rotor_inertia = 0.0;            ///< d_j, reflected armature inertia per DOF [kg·m² or kg]
+  double breakaway_friction = 0.0;       ///< f_j ≥ 0, static friction bound per DOF
   double kinetic_friction = 0.0;         ///< f_c,j ≥ 0, Coulomb friction while moving
   double viscous_friction = 0.0;         ///< b_j ≥ 0, viscous friction coefficient (URDF `dynamics damping`)
   double lower = -std::numeric_limits<double>::infinity();  ///< position limits: lower [rad or m]
@@ -84,21 +121,35 @@ struct Joint {
   /// The leader this joint follows, if it is a mimic joint (chains of mimic
   /// joints are resolved to the first leader when the model is built).
   Mimic mimic;
+  /// First entry of the joint's coordinates in the model's q (set by ModelBuilder::build).
+  int q_index = -1;
+  /// First entry of its velocity coordinates in q̇, τ and q̈; its DOFs move
+  /// bodies v_index + 1 … v_index + nv() (set by ModelBuilder::build).
+  int v_index = -1;
 
+  /// Entries of q: configurationSize(type).
+  int nq() const { return configurationSize(type); }
+  /// Entries of v: velocitySize(type).
+  int nv() const { return velocitySize(type); }
+  /// The child body: the body its last DOF moves.
+  int body() const { return v_index + nv(); }
   /// True for revolute and continuous joints.
-  bool isRevolute() const { return type != JointType::Prismatic; }
-  /// Motion subspace S (6-vector, linear first) in the child body frame.
+  bool isRevolute() const { return type == JointType::Revolute || type == JointType::Continuous; }
+  /// Motion subspace S (6-vector, linear first) of a one-DOF joint in the child body frame.
   Vec6 motionSubspace() const {
     return isRevolute() ? spatial::stack(Vec3::Zero(), axis) : spatial::stack(axis, Vec3::Zero());
   }
-  /// ʲX_parent(q) = X_J(q) · X_T: the placement followed by the joint motion.
+  /// ʲX_parent(q) = X_J(q) · X_T of a one-DOF joint: the placement followed by the joint motion.
   Transform transform(double q) const;
+  /// ʲX_parent(q) of any joint, from its nq() coordinates (a quaternion already
+  /// of unit norm: checkConfiguration).
+  Transform transform(const double* q) const;
 };
 
 inline Transform Joint::transform(double q) const {
   // X_J(q): the child frame is the joint frame rotated by q about (or shifted by
   // q along) the axis; then ʲX_parent = X_J · X_T with X_T = placement.
-  if (!isRevolute()) return {placement.E, placement.r + placement.E.transpose() * (q * axis)};
+  if (type == JointType::Prismatic) return {placement.E, placement.r + placement.E.transpose() * (q * axis)};
   // X_J = rotation(R), R = c·1 + s·[a]× + (1 − c)·a aᵀ (Rodrigues), so
   // E = Rᵀ E_T = c·E_T − s·(a × E_T) + (1 − c)·a (aᵀ E_T), column by column.
   const double s = std::sin(q), c = std::cos(q);
@@ -110,6 +161,27 @@ inline Transform Joint::transform(double q) const {
   X.r = placement.r;
   return X;
 }
+
+/// One degree of freedom as the sweeps see it (Model::dofs(), entry k of v):
+/// body k + 1 moves relative to its parent by a rotation about `axis` through
+/// the body's origin, or by a translation along it. Its joint's drive and
+/// friction, per DOF.
+struct Dof {
+  int joint = -1;          ///< the joint it belongs to: its index in Model::joints(), −1 for the root's joint
+  int index_in_joint = 0;  ///< 0 … nv − 1 within its joint
+  bool rotation = true;    ///< a rotation about `axis` through the body origin; false: a translation along it
+  /// `axis` is fixed in the joint frame (the parent's side: a planar joint's x
+  /// and y); false: in the child body's frame.
+  bool in_joint_frame = false;
+  Vec3 axis = Vec3::UnitZ();                                ///< unit axis in that frame
+  double rotor_inertia = 0.0;                               ///< d_k [kg·m² or kg]
+  double breakaway_friction = 0.0;                          ///< f_k ≥ 0
+  double kinetic_friction = 0.0;                            ///< f_c,k ≥ 0
+  double viscous_friction = 0.0;                            ///< b_k ≥ 0
+  double lower = -std::numeric_limits<double>::infinity();  ///< position limit (one-DOF joints)
+  double upper = std::numeric_limits<double>::infinity();   ///< position limit (one-DOF joints)
+  std::string name;  ///< the joint's name, with ".<coordinate>" for a multi-DOF joint ("hip.wx")
+};
 
 /// Something in the model data (or in a task on it) that is physically doubtful
 /// but usable: the model loads and the dynamics uses the data as given
@@ -149,35 +221,44 @@ struct Frame {
 /// The robot: a tree of moving joints and rigid bodies, immutable once built (ModelBuilder, loadUrdfFile).
 class Model {
  public:
-  /// Number of moving (1-DOF) joints n. On a fixed base this is the length of
-  /// q, q̇, τ and q̈; a floating base puts its coordinates in front (nq(), nv()).
-  int dof() const { return static_cast<int>(joints_.size()); }
-  /// Number of bodies, n + 1 with the base (body 0).
-  int bodyCount() const { return dof() + 1; }
-  /// How the base is attached to the world.
+  /// Degrees of freedom of the joints below the root: nv() without a floating
+  /// base's. The length of the per-DOF friction vectors (FrictionOptions,
+  /// FrictionResult); with one-DOF joints only, the number of joints.
+  int dof() const { return nv_ - baseVelocitySize(); }
+  /// Number of bodies, nv() + 1 with body 0 (the world, or a fixed base).
+  int bodyCount() const { return nv_ + 1; }
+  /// How the base is attached to the world: its root joint's type.
   BaseType baseType() const { return base_type_; }
-  /// True for a Free or Planar base: body 0 moves, unactuated.
+  /// True for a Free or Planar base: the root link moves, on an unactuated root joint.
   bool hasFloatingBase() const { return base_type_ != BaseType::Fixed; }
   /// Entries of q for the base: 0 (fixed), 7 (free), 3 (planar).
-  int baseConfigurationSize() const {
-    return base_type_ == BaseType::Free ? 7 : base_type_ == BaseType::Planar ? 3 : 0;
-  }
+  int baseConfigurationSize() const { return hasFloatingBase() ? root_.front().nq() : 0; }
   /// Entries of q̇, τ, q̈ for the base: 0 (fixed), 6 (free), 3 (planar).
-  int baseVelocitySize() const { return base_type_ == BaseType::Free ? 6 : base_type_ == BaseType::Planar ? 3 : 0; }
-  /// Length of q: the base's coordinates, then one per joint.
-  int nq() const { return baseConfigurationSize() + dof(); }
-  /// Length of q̇, τ and q̈: the base's velocity coordinates, then one per joint.
-  int nv() const { return baseVelocitySize() + dof(); }
+  int baseVelocitySize() const { return hasFloatingBase() ? root_.front().nv() : 0; }
+  /// Length of q: the base's coordinates, then each joint's nq().
+  int nq() const { return nq_; }
+  /// Length of q̇, τ and q̈: the base's velocity coordinates, then each joint's nv().
+  int nv() const { return nv_; }
   /// Planar base: the plane's frame in the world, ᴾX_world (its x, y span the
   /// plane, z is the yaw axis; identity: the world's XY plane at height 0).
   /// Identity for the other bases.
   const Transform& basePlacement() const { return base_placement_; }
   /// The robot's name (URDF `<robot name>`).
   const std::string& name() const { return name_; }
+  /// The body of the root link (the base): body 0 on a fixed base, the root
+  /// joint's last body on a floating one.
+  int baseBody() const { return baseVelocitySize(); }
 
-  /// The moving joints in the model's (depth-first) order: the order of q, q̇, τ and q̈.
+  /// The moving joints below the root in the model's (depth-first) order: the
+  /// order of their entries in q, q̇, τ and q̈, after the base's.
   const std::vector<Joint>& joints() const { return joints_; }
-  /// The parent body of body b (−1 for the base, b = 0).
+  /// Every joint in the order of q and v: a floating base's root joint first
+  /// (named "root_joint", unactuated and frictionless), then joints(). What
+  /// the kinematics visits.
+  const std::vector<Joint>& allJoints() const { return all_joints_; }
+  /// Every DOF in the order of v (nv() entries): DOF k moves body k + 1.
+  const std::vector<Dof>& dofs() const { return dofs_; }
+  /// The parent body of body b (−1 for body 0).
   int parent(int b) const { return parents_[static_cast<std::size_t>(b)]; }
   /// One past the last body of b's subtree: the subtree is [b, subtreeEnd(b)).
   int subtreeEnd(int b) const { return subtree_end_[static_cast<std::size_t>(b)]; }
@@ -185,11 +266,12 @@ class Model {
   bool supports(int a, int b) const { return a <= b && b < subtreeEnd(a); }
   /// True when every body's parent is the body before it: a serial chain.
   bool isChain() const { return is_chain_; }
-  /// The body joint j hangs from (0: the base).
-  int parentBodyOfJoint(int j) const { return parent(j + 1); }
-  /// Joint j (0-based; throws std::out_of_range outside [0, dof())).
+  /// The body joint j hangs from (the base's body for the joints on the root link).
+  int parentBodyOfJoint(int j) const { return parent(joint(j).v_index + 1); }
+  /// Joint j (0-based; throws std::out_of_range outside [0, joints().size())).
   const Joint& joint(int j) const { return joints_.at(static_cast<std::size_t>(j)); }
-  /// Inertia of body b (b = 0 is the base, unused by the dynamics) in its own frame.
+  /// Inertia of body b in its own frame (zero for a joint's intermediate
+  /// bodies; body 0's, a fixed base's, is unused by the dynamics).
   const RigidInertia& inertia(int b) const { return inertias_.at(static_cast<std::size_t>(b)); }
   /// Every frame: the base, each body's link and the links on fixed joints.
   const std::vector<Frame>& frames() const { return frames_; }
@@ -204,7 +286,8 @@ class Model {
   int frameIndex(const std::string& name) const;
   /// True when a frame of that name exists.
   bool hasFrame(const std::string& name) const;
-  /// The frame of body b (the link the moving joint b−1 ends in; b = 0: the base link).
+  /// The frame of body b: the link its joint ends in (an intermediate body:
+  /// the link of the joint it belongs to, whose pose it shares), the base link for body 0.
   int bodyFrame(int b) const { return body_frames_.at(static_cast<std::size_t>(b)); }
   /// The mimic joints (Joint::mimic active), in model order. Every solve adds
   /// one internal balance row per mimic joint, q̈_m − a·q̈_leader = 0.
@@ -220,17 +303,28 @@ class Model {
  private:
   friend class ModelBuilder;
   std::string name_;
+  // What the builder works on: links (0: the root link; j + 1: joint j's child)
+  // and the frames on them. build() lays the bodies out from these.
   std::vector<Joint> joints_;
-  std::vector<RigidInertia> inertias_;  // bodyCount() entries
+  std::vector<int> link_parents_{-1};            // per link, its parent link
+  std::vector<RigidInertia> link_inertias_{{}};  // per link, with the links welded to it
+  std::vector<int> frame_links_;                 // per frame, its link
+  std::vector<int> link_frames_;                 // per link, its frame
+  BaseType base_type_ = BaseType::Fixed;
+  Transform base_placement_;
+  std::vector<ModelWarning> warnings_;
+  // What build() lays out.
+  std::vector<Joint> root_;        // the root joint of a floating base (none on a fixed one)
+  std::vector<Joint> all_joints_;  // root_, then joints_
+  std::vector<Dof> dofs_;
+  int nq_ = 0, nv_ = 0;
+  std::vector<RigidInertia> inertias_{{}};  // bodyCount() entries
   std::vector<Frame> frames_;
-  std::vector<int> body_frames_;
+  std::vector<int> body_frames_{0};
   std::vector<int> parents_{-1};     // bodyCount() entries, parents_[0] = −1
   std::vector<int> subtree_end_{1};  // bodyCount() entries
   bool is_chain_ = true;
-  BaseType base_type_ = BaseType::Fixed;
-  Transform base_placement_;
   std::vector<int> mimic_joints_;
-  std::vector<ModelWarning> warnings_;
 };
 
 /// Builds a Model link by link (the URDF loader and the test generators use it).
@@ -275,7 +369,7 @@ class ModelBuilder {
   /// base add theirs through addFixedFrame.
   ModelBuilder& addBaseLinkInertia(const RigidInertia& inertia);
   /// Let the base float: a free-flyer or a planar joint between the world and
-  /// body 0 (unactuated). `placement` is the plane's frame for a Planar base
+  /// the root link (unactuated: the root joint, Model::allJoints()). `placement` is the plane's frame for a Planar base
   /// (ᴾX_world; must be identity for Free). ModelError when the base already
   /// floats (the URDF had a floating root joint, say) or the placement is not finite.
   ModelBuilder& setBase(BaseType type, const Transform& placement = Transform{});
@@ -288,7 +382,8 @@ class ModelBuilder {
  private:
   Model model_;
   Joint& jointNamed(const std::string& name);
-  void checkLinkInertia(const std::string& link, int body, const RigidInertia& inertia);
+  void checkLinkInertia(const std::string& link_name, int link, const RigidInertia& inertia);
+  static void layOutBodies(Model& model);
 };
 
 /// Validation helpers shared by the builder and the URDF loader.

@@ -33,7 +33,8 @@ EntryName stateEntry(const Model& model, Eigen::Index k, int base, const char* c
   EntryName name;
   if (k < base)
     std::snprintf(name.text, sizeof name.text, "%s",
-                  model.baseType() == BaseType::Free ? free_names[k] : planar_names[k]);
+                  model.baseType() == BaseType::Free ? free_names[std::min<Eigen::Index>(k, 6)]
+                                                     : planar_names[std::min<Eigen::Index>(k, 2)]);
   else
     std::snprintf(name.text, sizeof name.text, "joint '%.60s'",
                   model.joints()[static_cast<std::size_t>(k - base)].name.c_str());

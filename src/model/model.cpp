@@ -14,8 +14,68 @@ const char* toString(JointType type) {
     case JointType::Revolute: return "revolute";
     case JointType::Continuous: return "continuous";
     case JointType::Prismatic: return "prismatic";
+    case JointType::Spherical: return "spherical";
+    case JointType::Planar: return "planar";
+    case JointType::Free: return "free";
   }
   return "unknown";
+}
+
+int configurationSize(JointType type) {
+  switch (type) {
+    case JointType::Revolute:
+    case JointType::Continuous:
+    case JointType::Prismatic: return 1;
+    case JointType::Spherical: return 4;
+    case JointType::Planar: return 3;
+    case JointType::Free: return 7;
+  }
+  return 0;
+}
+
+int velocitySize(JointType type) {
+  switch (type) {
+    case JointType::Revolute:
+    case JointType::Continuous:
+    case JointType::Prismatic: return 1;
+    case JointType::Spherical: return 3;
+    case JointType::Planar: return 3;
+    case JointType::Free: return 6;
+  }
+  return 0;
+}
+
+namespace {
+// The rotation a unit quaternion (w, x, y, z) makes: child axes in the joint frame.
+Mat3 rotationOfQuaternion(double w, double x, double y, double z) {
+  Mat3 R;
+  R << 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),  //
+      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),   //
+      2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y);
+  return R;
+}
+}  // namespace
+
+Transform Joint::transform(const double* q) const {
+  // ʲX_parent = X_J(q) · X_T: X_J is the child's pose (rotation R, origin p)
+  // in the joint frame, so E = Rᵀ E_T and the origin is r_T + E_Tᵀ p.
+  switch (type) {
+    case JointType::Revolute:
+    case JointType::Continuous:
+    case JointType::Prismatic: return transform(q[0]);
+    case JointType::Spherical:
+      return {rotationOfQuaternion(q[0], q[1], q[2], q[3]).transpose() * placement.E, placement.r};
+    case JointType::Planar: {
+      const double c = std::cos(q[2]), s = std::sin(q[2]);
+      Mat3 Rt;  // Rz(ψ)ᵀ
+      Rt << c, s, 0, -s, c, 0, 0, 0, 1;
+      return {Rt * placement.E, placement.r + placement.E.transpose() * Vec3(q[0], q[1], 0.0)};
+    }
+    case JointType::Free:
+      return {rotationOfQuaternion(q[3], q[4], q[5], q[6]).transpose() * placement.E,
+              placement.r + placement.E.transpose() * Vec3(q[0], q[1], q[2])};
+  }
+  return placement;
 }
 
 namespace {
@@ -31,8 +91,8 @@ bool finite(const Transform& X) { return X.E.allFinite() && X.r.allFinite(); }
 }  // namespace
 
 int Model::jointIndex(const std::string& name) const {
-  for (int j = 0; j < dof(); ++j)
-    if (joints_[static_cast<std::size_t>(j)].name == name) return j;
+  for (std::size_t j = 0; j < joints_.size(); ++j)
+    if (joints_[j].name == name) return static_cast<int>(j);
   std::vector<std::string> names;  // only on the error path: a lookup that succeeds allocates nothing
   for (const Joint& joint : joints_) names.push_back(joint.name);
   throw ModelError("model '" + name_ + "' has no moving joint '" + name + "' (joints: " + knownNames(names) + ")");
@@ -157,12 +217,31 @@ std::vector<ModelWarning> validate::rigidInertia(const std::string& where, const
 
 ModelBuilder::ModelBuilder(std::string robot_name, std::string base_frame) {
   model_.name_ = std::move(robot_name);
-  model_.inertias_.push_back(RigidInertia{});
   model_.frames_.push_back(Frame{std::move(base_frame), 0, Transform{}});
-  model_.body_frames_.push_back(0);
+  model_.frame_links_.push_back(0);
+  model_.link_frames_.push_back(0);
 }
 
 ModelBuilder::ModelBuilder(const Model& model) : model_(model) {}
+
+namespace {
+// The type-specific checks of a joint's data; `where` names it.
+void checkJointType(const std::string& where, Joint& joint) {
+  const bool one_dof = joint.nv() == 1;
+  if (one_dof) {
+    if (!joint.axis.allFinite() || joint.axis.norm() < 1e-9)
+      throw ModelError(where + ": axis must be a finite non-zero vector");
+    joint.axis.normalize();
+    return;
+  }
+  // A multi-DOF joint has no axis and, in zwang, no position limits: a
+  // spherical joint's cone limit is a later feature (docs/conventions.md, "Joint types").
+  if (std::isfinite(joint.lower) || std::isfinite(joint.upper))
+    throw ModelError(where + ": a " + toString(joint.type) + " joint takes no position limits (only one-DOF " +
+                     "joints have them; a spherical joint's cone limit is not supported yet)");
+  if (joint.mimic.active()) throw ModelError(where + ": only one-DOF joints can mimic another");
+}
+}  // namespace
 
 ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& child_frame,
                                      const RigidInertia& child_inertia, const std::string& parent_frame) {
@@ -171,22 +250,20 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
   for (const Joint& j : model_.joints_)
     if (j.name == joint_in.name) throw ModelError(where + ": a joint of that name exists already");
   if (model_.hasFrame(child_frame)) throw ModelError(where + ": frame '" + child_frame + "' exists already");
-  const int last_body = model_.bodyCount() - 1;
-  int parent_body = last_body;
+  const int last_link = static_cast<int>(model_.link_parents_.size()) - 1;
+  int parent_link = last_link;
   if (!parent_frame.empty()) {
-    parent_body = model_.frame(model_.frameIndex(parent_frame)).body;
-    // Depth first: the parent is on the path from the last body to the base, so
+    parent_link = model_.frame_links_[static_cast<std::size_t>(model_.frameIndex(parent_frame))];
+    // Depth first: the parent is on the path from the last link to the root, so
     // that every subtree stays a contiguous range of bodies (model.hpp).
-    int b = last_body;
-    while (b > parent_body) b = model_.parent(b);
-    if (b != parent_body)
+    int l = last_link;
+    while (l > parent_link) l = model_.link_parents_[static_cast<std::size_t>(l)];
+    if (l != parent_link)
       throw ModelError(where + ": parent frame '" + parent_frame + "' is on a branch that is already complete (add " +
                        "joints depth first: the parent must be the last body added or one of its ancestors)");
   }
   Joint joint = joint_in;
-  if (!joint.axis.allFinite() || joint.axis.norm() < 1e-9)
-    throw ModelError(where + ": axis must be a finite non-zero vector");
-  joint.axis.normalize();
+  checkJointType(where, joint);
   if (!finite(joint.placement)) throw ModelError(where + ": origin is not finite");
   const struct {
     const char* field;
@@ -205,7 +282,8 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
     throw ModelError(where + ": effort limit must be non-negative");
   if (std::isnan(joint.velocity_limit) || joint.velocity_limit < 0.0)
     throw ModelError(where + ": velocity limit must be non-negative");
-  checkLinkInertia(child_frame, model_.bodyCount(), child_inertia);
+  const int link = last_link + 1;
+  checkLinkInertia(child_frame, link, child_inertia);
 
   // The joint's placement is relative to the parent link's frame; rebase it on
   // the parent body's frame (they differ when the parent link was merged in).
@@ -213,14 +291,11 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
     joint.placement = joint.placement * model_.frame(model_.frameIndex(parent_frame)).placement;
 
   model_.joints_.push_back(joint);
-  model_.inertias_.push_back(child_inertia);
-  const int body = model_.bodyCount() - 1;
-  model_.parents_.push_back(parent_body);
-  model_.subtree_end_.push_back(body + 1);
-  for (int a = parent_body; a >= 0; a = model_.parent(a)) model_.subtree_end_[static_cast<std::size_t>(a)] = body + 1;
-  model_.is_chain_ = model_.is_chain_ && parent_body == body - 1;
-  model_.frames_.push_back(Frame{child_frame, body, Transform{}});
-  model_.body_frames_.push_back(static_cast<int>(model_.frames_.size()) - 1);
+  model_.link_parents_.push_back(parent_link);
+  model_.link_inertias_.push_back(child_inertia);
+  model_.frames_.push_back(Frame{child_frame, 0, Transform{}});
+  model_.frame_links_.push_back(link);
+  model_.link_frames_.push_back(static_cast<int>(model_.frames_.size()) - 1);
   return *this;
 }
 
@@ -229,21 +304,24 @@ ModelBuilder& ModelBuilder::addFixedFrame(const std::string& name, const std::st
   const std::string where = "link '" + name + "'";
   if (model_.hasFrame(name)) throw ModelError(where + ": a frame of that name exists already");
   if (!finite(placement)) throw ModelError(where + ": origin of its fixed joint is not finite");
-  const Frame& parent = model_.frame(model_.frameIndex(parent_frame));
-  checkLinkInertia(name, parent.body, inertia);
+  const int parent = model_.frameIndex(parent_frame);
+  const int link = model_.frame_links_[static_cast<std::size_t>(parent)];
+  checkLinkInertia(name, link, inertia);
   // ᶠX_body = ᶠX_parent · ᵖX_body
-  const Frame frame{name, parent.body, placement * parent.placement};
-  model_.inertias_[static_cast<std::size_t>(frame.body)] += spatial::inverseTransformInertia(frame.placement, inertia);
+  const Frame frame{name, 0, placement * model_.frame(parent).placement};
+  model_.link_inertias_[static_cast<std::size_t>(link)] += spatial::inverseTransformInertia(frame.placement, inertia);
   model_.frames_.push_back(frame);
+  model_.frame_links_.push_back(link);
   return *this;
 }
 
-void ModelBuilder::checkLinkInertia(const std::string& link, int body, const RigidInertia& inertia) {
+void ModelBuilder::checkLinkInertia(const std::string& link_name, int link, const RigidInertia& inertia) {
   // The base never moves: what is welded to it does not enter the dynamics, so
   // its flaws cannot change an answer (and the verdict must not depend on
   // which link the user picks as the root).
-  if (body == 0) return;
-  for (const ModelWarning& w : validate::rigidInertia("link '" + link + "'", inertia)) addWarning(w.code, w.message);
+  if (link == 0) return;
+  for (const ModelWarning& w : validate::rigidInertia("link '" + link_name + "'", inertia))
+    addWarning(w.code, w.message);
 }
 
 ModelBuilder& ModelBuilder::addWarning(WarningCode code, const std::string& message) {
@@ -293,7 +371,7 @@ const char* toString(BaseType type) {
 ModelBuilder& ModelBuilder::addBaseLinkInertia(const RigidInertia& inertia) {
   // Throws on an impossible inertia; its warnings come with build(), when the base floats.
   (void)validate::rigidInertia("link '" + model_.frames_[0].name + "'", inertia);
-  model_.inertias_[0] += inertia;
+  model_.link_inertias_[0] += inertia;
   return *this;
 }
 
@@ -319,6 +397,8 @@ ModelBuilder& ModelBuilder::setMimic(const std::string& joint, const std::string
   if (joint == leader) throw ModelError(where + ": a joint cannot mimic itself");
   if (!std::isfinite(multiplier) || !std::isfinite(offset))
     throw ModelError(where + ": multiplier and offset must be finite");
+  if (jointNamed(joint).nv() != 1 || jointNamed(leader).nv() != 1)
+    throw ModelError(where + ": only one-DOF joints can mimic or be mimicked");
   Mimic& mimic = jointNamed(joint).mimic;
   mimic.leader = model_.jointIndex(leader);
   mimic.multiplier = multiplier;
@@ -352,53 +432,159 @@ void resolveMimicChains(std::vector<Joint>& joints, std::vector<int>& mimic_join
 }  // namespace
 
 void Model::followLeaders(Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> qd) const {
-  const int iq = baseConfigurationSize(), iv = baseVelocitySize();  // the joints' entries follow the base's
   for (const int m : mimic_joints_) {
-    const Mimic& law = joints_[static_cast<std::size_t>(m)].mimic;
-    if (q.size() == nq()) q[iq + m] = law.multiplier * q[iq + law.leader] + law.offset;
-    if (qd.size() == nv()) qd[iv + m] = law.multiplier * qd[iv + law.leader];
+    const Joint& joint = joints_[static_cast<std::size_t>(m)];
+    const Joint& leader = joints_[static_cast<std::size_t>(joint.mimic.leader)];
+    if (q.size() == nq()) q[joint.q_index] = joint.mimic.multiplier * q[leader.q_index] + joint.mimic.offset;
+    if (qd.size() == nv()) qd[joint.v_index] = joint.mimic.multiplier * qd[leader.v_index];
+  }
+}
+
+namespace {
+// A joint's DOFs as the sweeps see them (model.hpp, Dof): each a rotation about
+// or a translation along one axis. What a new joint type adds here, with its
+// transform and its configuration operations (configuration.cpp).
+void appendDofs(const Joint& joint, int index, std::vector<Dof>& dofs) {
+  struct Axis {
+    bool rotation, in_joint_frame;
+    Vec3 axis;
+    const char* coordinate;
+  };
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+  std::vector<Axis> axes;
+  switch (joint.type) {
+    case JointType::Revolute:
+    case JointType::Continuous: axes = {{true, false, joint.axis, ""}}; break;
+    case JointType::Prismatic: axes = {{false, false, joint.axis, ""}}; break;
+    case JointType::Spherical: axes = {{true, false, x, "wx"}, {true, false, y, "wy"}, {true, false, z, "wz"}}; break;
+    case JointType::Planar: axes = {{false, true, x, "x"}, {false, true, y, "y"}, {true, false, z, "yaw"}}; break;
+    case JointType::Free:
+      axes = {{false, false, x, "vx"}, {false, false, y, "vy"}, {false, false, z, "vz"},
+              {true, false, x, "wx"},  {true, false, y, "wy"},  {true, false, z, "wz"}};
+      break;
+  }
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    Dof d;
+    d.joint = index;
+    d.index_in_joint = static_cast<int>(k);
+    d.rotation = axes[k].rotation;
+    d.in_joint_frame = axes[k].in_joint_frame;
+    d.axis = axes[k].axis;
+    d.rotor_inertia = joint.rotor_inertia;
+    d.breakaway_friction = joint.breakaway_friction;
+    d.kinetic_friction = joint.kinetic_friction;
+    d.viscous_friction = joint.viscous_friction;
+    d.lower = joint.lower;
+    d.upper = joint.upper;
+    d.name = axes.size() == 1 ? joint.name : joint.name + "." + axes[k].coordinate;
+    dofs.push_back(d);
+  }
+}
+}  // namespace
+
+void ModelBuilder::layOutBodies(Model& model) {
+  // The root joint of a floating base: unactuated, frictionless, no limits.
+  model.root_.clear();
+  if (model.base_type_ != BaseType::Fixed) {
+    Joint root;
+    root.name = "root_joint";
+    root.type = model.base_type_ == BaseType::Free ? JointType::Free : JointType::Planar;
+    root.placement = model.base_placement_;
+    model.root_.push_back(root);
+  }
+  model.all_joints_ = model.root_;
+  model.all_joints_.insert(model.all_joints_.end(), model.joints_.begin(), model.joints_.end());
+  // Coordinates and bodies in joint order: DOF k moves body k + 1.
+  const std::size_t links = model.link_parents_.size();
+  std::vector<int> link_body(links, 0);
+  model.dofs_.clear();
+  model.parents_.assign(1, -1);
+  model.inertias_.assign(1, RigidInertia{});
+  model.body_frames_.assign(1, model.link_frames_[0]);
+  int nq = 0, nv = 0;
+  const int first_link = model.root_.empty() ? 1 : 0;  // the root joint moves link 0
+  for (std::size_t j = 0; j < model.all_joints_.size(); ++j) {
+    Joint& joint = model.all_joints_[j];
+    const auto link = static_cast<std::size_t>(static_cast<int>(j) + first_link);
+    const int parent_body = link == 0 ? 0 : link_body[static_cast<std::size_t>(model.link_parents_[link])];
+    joint.q_index = nq;
+    joint.v_index = nv;
+    appendDofs(joint, static_cast<int>(j) - static_cast<int>(model.root_.size()), model.dofs_);
+    for (int k = 0; k < joint.nv(); ++k) {
+      model.parents_.push_back(k == 0 ? parent_body : nv + k);
+      model.inertias_.push_back(RigidInertia{});
+      model.body_frames_.push_back(model.link_frames_[link]);
+    }
+    nq += joint.nq();
+    nv += joint.nv();
+    link_body[link] = nv;
+    model.inertias_.back() = model.link_inertias_[link];
+  }
+  if (model.root_.empty()) model.inertias_[0] = model.link_inertias_[0];
+  model.nq_ = nq;
+  model.nv_ = nv;
+  std::copy(model.all_joints_.begin() + static_cast<std::ptrdiff_t>(model.root_.size()), model.all_joints_.end(),
+            model.joints_.begin());
+  for (std::size_t f = 0; f < model.frames_.size(); ++f)
+    model.frames_[f].body = link_body[static_cast<std::size_t>(model.frame_links_[f])];
+  // Subtrees: bodies are in depth-first order, so each body's subtree ends
+  // where the next body not below it starts.
+  const int bodies = nv + 1;
+  model.subtree_end_.assign(static_cast<std::size_t>(bodies), 0);
+  model.is_chain_ = true;
+  for (int b = bodies - 1; b >= 0; --b) {
+    auto& end = model.subtree_end_[static_cast<std::size_t>(b)];
+    end = std::max(end, b + 1);
+    const int p = model.parents_[static_cast<std::size_t>(b)];
+    if (p >= 0) {
+      auto& parent_end = model.subtree_end_[static_cast<std::size_t>(p)];
+      parent_end = std::max(parent_end, end);
+      model.is_chain_ = model.is_chain_ && p == b - 1;
+    }
   }
 }
 
 Model ModelBuilder::build() const {
   // Each link passed on its own; their sum is checked too, to rounding of the
   // merged figures, so no moving body reaches a solve with a negative moment.
-  for (int b = 1; b < model_.bodyCount(); ++b) {
+  const auto links = static_cast<int>(model_.link_parents_.size());
+  for (int l = 1; l < links; ++l) {
     const std::string link =
-        model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(b)])].name;
+        model_.frames_[static_cast<std::size_t>(model_.link_frames_[static_cast<std::size_t>(l)])].name;
     validate::rigidInertia("body of link '" + link + "' (with the links welded to it)",
-                           model_.inertias_[static_cast<std::size_t>(b)]);
+                           model_.link_inertias_[static_cast<std::size_t>(l)]);
   }
   // A moving body must carry inertia somewhere in its subtree (or its joint a
   // rotor inertia), or its acceleration is undetermined. The leaves are the
   // bodies left bare most often, so check from the leaves inward.
-  std::vector<double> mass_beyond(static_cast<std::size_t>(model_.bodyCount()), 0.0);
-  for (int j = model_.dof() - 1; j >= 0; --j) {
-    const auto body = static_cast<std::size_t>(j + 1);
-    const RigidInertia& I = model_.inertias_[body];
-    mass_beyond[body] += I.mass + I.Ibar.trace();
-    mass_beyond[static_cast<std::size_t>(model_.parent(j + 1))] += mass_beyond[body];
-    const Joint& joint = model_.joints_[static_cast<std::size_t>(j)];
-    if (mass_beyond[body] <= 0.0 && joint.rotor_inertia <= 0.0) {
-      const std::string link =
-          model_.frames_[static_cast<std::size_t>(model_.body_frames_[static_cast<std::size_t>(j + 1)])].name;
-      throw ModelError("link '" + link + "': zero mass on a moving body with nothing beyond it (joint '" + joint.name +
+  std::vector<double> mass_beyond(static_cast<std::size_t>(links), 0.0);
+  for (int l = links - 1; l >= 1; --l) {
+    const auto link = static_cast<std::size_t>(l);
+    const RigidInertia& I = model_.link_inertias_[link];
+    mass_beyond[link] += I.mass + I.Ibar.trace();
+    mass_beyond[static_cast<std::size_t>(model_.link_parents_[link])] += mass_beyond[link];
+    const Joint& joint = model_.joints_[link - 1];
+    if (mass_beyond[link] <= 0.0 && joint.rotor_inertia <= 0.0) {
+      const std::string name = model_.frames_[static_cast<std::size_t>(model_.link_frames_[link])].name;
+      throw ModelError("link '" + name + "': zero mass on a moving body with nothing beyond it (joint '" + joint.name +
                        "' would have no inertia to move)");
     }
   }
   if (model_.hasFloatingBase()) {
-    // Body 0 moves: its inertia (the root link and what is welded to it) now
-    // enters the dynamics, so it gets the checks the other bodies got.
+    // The root link moves: its inertia (and what is welded to it) now enters
+    // the dynamics, so it gets the checks the other bodies got.
     const std::string link = model_.frames_[0].name;
-    if (mass_beyond[0] + model_.inertias_[0].mass + model_.inertias_[0].Ibar.trace() <= 0.0)
+    if (mass_beyond[0] + model_.link_inertias_[0].mass + model_.link_inertias_[0].Ibar.trace() <= 0.0)
       throw ModelError("link '" + link + "': a floating base with no mass anywhere in the robot");
   }
   Model model = model_;
   if (model.hasFloatingBase())
-    for (const ModelWarning& w : validate::rigidInertia(
-             "base body of link '" + model.frames_[0].name + "' (with the links welded to it)", model.inertias_[0]))
+    for (const ModelWarning& w :
+         validate::rigidInertia("base body of link '" + model.frames_[0].name + "' (with the links welded to it)",
+                                model.link_inertias_[0]))
       model.warnings_.push_back(w);
   resolveMimicChains(model.joints_, model.mimic_joints_);
+  layOutBodies(model);
   return model;
 }
 

@@ -188,8 +188,7 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   fs.stuck_dofs.clear();  // reserved for every DOF: no allocation
   for (const int j : stuck) fs.stuck_dofs.push_back(dofOfEntry(model, j));
   if (k > 0)
-    unitTorqueColumns(model, task, ws, fs.stuck_dofs, fs.unit_torques, fs.dnu.topLeftCorner(m, k),
-                      fs.dqdd.leftCols(k));
+    unitTorqueColumns(model, task, ws, fs.stuck_dofs, fs.unit_torques, fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k));
   return {};
 }
 
@@ -204,9 +203,15 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
 // to the base (line 29, every motion in the world frame).
 Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const FrictionScratch& fs, Eigen::Index a,
                              int body) {
-  Vec6 terms = Vec6::Zero();
-  for (int l = model.parent(body); l > 0; l = model.parent(l))
-    terms += ws.S[static_cast<std::size_t>(l)].cwiseAbs() * std::abs(fs.dqdd(l - 1, a));
+  // A joint's motion S δq̈ is one term, however many DOFs it has (its DOFs
+  // share a body: their parts are the components of one motion).
+  Vec6 terms = Vec6::Zero(), joint_motion = Vec6::Zero();
+  for (int l = model.parent(body); l > 0; l = model.parent(l)) {
+    joint_motion += ws.S[static_cast<std::size_t>(l)] * fs.dqdd(l - 1, a);
+    if (model.dofs()[static_cast<std::size_t>(l - 1)].index_in_joint > 0) continue;
+    terms += joint_motion.cwiseAbs();
+    joint_motion.setZero();
+  }
   return terms;
 }
 
@@ -265,8 +270,10 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
     // without this term, 1e-14 with it, found by test_mimic).
     const int m = task.solverColumns();
     if (m > 0)
-      curvature_scale = std::max(curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
-                                                      ws.SA.topRows(m).cwiseAbs().maxCoeff() / min_D);
+      curvature_scale = std::max(
+          curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
+                               ws.SA.block(0, bodyOfDof(dofOfEntry(model, 0)), m, model.dof()).cwiseAbs().maxCoeff() /
+                               min_D);  // over the DOFs friction acts on
   }
   termSizes(model, task, ws, stuck, fs);
   const double tolerance = options.kkt_tolerance * acc_scale;

@@ -31,14 +31,15 @@
 //
 // So that the comparison can fail, the last test case makes two plausible convention mistakes (a ball's ω read in
 // the joint frame instead of the child's; a free spec joint's linear qvel read in body axes) and requires each to be
-// seen far above 1e-9; another checks the conversion itself on MuJoCo alone (a free spec joint on the world is
-// MuJoCo's free base, in our coordinates).
+// seen far above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world
+// is MuJoCo's free base, in our coordinates; at rest, a ball joint is three hinges about the child's axes).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <mujoco/mujoco.h>
@@ -479,6 +480,127 @@ TEST_CASE("joint types: a free joint on the world is MuJoCo's free base, in our 
       "%.2e\n",
       worst);
   CHECK(worst < 1e-12);
+}
+
+namespace {
+
+// MuJoCo's state, forward and inverse dynamics at v = 0 in OUR dof order (`dof`: MuJoCo's dof address per entry).
+struct AtRest {
+  Eigen::VectorXd qacc, qfrc_inverse;
+  Eigen::MatrixXd M;
+};
+
+AtRest mujocoAtRest(const std::string& xml, const std::vector<std::pair<std::string, int>>& qpos_names,
+                    const Eigen::VectorXd& qpos, const std::vector<std::pair<std::string, int>>& dof_names,
+                    const Eigen::VectorXd& tau, const Eigen::VectorXd& qdd) {
+  const Mujoco mj(xml);
+  const mjModel* m = mj.m();
+  mjData* d = mj.d();
+  // (joint name, entry within the joint) → MuJoCo's address.
+  auto addresses = [m](const std::vector<std::pair<std::string, int>>& names, const int* adr) {
+    std::vector<int> out;
+    for (const auto& [name, entry] : names) {
+      const int id = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+      REQUIRE(id >= 0);
+      out.push_back(adr[id] + entry);
+    }
+    return out;
+  };
+  const std::vector<int> qadr = addresses(qpos_names, m->jnt_qposadr), vadr = addresses(dof_names, m->jnt_dofadr);
+  REQUIRE(m->nv == static_cast<int>(vadr.size()));
+  scatter(qpos, qadr, d->qpos);
+  scatter(tau, vadr, d->qfrc_applied);
+  mj_forward(m, d);
+  AtRest r;
+  r.qacc = gather(d->qacc, vadr);
+  r.M = mujocoMassMatrix(m, d, vadr);
+  std::fill(d->qfrc_applied, d->qfrc_applied + m->nv, 0.0);
+  scatter(qdd, vadr, d->qacc);
+  mj_inverse(m, d);
+  r.qfrc_inverse = gather(d->qfrc_inverse, vadr);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("joint types: MuJoCo's ball velocity is the angular velocity in the child frame", "[joints][mujoco]") {
+  // MuJoCo alone, so that the ball convention the header states is checked without zwang: each ball joint at its
+  // quaternion Q against three hinges about the child's x, y, z at angle 0 in one body (MuJoCo composes a body's
+  // joints in order) placed at the joint placement times Q. At rest (v = 0, no velocity products) the two are the
+  // same mechanism in the same coordinates exactly when the ball's qvel is ω in the child frame: the same M, qacc
+  // under τ and gravity, and qfrc_inverse for a q̈, to round-off (1e-11: both sides are MuJoCo's double-precision
+  // sweeps on the same numbers, the placements composed in another order, qacc's round-off amplified by M's
+  // condition). Read in the joint frame, M would be rotated by Q on each ball's block.
+  std::mt19937_64 rng(78);
+  double worst = 0.0;
+  int balls = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const JointsProblem p = randomJointsProblem(rng, trial % 2 == 0, 0.0);
+    ChainSpec hinges = p.spec;
+    std::vector<std::pair<std::string, int>> q_ball, v_ball, q_hinge, v_hinge;
+    Eigen::VectorXd qpos_hinge(p.base.nv(p.spec) + (p.base.kind == BaseKind::Free ? 1 : 0));
+    Eigen::Index qi = 0, hi = 0;
+    if (p.base.kind == BaseKind::Free) {
+      for (int i = 0; i < 7; ++i) q_ball.emplace_back(kMjcfFreeJoint, i);
+      for (int i = 0; i < 6; ++i) v_ball.emplace_back(kMjcfFreeJoint, i);
+      q_hinge = q_ball;
+      v_hinge = v_ball;
+      qpos_hinge.head<7>() = p.input.q.head<7>();
+      qi = hi = 7;
+    }
+    const char* suffix[] = {"", "_y", "_z"};
+    for (const int k : p.spec.movingJoints()) {
+      JointSpec& joint = hinges.joints[static_cast<std::size_t>(k)];
+      const int nq = joint.nq();  // before the ball becomes a hinge
+      for (int i = 0; i < nq; ++i) q_ball.emplace_back(joint.name, i);
+      for (int i = 0; i < joint.nv(); ++i) v_ball.emplace_back(joint.name, i);
+      if (joint.isSpherical()) {
+        ++balls;
+        const Eigen::Quaterniond Q(p.input.q(qi), p.input.q(qi + 1), p.input.q(qi + 2), p.input.q(qi + 3));
+        const Eigen::Matrix3d R = rpyToMatrix(joint.rpy) * Q.toRotationMatrix();
+        const Eigen::Vector3d ypr = R.eulerAngles(2, 1, 0);  // R = Rz(yaw)·Ry(pitch)·Rx(roll)
+        joint.rpy = Eigen::Vector3d(ypr(2), ypr(1), ypr(0));
+        joint.type = "revolute";
+        joint.axis = Eigen::Vector3d::UnitX();  // the other two hinges are written into the same body below
+        for (int i = 0; i < 3; ++i) {
+          q_hinge.emplace_back(joint.name + suffix[i], 0);
+          v_hinge.emplace_back(joint.name + suffix[i], 0);
+          qpos_hinge(hi++) = 0.0;
+        }
+      } else {
+        q_hinge.emplace_back(joint.name, 0);
+        v_hinge.emplace_back(joint.name, 0);
+        qpos_hinge(hi++) = p.input.q(qi);
+      }
+      qi += nq;
+    }
+    std::string xml = toMjcf(hinges, p.input.gravity, p.base);
+    for (const int k : p.spec.movingJoints()) {
+      const JointSpec& joint = p.spec.joints[static_cast<std::size_t>(k)];
+      if (!joint.isSpherical()) continue;
+      const std::string name = "<joint name=\"" + joint.name + "\" type=\"hinge\"";
+      const std::size_t begin = xml.find(name), end = xml.find('\n', begin);
+      REQUIRE(begin != std::string::npos);
+      std::string x_line = xml.substr(begin, end - begin), y_line = x_line, z_line = x_line;
+      y_line.replace(y_line.find(joint.name + "\""), joint.name.size() + 1, joint.name + "_y\"");
+      z_line.replace(z_line.find(joint.name + "\""), joint.name.size() + 1, joint.name + "_z\"");
+      y_line.replace(y_line.find("axis=\"1 0 0\""), 12, "axis=\"0 1 0\"");
+      z_line.replace(z_line.find("axis=\"1 0 0\""), 12, "axis=\"0 0 1\"");
+      const std::string indent = xml.substr(xml.rfind('\n', begin) + 1, begin - xml.rfind('\n', begin) - 1);
+      xml.insert(end, "\n" + indent + y_line + "\n" + indent + z_line);
+    }
+    const AtRest ball =
+        mujocoAtRest(toMjcf(p.spec, p.input.gravity, p.base), q_ball, p.input.q, v_ball, p.input.tau, p.qdd_inverse);
+    const AtRest hinge = mujocoAtRest(xml, q_hinge, qpos_hinge, v_hinge, p.input.tau, p.qdd_inverse);
+    worst = std::max({worst, relativeError(ball.qacc, hinge.qacc), relativeError(ball.qfrc_inverse, hinge.qfrc_inverse),
+                      matrixRelativeError(ball.M, hinge.M)});
+  }
+  std::printf(
+      "MuJoCo ball joints vs three hinges about the child's axes, at rest: 30 trees, %d ball joints, max rel. "
+      "difference %.2e\n",
+      balls, worst);
+  CHECK(balls >= 50);
+  CHECK(worst < 1e-11);
 }
 
 TEST_CASE("joint types: the MuJoCo comparison fails on a wrong velocity convention", "[joints][mujoco]") {

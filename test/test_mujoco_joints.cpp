@@ -27,7 +27,13 @@
 //    frame]. With R = ⁰R_child and T = blockdiag(R, 1₃) on each free joint's six entries, the identity elsewhere:
 //      qvel = T v,  qacc = T v̇ + Ṫ v (Ṫ v = [R (ω × v_lin); 0]),  v̇ = T⁻¹ (qacc − Ṫ v),
 //      qfrc = T⁻ᵀ τ,  τ = Tᵀ qfrc_inverse,  H = Tᵀ M_mj T
-//    (the same power τᵀv and kinetic energy on both sides; support/mujoco_bridge.hpp derives it).
+//    (the same power τᵀv and kinetic energy on both sides; support/mujoco_bridge.hpp derives it);
+//  * armature on a free joint: both add it to the diagonal of the inertia matrix in their own coordinates, which for
+//    the translations differ: MuJoCo's acts on ṗ in world axes (a force a p̈ = a R (v̇_lin + ω × v_lin)), zwang's
+//    rotor inertia d on its child-frame v_lin (a force d v̇_lin, as Pinocchio's armature on a free-flyer). The same
+//    H, but MuJoCo's dynamics carry the extra a ω × v_lin on those entries (in our coordinates): the test adds it to
+//    τ before handing τ to mj_forward and takes it out of mj_inverse's answer (armatureCorrection). Rotations (ball
+//    joints, a free joint's ω) have the same coordinates on both sides: no correction.
 //
 // So that the comparison can fail, the last test case makes two plausible convention mistakes (a ball's ω read in
 // the joint frame instead of the child's; a free spec joint's linear qvel read in body axes) and requires each to be
@@ -317,6 +323,21 @@ Eigen::MatrixXd mujocoMassMatrix(const mjModel* m, const mjData* d, const std::v
   return M;
 }
 
+// The generalized force MuJoCo's armature adds to zwang's on each free spec joint's translations (file comment):
+// a ω × v_lin on those entries (our coordinates), 0 elsewhere.
+Eigen::VectorXd armatureCorrection(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& v) {
+  Eigen::VectorXd correction = Eigen::VectorXd::Zero(v.size());
+  Eigen::Index vi = base.nvBase();
+  for (const int k : spec.movingJoints()) {
+    const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
+    if (joint.isFree())
+      correction.segment<3>(vi) =
+          joint.reflectedInertia() * Eigen::Vector3d(v.segment<3>(vi + 3)).cross(Eigen::Vector3d(v.segment<3>(vi)));
+    vi += joint.nv();
+  }
+  return correction;
+}
+
 // The same quantities from MuJoCo for (spec, base), in our coordinates by `change`.
 Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const JointsProblem& p,
                         const VelocityChange& change, bool check_conventions = true) {
@@ -328,10 +349,12 @@ Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const J
   if (check_conventions) checkMujocoConventions(p, m, map);
   Answers a;
 
-  // Forward: the state, τ as the generalized force T⁻ᵀ τ, the wrench at its body's COM.
+  // Forward: the state, τ (with the armature correction) as the generalized force T⁻ᵀ τ, the wrench at its body's
+  // COM.
+  const Eigen::VectorXd armature = armatureCorrection(spec, base, in.v);
   scatter(in.q, map.qpos, d->qpos);
   scatter(change.T * in.v, map.dof, d->qvel);
-  scatter(change.T.transpose().lu().solve(in.tau), map.dof, d->qfrc_applied);
+  scatter(change.T.transpose().lu().solve(in.tau + armature), map.dof, d->qfrc_applied);
   mj_kinematics(m, d);
   const std::vector<Eigen::Isometry3d> poses = mujocoLinkPoses(spec, m, d);
   addWrenchesToXfrc(spec, poses, in.wrenches, m, d);
@@ -347,7 +370,7 @@ Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const J
   scatter(change.T * p.qdd_inverse + change.Tdot_v, map.dof, d->qacc);
   mj_inverse(m, d);
   const std::vector<mjtNum> qfrc_wrenches = wrenchGeneralizedForces(spec, poses, in.wrenches, m, d);
-  a.tau = change.T.transpose() * (gather(d->qfrc_inverse, map.dof) - gather(qfrc_wrenches.data(), map.dof));
+  a.tau = change.T.transpose() * (gather(d->qfrc_inverse, map.dof) - gather(qfrc_wrenches.data(), map.dof)) - armature;
   return a;
 }
 

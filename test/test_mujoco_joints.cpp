@@ -35,9 +35,9 @@
 //    τ before handing τ to mj_forward and takes it out of mj_inverse's answer (armatureCorrection). Rotations (ball
 //    joints, a free joint's ω) have the same coordinates on both sides: no correction.
 //
-// So that the comparison can fail, the last test case makes two plausible convention mistakes (a ball's ω read in
-// the joint frame instead of the child's; a free spec joint's linear qvel read in body axes) and requires each to be
-// seen far above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world
+// So that the comparison can fail, the last test case makes three plausible convention mistakes (a ball's ω read in
+// the joint frame instead of the child's; a free spec joint's linear qvel read in body axes; MuJoCo's armature on a
+// free joint taken as ours) and requires each to be seen far above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world
 // is MuJoCo's free base, in our coordinates; at rest, a ball joint is three hinges about the child's axes).
 #include <algorithm>
 #include <cmath>
@@ -76,6 +76,7 @@ enum class Conversion {
   Correct,
   BallRatesInJointFrame,  // a ball's qvel taken as ω in the joint (parent) frame: T block = the joint's rotation
   FreeJointLinearInBody,  // a free spec joint's linear qvel taken as body axes (T = 1 on it)
+  FreeArmatureAsOurs,     // MuJoCo's armature on a free joint's translations taken as zwang's (no correction)
 };
 
 // A random unit quaternion (w x y z), uniform on the sphere: a normalised Gaussian 4-vector.
@@ -340,7 +341,7 @@ Eigen::VectorXd armatureCorrection(const ChainSpec& spec, const FloatingBase& ba
 
 // The same quantities from MuJoCo for (spec, base), in our coordinates by `change`.
 Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const JointsProblem& p,
-                        const VelocityChange& change, bool check_conventions = true) {
+                        const VelocityChange& change, bool check_conventions = true, bool correct_armature = true) {
   const FloatingInput& in = p.input;
   const Mujoco mj(toMjcf(spec, in.gravity, base));
   const mjModel* m = mj.m();
@@ -351,7 +352,8 @@ Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const J
 
   // Forward: the state, τ (with the armature correction) as the generalized force T⁻ᵀ τ, the wrench at its body's
   // COM.
-  const Eigen::VectorXd armature = armatureCorrection(spec, base, in.v);
+  const Eigen::VectorXd armature =
+      correct_armature ? armatureCorrection(spec, base, in.v) : Eigen::VectorXd::Zero(in.v.size());
   scatter(in.q, map.qpos, d->qpos);
   scatter(change.T * in.v, map.dof, d->qvel);
   scatter(change.T.transpose().lu().solve(in.tau + armature), map.dof, d->qfrc_applied);
@@ -375,7 +377,8 @@ Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const J
 }
 
 Answers solveWithMujoco(const JointsProblem& p, Conversion conversion = Conversion::Correct) {
-  return solveWithMujoco(p.spec, p.base, p, velocityChange(p, conversion));
+  return solveWithMujoco(p.spec, p.base, p, velocityChange(p, conversion), true,
+                         conversion != Conversion::FreeArmatureAsOurs);
 }
 
 // max |x − y| / max(1, max |y|) over all entries of a matrix.
@@ -630,14 +633,17 @@ TEST_CASE("joint types: the MuJoCo comparison fails on a wrong velocity conventi
   // Each mistake on 20 random trees that have the joints it concerns: the least disagreement over them must stay far
   // above the tolerance, while the right conversion on the same trees stays within it.
   std::mt19937_64 rng(4712);
-  const Conversion mistakes[] = {Conversion::BallRatesInJointFrame, Conversion::FreeJointLinearInBody};
-  const char* names[] = {"ball omega read in the joint frame", "free joint's linear qvel read in body axes"};
-  for (int k = 0; k < 2; ++k) {
+  const Conversion mistakes[] = {Conversion::BallRatesInJointFrame, Conversion::FreeJointLinearInBody,
+                                 Conversion::FreeArmatureAsOurs};
+  const char* names[] = {"ball omega read in the joint frame", "free joint's linear qvel read in body axes",
+                         "MuJoCo's armature on a free joint's translations taken as ours"};
+  for (int k = 0; k < 3; ++k) {
     double least = 1e300, correct = 0.0;
     for (int trial = 0; trial < 20;) {
-      const JointsProblem p = randomJointsProblem(rng, k == 0 && trial % 2 == 0, k == 1 ? 1.0 : 0.0);
+      const JointsProblem p = randomJointsProblem(rng, k == 0 && trial % 2 == 0, k == 0 ? 0.0 : 1.0);
       bool concerned = false;
-      for (const JointSpec& joint : p.spec.joints) concerned |= k == 0 ? joint.isSpherical() : joint.isFree();
+      for (const JointSpec& joint : p.spec.joints)
+        concerned |= k == 0 ? joint.isSpherical() : joint.isFree() && (k == 1 || joint.reflectedInertia() > 0.0);
       if (!concerned) continue;
       ++trial;
       const Answers ours = solveWithZwang(p);

@@ -73,9 +73,9 @@ Figures compareWithMujoco(const ChainSpec& spec, const FloatingBase& base, const
   mjData* d = mj.d();
   const MujocoCoordinates map = mapCoordinates(spec, base, m);
   const Eigen::MatrixXd T =
-      mistake.no_conversion ? Eigen::MatrixXd::Identity(nv, nv) : mujocoVelocityMap(base, in.q, nv);
+      mistake.no_conversion ? Eigen::MatrixXd::Identity(nv, nv) : mujocoVelocityMap(spec, base, in.q);
   const Eigen::VectorXd Tdot_v =
-      mistake.no_conversion ? Eigen::VectorXd::Zero(nv) : mujocoVelocityMapRate(base, in.q, in.v);
+      mistake.no_conversion ? Eigen::VectorXd::Zero(nv) : mujocoVelocityMapRate(spec, base, in.q, in.v);
 
   Figures f;
   // Forward: τ as generalized forces f_mj = T⁻ᵀ τ, wrenches as xfrc_applied at each body's COM.

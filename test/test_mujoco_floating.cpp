@@ -87,8 +87,9 @@ struct VelocityChange {
   Eigen::VectorXd Tdot_v;
 };
 
-VelocityChange velocityChange(const FloatingBase& base, const FloatingInput& in, int nv, Conversion conversion) {
-  VelocityChange change{mujocoVelocityMap(base, in.q, nv), mujocoVelocityMapRate(base, in.q, in.v)};
+VelocityChange velocityChange(const FloatingProblem& p, Conversion conversion) {
+  const FloatingInput& in = p.input;
+  VelocityChange change{mujocoVelocityMap(p.spec, p.base, in.q), mujocoVelocityMapRate(p.spec, p.base, in.q, in.v)};
   if (conversion == Conversion::FreeLinearInBaseAxes) {
     change.T.setIdentity();
     change.Tdot_v.setZero();
@@ -216,7 +217,7 @@ Answers solveWithMujoco(const FloatingProblem& p, const Eigen::VectorXd& qdd_inv
   mjData* d = mj.d();
   const MujocoCoordinates map = mapCoordinates(p.spec, p.base, m);
   checkMujocoConventions(p.spec, p.base, m, map);
-  const VelocityChange change = velocityChange(p.base, in, m->nv, conversion);
+  const VelocityChange change = velocityChange(p, conversion);
   Answers a;
 
   // Forward: the state, τ as the generalized force T⁻ᵀ τ, each wrench at its body's COM (poses from MuJoCo's own

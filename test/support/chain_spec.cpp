@@ -8,7 +8,23 @@
 
 namespace zwang::testing {
 
-int ChainSpec::dof() const { return static_cast<int>(movingJoints().size()); }
+int ChainSpec::dof() const {
+  int n = 0;
+  for (const JointSpec& joint : joints) n += joint.nv();
+  return n;
+}
+
+int ChainSpec::nq() const {
+  int n = 0;
+  for (const JointSpec& joint : joints) n += joint.nq();
+  return n;
+}
+
+bool ChainSpec::hasMultiDofJoints() const {
+  for (const JointSpec& joint : joints)
+    if (joint.nv() > 1) return true;
+  return false;
+}
 
 std::vector<int> ChainSpec::movingJoints() const {
   std::vector<int> moving;
@@ -34,11 +50,17 @@ void ChainSpec::check() const {
   for (const JointSpec& joint : joints) {
     if (!names.insert("joint:" + joint.name).second)
       throw std::invalid_argument(where + "repeated joint " + joint.name);
-    if (joint.type != "revolute" && joint.type != "continuous" && joint.type != "prismatic" && joint.type != "fixed")
+    if (joint.type != "revolute" && joint.type != "continuous" && joint.type != "prismatic" &&
+        joint.type != "spherical" && joint.type != "free" && joint.type != "fixed")
       throw std::invalid_argument(where + "joint " + joint.name + " has unknown type '" + joint.type + "'");
-    if (!joint.isFixed() && std::abs(joint.axis.norm() - 1.0) > 1e-12)
+    if (joint.nv() == 1 && std::abs(joint.axis.norm() - 1.0) > 1e-12)
       throw std::invalid_argument(where + "joint " + joint.name + " axis is not a unit vector");
+    if (joint.nv() > 1 && joint.isMimic())
+      throw std::invalid_argument(where + "joint " + joint.name + " has several DOFs and cannot mimic");
   }
+  // MimicLaw counts dofs by moving joint: one DOF each.
+  if (hasMimic() && hasMultiDofJoints())
+    throw std::invalid_argument(where + "mimic joints need every moving joint to have one DOF");
   for (std::size_t k = 0; k < joints.size(); ++k)
     if (parentLink(k) > static_cast<int>(k))
       throw std::invalid_argument(where + "joint " + joints[k].name + " has a parent after its child");

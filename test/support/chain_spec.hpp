@@ -28,10 +28,16 @@ struct LinkSpec {
 //  - the child link frame is the joint frame after the joint motion: a rotation
 //    by q about `axis` (revolute, continuous) or a translation by q along
 //    `axis` (prismatic); `axis` is a unit vector in the joint frame;
+//  - beyond URDF, two multi-DOF kinds (issue #25), `axis` unused:
+//    "spherical" (MJCF's ball): q = [w, x, y, z], the unit quaternion of the
+//    child's orientation in the joint frame, v = ω in the child frame (nq = 4, nv = 3);
+//    "free": q = [p; w, x, y, z], the child origin in the joint frame and its
+//    orientation, v = [v; ω], the origin's velocity and the angular velocity,
+//    both in the child frame (nq = 7, nv = 6); neither has limits or a mimic;
 //  - the reflected rotor inertia on the joint is rotor_inertia·gear_ratio².
 struct JointSpec {
   std::string name;
-  std::string type = "revolute";  // "revolute", "continuous", "prismatic", "fixed"
+  std::string type = "revolute";  // "revolute", "continuous", "prismatic", "spherical", "free", "fixed"
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
   Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
@@ -50,6 +56,11 @@ struct JointSpec {
 
   bool isFixed() const { return type == "fixed"; }
   bool isPrismatic() const { return type == "prismatic"; }
+  bool isSpherical() const { return type == "spherical"; }
+  bool isFree() const { return type == "free"; }
+  // Entries of q and of v (q̇, τ, q̈) the joint contributes: 0 fixed, 4 and 3 spherical, 7 and 6 free, else 1.
+  int nq() const { return isFixed() ? 0 : isSpherical() ? 4 : isFree() ? 7 : 1; }
+  int nv() const { return isFixed() ? 0 : isSpherical() ? 3 : isFree() ? 6 : 1; }
   bool isMimic() const { return !mimic.empty(); }
   // rotor_inertia · gear_ratio² (docs/conventions.md, "Joints, links, frames"); 0 for fixed joints.
   double reflectedInertia() const { return isFixed() ? 0.0 : rotor_inertia * gear_ratio * gear_ratio; }
@@ -75,14 +86,19 @@ struct ChainSpec {
   std::vector<LinkSpec> links;
   std::vector<JointSpec> joints;
 
-  // Number of non-fixed joints (the length of q).
+  // Length of v (q̇, τ, q̈): Σ nv of the moving joints; their number when every one has one DOF.
   int dof() const;
+  // Length of q: Σ nq of the moving joints.
+  int nq() const;
+  // True when some moving joint has more than one DOF (spherical, free).
+  bool hasMultiDofJoints() const;
   // Index into `links` of joints[k]'s parent link.
   int parentLink(std::size_t k) const { return joints[k].parent < 0 ? static_cast<int>(k) : joints[k].parent; }
   // True when no joint names a parent other than the previous link.
   bool isChain() const;
-  // Indices into `joints` of the non-fixed joints, in chain order; the k-th
-  // entry is the joint whose position is q(k).
+  // Indices into `joints` of the non-fixed joints, in chain order: the order of
+  // their coordinates in q and v (the k-th entry's position is q(k) when every
+  // joint has one DOF).
   std::vector<int> movingJoints() const;
   // Index into `links` of the link with this name; throws std::invalid_argument
   // naming the link when there is none.

@@ -68,7 +68,7 @@ struct FloatingBase {
 
   int nqBase() const { return kind == BaseKind::Free ? 7 : kind == BaseKind::Planar ? 3 : 0; }
   int nvBase() const { return kind == BaseKind::Free ? 6 : kind == BaseKind::Planar ? 3 : 0; }
-  int nq(const ChainSpec& spec) const { return nqBase() + spec.dof(); }
+  int nq(const ChainSpec& spec) const { return nqBase() + spec.nq(); }
   int nv(const ChainSpec& spec) const { return nvBase() + spec.dof(); }
 };
 

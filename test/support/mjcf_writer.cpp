@@ -73,9 +73,13 @@ struct Writer {
         << quat(rpyToMatrix(joint.rpy)) << "\">\n";
     const std::string inner = indent + "  ";
     if (!joint.isFixed()) {
-      out << inner << "<joint name=\"" << xmlEscape(joint.name) << "\" type=\""
-          << (joint.isPrismatic() ? "slide" : "hinge") << "\" pos=\"0 0 0\" axis=\"" << vec(joint.axis)
-          << "\" limited=\"false\" armature=\"" << num(joint.reflectedInertia())
+      const char* type = joint.isPrismatic()   ? "slide"
+                         : joint.isSpherical() ? "ball"
+                         : joint.isFree()      ? "free"
+                                               : "hinge";
+      out << inner << "<joint name=\"" << xmlEscape(joint.name) << "\" type=\"" << type << "\" pos=\"0 0 0\"";
+      if (joint.nv() == 1) out << " axis=\"" << vec(joint.axis) << "\"";
+      out << " limited=\"false\" armature=\"" << num(joint.reflectedInertia())
           << "\" damping=\"0\" stiffness=\"0\" frictionloss=\"0\"/>\n";
     }
     inertial(link, inner);
@@ -92,14 +96,23 @@ std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity) {
 
 std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const FloatingBase& base) {
   spec.check();  // among others: every joint's parent link comes before its child, so the links form a tree
-  Writer writer{spec, std::vector<std::vector<int>>(spec.links.size()), {}};
+  // Per link, the joints it is the parent of; one more entry: the free joints (top-level bodies).
+  Writer writer{spec, std::vector<std::vector<int>>(spec.links.size() + 1), {}};
   for (std::size_t k = 0; k < spec.joints.size(); ++k) {
     const JointSpec& joint = spec.joints[k];
     const LinkSpec& child = spec.links[k + 1];
     if (!joint.isFixed() && !(child.mass > 0.0))
       throw std::invalid_argument("toMjcf('" + spec.name + "'): link " + child.name + " moves on joint " + joint.name +
                                   " but has no mass (MuJoCo refuses a moving body without mass)");
-    writer.child_joints[static_cast<std::size_t>(spec.parentLink(k))].push_back(static_cast<int>(k));
+    if (joint.isFree() &&
+        (base.kind != BaseKind::Fixed || spec.parentLink(k) != 0 || !joint.xyz.isZero(0.0) || !joint.rpy.isZero(0.0)))
+      throw std::invalid_argument("toMjcf('" + spec.name + "'): free joint " + joint.name +
+                                  " must hang at the identity from the root link of a fixed base (MuJoCo's free "
+                                  "joints are on top-level bodies)");
+    // A free joint's body is written at the top level, beside links[0]'s (the same place: the root link is the
+    // world); every other body in its parent link's.
+    writer.child_joints[joint.isFree() ? spec.links.size() : static_cast<std::size_t>(spec.parentLink(k))].push_back(
+        static_cast<int>(k));
     if (base.kind != BaseKind::Fixed && (joint.name == kMjcfFreeJoint || joint.name == kMjcfPlanarX ||
                                          joint.name == kMjcfPlanarY || joint.name == kMjcfPlanarYaw))
       throw std::invalid_argument("toMjcf('" + spec.name + "'): joint " + joint.name +
@@ -144,8 +157,9 @@ std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const 
   }
   writer.inertial(spec.links[0], "      ");
   for (const int k : writer.child_joints[0]) writer.body(k, "      ");
-  out << "    </body>\n"
-      << "  </worldbody>\n"
+  out << "    </body>\n";
+  for (const int k : writer.child_joints[spec.links.size()]) writer.body(k, "    ");
+  out << "  </worldbody>\n"
       << "</mujoco>\n";
   return out.str();
 }

@@ -10,10 +10,15 @@
 //    as a unit quaternion "w x y z");
 //  - a moving joint is a <joint> of the body, named as the joint, at the body
 //    origin (pos="0 0 0"): type "hinge" (revolute, continuous) or "slide"
-//    (prismatic), its axis in the body (= joint) frame, armature = the reflected
-//    rotor inertia rotor_inertia·gear_ratio², no damping, stiffness, friction
-//    loss or limits (limited="false"); a fixed joint writes no <joint>: the body
-//    is welded to its parent;
+//    (prismatic), its axis in the body (= joint) frame, or "ball" (spherical:
+//    qpos = our quaternion, qvel = our ω in the body frame) or "free" (free:
+//    qpos ours, qvel's linear part in WORLD axes, support/mujoco_bridge.hpp),
+//    armature = the reflected rotor inertia rotor_inertia·gear_ratio² (on each
+//    DOF), no damping, stiffness, friction loss or limits (limited="false"); a
+//    fixed joint writes no <joint>: the body is welded to its parent. MuJoCo
+//    2.2.2 takes free joints on top-level bodies only: a free spec joint must
+//    hang at the identity from links[0] of a fixed base, and its body is
+//    written at the top level (links[0] is the world's frame);
 //  - a link with mass gets <inertial pos=com quat mass diaginertia>: the URDF
 //    inertia I (about the COM, axes R = R(inertial_rpy)) diagonalised here,
 //    I = V Λ Vᵀ, quat = R V, diaginertia = Λ (not fullinertia: MuJoCo 2.2.2's
@@ -39,7 +44,8 @@ namespace zwang::testing {
 // Throws std::invalid_argument when ChainSpec::check does (a parent after its
 // child among others) or, naming the link, when a moving joint's child link has
 // no mass (MuJoCo refuses a moving body without mass; the random trees and
-// chains give every link mass). Any tree, depth first or not: MuJoCo numbers
+// chains give every link mass), or when a free joint is not where MuJoCo takes
+// it (above). Any tree, depth first or not: MuJoCo numbers
 // the dofs depth first, children in joint order, so a caller maps vectors by
 // joint name.
 std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity);

@@ -62,12 +62,43 @@ MujocoCoordinates mapCoordinates(const ChainSpec& spec, const FloatingBase& base
   }
   for (const int k : spec.movingJoints()) {
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
-    const int id = jointId(m, joint.name, joint.isPrismatic() ? mjJNT_SLIDE : mjJNT_HINGE);
-    map.qpos.push_back(m->jnt_qposadr[id]);
-    map.dof.push_back(m->jnt_dofadr[id]);
+    const int type = joint.isPrismatic()   ? mjJNT_SLIDE
+                     : joint.isSpherical() ? mjJNT_BALL
+                     : joint.isFree()      ? mjJNT_FREE
+                                           : mjJNT_HINGE;
+    const int id = jointId(m, joint.name, type);
+    for (int i = 0; i < joint.nq(); ++i) map.qpos.push_back(m->jnt_qposadr[id] + i);
+    for (int i = 0; i < joint.nv(); ++i) map.dof.push_back(m->jnt_dofadr[id] + i);
   }
   return map;
 }
+
+namespace {
+
+// A free joint's place in q and v and its child's orientation ⁰R (the joint hangs from the world at the identity).
+struct FreeBlock {
+  Eigen::Index v = 0;
+  Eigen::Matrix3d R;
+};
+
+// The base's free joint, then the spec's free joints (q and v laid out as mapCoordinates does).
+std::vector<FreeBlock> freeBlocks(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q) {
+  std::vector<FreeBlock> blocks;
+  if (base.kind == BaseKind::Free) blocks.push_back({0, basePose(base, q).linear()});
+  Eigen::Index qi = base.nqBase(), vi = base.nvBase();
+  for (const int k : spec.movingJoints()) {
+    const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
+    if (joint.isFree()) {
+      const Eigen::Quaterniond quat(q(qi + 3), q(qi + 4), q(qi + 5), q(qi + 6));  // w x y z
+      blocks.push_back({vi, quat.normalized().toRotationMatrix()});
+    }
+    qi += joint.nq();
+    vi += joint.nv();
+  }
+  return blocks;
+}
+
+}  // namespace
 
 void scatter(const Eigen::VectorXd& x, const std::vector<int>& address, mjtNum* to) {
   for (std::size_t i = 0; i < address.size(); ++i) to[address[i]] = x(static_cast<Eigen::Index>(i));
@@ -79,16 +110,19 @@ Eigen::VectorXd gather(const mjtNum* from, const std::vector<int>& address) {
   return x;
 }
 
-Eigen::MatrixXd mujocoVelocityMap(const FloatingBase& base, const Eigen::VectorXd& q, int nv) {
+Eigen::MatrixXd mujocoVelocityMap(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q) {
+  const int nv = base.nv(spec);
   Eigen::MatrixXd T = Eigen::MatrixXd::Identity(nv, nv);
-  if (base.kind == BaseKind::Free) T.topLeftCorner<3, 3>() = basePose(base, q).linear();
+  for (const FreeBlock& block : freeBlocks(spec, base, q)) T.block<3, 3>(block.v, block.v) = block.R;
   return T;
 }
 
-Eigen::VectorXd mujocoVelocityMapRate(const FloatingBase& base, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+Eigen::VectorXd mujocoVelocityMapRate(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q,
+                                      const Eigen::VectorXd& v) {
   Eigen::VectorXd rate = Eigen::VectorXd::Zero(v.size());
-  if (base.kind == BaseKind::Free)
-    rate.head<3>() = basePose(base, q).linear() * Eigen::Vector3d(v.segment<3>(3)).cross(Eigen::Vector3d(v.head<3>()));
+  for (const FreeBlock& block : freeBlocks(spec, base, q))
+    rate.segment<3>(block.v) =
+        block.R * Eigen::Vector3d(v.segment<3>(block.v + 3)).cross(Eigen::Vector3d(v.segment<3>(block.v)));
   return rate;
 }
 

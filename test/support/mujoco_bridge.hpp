@@ -14,6 +14,9 @@
 //  * joints are mapped by name (mj_name2id), never by position: MuJoCo numbers
 //    its dofs depth first through the MJCF body tree;
 //  * hinge and slide joints: qpos, qvel, qacc, qfrc_* are our q, q̇, q̈, τ;
+//  * ball joints (our spherical): the same: qpos = the child's quaternion in the joint frame, w x y z, as ours;
+//    qvel = ω in the child (body) frame, as ours; qfrc = the moment in the child frame;
+//  * free joints in the spec (on top-level bodies: the child's pose in the world) as the free base below;
 //  * Planar base (slide x, slide y, hinge z in the plane's axes): the same;
 //  * Free base: qpos = [p; w x y z] is our q, but MuJoCo's free joint has
 //      u = qvel = [ṗ in WORLD axes; ω in BODY axes],  u̇ = qacc = [p̈ world; ω̇ body],
@@ -75,10 +78,12 @@ MujocoCoordinates mapCoordinates(const ChainSpec& spec, const FloatingBase& base
 void scatter(const Eigen::VectorXd& x, const std::vector<int>& address, mjtNum* to);
 Eigen::VectorXd gather(const mjtNum* from, const std::vector<int>& address);
 
-// T with u_mujoco = T v (our order, nv × nv): the identity but for R = ⁰R_base on a free base's linear velocity.
-Eigen::MatrixXd mujocoVelocityMap(const FloatingBase& base, const Eigen::VectorXd& q, int nv);
-// Ṫ v = [R (ω × v_lin); 0] for a free base (nv entries), 0 otherwise.
-Eigen::VectorXd mujocoVelocityMapRate(const FloatingBase& base, const Eigen::VectorXd& q, const Eigen::VectorXd& v);
+// T with u_mujoco = T v (our order, nv × nv): the identity but for R = ⁰R_child on the linear velocity of a free
+// base and of each free spec joint (which hangs from the world: mjcf_writer.hpp).
+Eigen::MatrixXd mujocoVelocityMap(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q);
+// Ṫ v: [R (ω × v_lin); 0] on each free joint's entries (the base's and the spec's), 0 elsewhere.
+Eigen::VectorXd mujocoVelocityMapRate(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q,
+                                      const Eigen::VectorXd& v);
 
 // ⁰T_link of every spec link (index as spec.links) as MuJoCo placed its body (xpos, xmat), after mj_kinematics (or
 // mj_forward) on the qpos in d.

@@ -95,6 +95,8 @@ Model modelFromSpecByBuilder(const ChainSpec& spec) {
     joint.name = js.name;
     joint.type = js.isPrismatic()          ? JointType::Prismatic
                  : js.type == "continuous" ? JointType::Continuous
+                 : js.isSpherical()        ? JointType::Spherical
+                 : js.isFree()             ? JointType::Free
                                            : JointType::Revolute;
     joint.axis = js.axis;
     joint.placement = placement;
@@ -102,7 +104,7 @@ Model modelFromSpecByBuilder(const ChainSpec& spec) {
     joint.breakaway_friction = js.friction;
     joint.kinetic_friction = js.friction;
     joint.viscous_friction = js.damping;
-    if (joint.type != JointType::Continuous) {
+    if (joint.type != JointType::Continuous && js.nv() == 1) {  // multi-DOF joints have no position limits
       joint.lower = js.lower;
       joint.upper = js.upper;
     }

@@ -465,3 +465,37 @@ TEST_CASE("configuration joints: messages name the joint and the coordinate", "[
   big[13] = 1e300;  // drone linear velocity x
   expect(integrate(model, q, big, 1e10, out), StatusCode::NonFinite, {"joint 'drone' position", "too large"});
 }
+
+TEST_CASE("configuration joints: entries up to 1e100 never overflow (one pass), beyond them errors change nothing",
+          "[configuration]") {
+  // integrate and difference skip their overflow checks when every entry of
+  // q and v·dt is at most 1e100 (configuration.cpp): the outputs must then be finite.
+  const Model model = handModel();
+  std::mt19937_64 rng(2514);
+  Eigen::VectorXd q(model.nq()), q1(model.nq()), out(model.nq()), dv(model.nv());
+  for (int draw = 0; draw < 2000; ++draw) {
+    std::uint64_t state = rng();
+    REQUIRE(randomConfiguration(model, state, q));
+    REQUIRE(randomConfiguration(model, state, q1));
+    Eigen::VectorXd v(model.nv());
+    for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = (rng() % 2 ? 1e100 : -1e100) * uniform(rng, 0.5, 1.0);
+    for (const Joint& joint : model.allJoints())  // positions and one-DOF coordinates at the bound too
+      for (int k = 0; k < (joint.type == JointType::Spherical ? 0
+                           : joint.type == JointType::Free    ? 3
+                                                              : joint.nq());
+           ++k) {
+        q[joint.q_index + k] = rng() % 2 ? 1e100 : -1e100;
+        q1[joint.q_index + k] = rng() % 2 ? 1e100 : -1e100;
+      }
+    REQUIRE(integrate(model, q, v, 1.0, out));
+    CHECK(out.allFinite());
+    REQUIRE(difference(model, q, q1, dv));
+    CHECK(dv.allFinite());
+  }
+  // Beyond the bound the checks run: an overflow in the last joint leaves q_out as it was.
+  Eigen::VectorXd v = Eigen::VectorXd::Constant(model.nv(), 1e200);
+  out.setConstant(-7.0);
+  const Status s = integrate(model, q, v, 1e200, out);
+  CHECK(s.code == StatusCode::NonFinite);
+  CHECK((out.array() == -7.0).all());
+}

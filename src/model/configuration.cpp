@@ -27,6 +27,15 @@ constexpr double kSeriesBelow = 1e-3;
 // The most coordinates one joint has (a free joint's q).
 constexpr int kMaxJointCoordinates = 7;
 
+// No joint's integrate or difference overflows when every entry of q (q0, q1)
+// and v·dt is at most this large: the largest intermediate, a free joint's
+// [w]×²u with |w|, |u| ≤ √3·1e100, stays under 1e301.
+constexpr double kCannotOverflow = 1e100;
+
+double largestMagnitude(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff();
+}
+
 // ---- What each joint type's coordinates are (the one place a new type adds its names)
 
 // Where a joint's unit quaternion starts among its own q entries; −1: it has none.
@@ -431,11 +440,14 @@ Status integrate(const Model& model, const ConstVector& q, const ConstVector& v,
   if (!std::isfinite(dt)) return Status::error(StatusCode::NonFinite, "dt is %g (not finite)", dt);
   if (Status s = checkConfigurationSize(model, "q_out", q_out.size()); !s) return s;
 
-  // Every joint's step is checked before q_out is touched (an overflow must
-  // leave it unchanged), then taken again into q_out; each joint reads only
-  // its own entries, so q_out may be q.
+  // An error must leave q_out unchanged: unless the sizes rule an overflow
+  // out, every joint's step is taken and checked before q_out is touched.
+  // Each joint reads only its own entries, so q_out may be q.
   double next[kMaxJointCoordinates];
-  for (const Joint& joint : model.allJoints()) {
+  const bool may_overflow =
+      !(largestMagnitude(q) <= kCannotOverflow && largestMagnitude(v) * std::abs(dt) <= kCannotOverflow);
+  for (std::size_t j = 0; may_overflow && j < model.allJoints().size(); ++j) {
+    const Joint& joint = model.allJoints()[j];
     integrateJoint(joint.type, q.data() + joint.q_index, v.data() + joint.v_index, dt, next);
     for (int k = 0; k < joint.nq(); ++k)
       if (!std::isfinite(next[k]))
@@ -455,11 +467,13 @@ Status difference(const Model& model, const ConstVector& q0, const ConstVector& 
   if (Status s = checkConfigurationNamed(model, "q1", q1); !s) return s;
   if (v_out.size() != model.nv()) return sizeMismatch(model, "v_out", v_out.size(), true);
 
-  // Every joint's difference is checked before v_out is touched: differences
-  // of finite numbers may still overflow (1e308 − (−1e308)), and an error
-  // leaves v_out unchanged.
+  // Differences of finite numbers may still overflow (1e308 − (−1e308)), and
+  // an error must leave v_out unchanged: unless the sizes rule an overflow
+  // out, every joint's difference is checked before v_out is touched.
   double d[kMaxJointCoordinates];
-  for (const Joint& joint : model.allJoints()) {
+  const bool may_overflow = !(largestMagnitude(q0) <= kCannotOverflow && largestMagnitude(q1) <= kCannotOverflow);
+  for (std::size_t j = 0; may_overflow && j < model.allJoints().size(); ++j) {
+    const Joint& joint = model.allJoints()[j];
     differenceJoint(joint.type, q0.data() + joint.q_index, q1.data() + joint.q_index, d);
     for (int k = 0; k < joint.nv(); ++k)
       if (!std::isfinite(d[k]))

@@ -136,6 +136,10 @@ def test_builder_errors():
     with pytest.raises(ValueError, match="set_base: unknown base 'fixed'"):
         b.set_base("fixed")
     assert b.add_joint("j", "spherical", "l", mass=1.0) is b  # chains
+    c, s = math.cos(0.3), math.sin(0.3)
+    P = np.array([[c, -s, 0, 0.1], [s, c, 0, 0.2], [0, 0, 1, 0.3], [0, 0, 0, 1.0]])
+    b.add_joint("k", "revolute", "m", mass=1.0, placement=P)
+    np.testing.assert_array_equal(b.build().joint("k").placement, P)  # the pose given is the pose read back
     with pytest.raises(zwang.ModelError, match="zero mass on a moving body"):
         zwang.ModelBuilder().add_joint("j", "free", "l").build()
 

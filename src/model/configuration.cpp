@@ -32,9 +32,7 @@ constexpr int kMaxJointCoordinates = 7;
 // [w]×²u with |w|, |u| ≤ √3·1e100, stays under 1e301.
 constexpr double kCannotOverflow = 1e100;
 
-double largestMagnitude(const Eigen::Ref<const Eigen::VectorXd>& x) {
-  return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff();
-}
+double largestMagnitude(const ConstVector& x) { return x.size() == 0 ? 0.0 : x.cwiseAbs().maxCoeff(); }
 
 // ---- What each joint type's coordinates are (the one place a new type adds its names)
 

@@ -61,7 +61,7 @@ void printTable(const std::vector<std::vector<std::string>>& rows) {
 // Either way it is shown apart from the bodies the joints move.
 struct Masses {
   double moving = 0.0, base = 0.0;
-  explicit Masses(const Model& model) : base(model.inertia(0).mass) {
+  explicit Masses(const Model& model) : base(model.inertia(model.baseBody()).mass) {
     for (int b = 1; b < model.bodyCount(); ++b) moving += model.inertia(b).mass;
   }
 };

@@ -381,7 +381,7 @@ void bindModel(py::module_& m) {
       if (b != model.baseBody()) mass += model.inertia(b).mass;
     return mass;
           },
-          "total mass of the moving bodies [kg]")
+          "total mass of the bodies beyond the base [kg] (base_mass is the base's)")
       .def(
           "with_rotor_inertia",
           [](const Model& model, py::handle values) {

@@ -450,16 +450,15 @@ TEST_CASE("configuration joints: messages name the joint and the coordinate", "[
   bad.segment<4>(18).setZero();
   expect(checkConfiguration(model, bad), StatusCode::BadConfiguration,
          {"q: joint 'drone' quaternion (entries 18-21, w x y z) is zero: not an orientation"});
-  // Sizes: multi-DOF joints count their coordinates.
+  // Sizes: multi-DOF joints count their coordinates (worded as the solver words qd, tau).
   Eigen::VectorXd short_q = q.head(model.nq() - 1);
   expect(checkConfiguration(model, short_q), StatusCode::SizeMismatch,
-         {"q has 23 entries, the model has nq = 24 (7 base coordinates + 17 coordinates of 6 joints)"});
-  expect(
-      integrate(model, q, v.head(model.nv() - 1), 0.1, out), StatusCode::SizeMismatch,
-      {"v has 20 entries, the model has nv = 21 (6 base velocity coordinates + 15 velocity coordinates of 6 joints)"});
+         {"q has 23 entries, the model has nq = 24 (7 base coordinates + 17 joint coordinates)"});
+  expect(integrate(model, q, v.head(model.nv() - 1), 0.1, out), StatusCode::SizeMismatch,
+         {"v has 20 entries, the model has nv = 21 (6 base velocity coordinates + 15 joint DOFs)"});
   const Model fixed = handModel(BaseType::Fixed);
   expect(checkConfiguration(fixed, short_q), StatusCode::SizeMismatch,
-         {"q has 23 entries, the model has nq = 17 (17 coordinates of 6 joints)"});
+         {"q has 23 entries, the model has nq = 17 (0 base coordinates + 17 joint coordinates)"});
   // Overflows name the entry.
   Eigen::VectorXd big = v;
   big[13] = 1e300;  // drone linear velocity x

@@ -111,26 +111,20 @@ EntryName entryName(const Model& model, Eigen::Index k, bool velocity) {
 EntryName configurationEntry(const Model& model, Eigen::Index k) { return entryName(model, k, false); }
 EntryName velocityEntry(const Model& model, Eigen::Index k) { return entryName(model, k, true); }
 
-// `what` has the wrong size: say what the model's nq (or nv) entries are.
+// `what` has the wrong size: say what the model's nq (or nv) entries are,
+// worded as the solver's other state vectors are (dynamics/checks.cpp).
 Status sizeMismatch(const Model& model, const char* what, Eigen::Index size, bool velocity) {
   const int n = velocity ? model.nv() : model.nq();
   const int base = velocity ? model.baseVelocitySize() : model.baseConfigurationSize();
   const int joints = static_cast<int>(model.joints().size());
-  const char* coordinates = velocity ? "velocity coordinates" : "coordinates";
-  const char* n_name = velocity ? "nv" : "nq";
   const long given = static_cast<long>(size);
-  char below[96];  // the joints' share: "7 joints", or "9 coordinates of 5 joints" with multi-DOF joints
-  if (n - base == joints)
-    std::snprintf(below, sizeof below, "%d joints", joints);
-  else
-    std::snprintf(below, sizeof below, "%d %s of %d joints", n - base, coordinates, joints);
-  if (base == 0 && n == joints)  // worded as the solver's other state vectors are
+  if (base == 0 && n == joints)  // one-DOF joints on a fixed base
     return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %d joints", what, given, joints);
-  if (base == 0)
-    return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %s = %d (%s)", what, given,
-                         n_name, n, below);
-  return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %s = %d (%d base %s + %s)", what,
-                       given, n_name, n, base, coordinates, below);
+  // "joints" while every joint below the root has one coordinate, else what they have.
+  const char* below = n - base == joints ? "joints" : velocity ? "joint DOFs" : "joint coordinates";
+  return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %s = %d (%d base %s + %d %s)", what,
+                       given, velocity ? "nv" : "nq", n, base, velocity ? "velocity coordinates" : "coordinates",
+                       n - base, below);
 }
 
 Status checkConfigurationSize(const Model& model, const char* what, Eigen::Index size) {

@@ -10,7 +10,7 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
       mimic_rows_(static_cast<int>(model.mimicJoints().size())) {
   const auto bodies = static_cast<std::size_t>(model.bodyCount());
   const int n = dof_, m = balanceCapacity();
-  const int nv = model.nv(), k = model.baseVelocitySize();
+  const int nv = model.nv();
   solution.qdd.setZero(nv);
   solution.nu.setZero(0);
   solution.tau_constraint.setZero(nv);
@@ -29,13 +29,6 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   inverse_D.assign(bodies, 0.0);
   u.assign(bodies, 0.0);
   const int columns = columnCapacity();
-  S_base.setZero(6, k);
-  IAS_base.setZero(6, k);
-  D_base.compute(MatrixXmax6::Identity(k, k));  // sized once: compute() on k × k later allocates nothing
-  u_base.setZero(k);
-  qdd_base.setZero(k);
-  SA_base.setZero(6, columns);
-  SA_base_D.setZero(6, columns);
   SA.setZero(columns, static_cast<Eigen::Index>(bodies));
   Ahat.setZero(6, columns);
   U.setZero(columns);

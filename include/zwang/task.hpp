@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "zwang/model.hpp"
@@ -87,12 +88,14 @@ class Task {
   int addRelativeConstraint(const std::string& frame, const std::string& reference, const ConstraintMatrix& A,
                             Expressed expressed = Expressed::Reference);
 
-  /// Constrain the acceleration of moving joint `joint`: q̈_joint = b (one row,
-  /// b starts at 0). Its force is a torque (a force, for a prismatic joint)
-  /// along the joint, equal and opposite on the two bodies it connects: what
-  /// the joint's own motor gives. So a posture held joint by joint is held by
-  /// the motors, also on a floating base (docs/solver.md, "Joint rows and
-  /// contacts"). ModelError for a joint index out of range. Returns the row.
+  /// Constrain the acceleration of moving joint `joint` (an index in
+  /// Model::joints()): q̈_joint = b, one row per DOF of the joint in the order
+  /// of its entries of v (b starts at 0). Its force is a torque (a force, for
+  /// a translation) along each DOF, equal and opposite on the two bodies it
+  /// connects: what the joint's own motor gives. So a posture held joint by
+  /// joint is held by the motors, also on a floating base (docs/solver.md,
+  /// "Joint rows and contacts"). ModelError for a joint index out of range.
+  /// Returns the first row.
   int addJointConstraint(int joint);
   /// The same, with the joint given by name (ModelError for an unknown name).
   int addJointConstraint(const std::string& joint);
@@ -158,10 +161,11 @@ class Task {
     ConstraintMatrix A;           ///< 6 × rows
     int reference = -1;           ///< the frame a relative constraint refers to (−1: the world)
     bool reference_side = false;  ///< this entry is the reference (or parent body's) side
-    /// A piece of a joint row (rows = 1, A unused): coefficient·q̈_joint, read
-    /// as a unit effort along the joint on the joint's body and its opposite
-    /// on the parent body (reference_side). −1: a frame constraint.
-    int joint = -1;
+    /// A piece of a joint row (rows = 1, A unused): coefficient·q̈_dof, for
+    /// the DOF of this entry of v, read as a unit effort along it on the body
+    /// it moves and its opposite on the parent body (reference_side). −1: a
+    /// frame constraint.
+    int dof = -1;
     double coefficient = 0.0;  ///< 1 for the joint of a joint row or a mimic joint, −multiplier for a leader
     bool mimic_row = false;    ///< a piece of a mimic row (its first_row counts the mimic rows)
     bool contact = false;      ///< the environment supplies its force (addContact)
@@ -222,7 +226,8 @@ class Task {
   int mimic_rows_ = 0;
   bool has_contacts_ = false;
   std::vector<char> contact_column_;
-  std::vector<int> joint_bodies_parent_;  // per joint, the body it hangs from (copied from the model)
+  std::vector<std::pair<int, int>> joint_dofs_;  // per joint, its v_index and nv (copied from the model)
+  std::vector<int> dof_parent_bodies_;            // per DOF, the parent of the body it moves
   std::vector<int> body_frames_;          // per body, its frame
   std::vector<Mimic> mimic_laws_;         // the law of each mimic row (its mimic joint below)
   std::vector<int> mimic_joint_of_row_;

@@ -4,9 +4,9 @@
 /// thread: the Model is shared, the Workspace is not.
 ///
 /// The members are named after the report's Algorithm 1 (chapter 4.2); index i
-/// is a body (0 = the base, fixed or floating), joint i−1 moves body i (from
-/// its parent). A floating base is the joint of body 0 to the world, with k = 6
-/// (free) or 3 (planar) coordinates: its quantities are the `*_base` members.
+/// is a body (model.hpp: one per DOF; 0 = the world, or a fixed base), DOF i−1
+/// moves body i (from its parent). A joint of nv DOFs, a floating base's root
+/// joint among them, is nv bodies: D_i, u_i, S_i are one DOF's.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -149,7 +149,7 @@ class Workspace {
   /// Move assignment.
   Workspace& operator=(Workspace&&) noexcept;
 
-  /// Joint count of the model the workspace was made for.
+  /// Model::dof() of the model the workspace was made for.
   int dof() const { return dof_; }
   /// The most constraint rows a task solved here may have.
   int constraintCapacity() const { return capacity_; }
@@ -186,18 +186,9 @@ class Workspace {
   std::vector<Mat6> IA;           ///< I^A_i
   std::vector<Vec6> FA;           ///< F^A_bias,i
   std::vector<Vec6> IAS;          ///< I^A_i S_i
-  std::vector<double> D;          ///< D_i = d_i + S_iᵀ I^A_i S_i
+  std::vector<double> D;          ///< D_i = d_i + S_iᵀ I^A_i S_i (a joint's D: these pivots are its LDLᵀ factor)
   std::vector<double> inverse_D;  ///< 1 / D_i (the sweeps multiply)
   std::vector<double> u;          ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
-  // --- a floating base: the joint of body 0 to the world, k = 6 or 3 coordinates
-  Matrix6Xmax S_base;                ///< S₀ (6 × k), base coordinates of the base's motion
-  Matrix6Xmax IAS_base;              ///< I^A₀ S₀ (6 × k)
-  Eigen::LLT<MatrixXmax6> D_base;    ///< D₀ = S₀ᵀ I^A₀ S₀ (k × k), factorised
-  VectorXmax6 u_base;                ///< τ₀ − S₀ᵀ(F^A₀ + I^A₀ Ẍ_bias,0) (k)
-  VectorXmax6 qdd_base;              ///< q̈₀ in the sweep's coordinates (k)
-  Eigen::MatrixXd SA_base;           ///< S₀ᵀ A₀ (k × columns; 6 rows kept)
-  Eigen::MatrixXd SA_base_D;         ///< D₀⁻¹ S₀ᵀ A₀ (k × columns; 6 rows kept)
-  double base_D_inverse_norm = 0.0;  ///< ‖D₀⁻¹‖₁, the size rounding in 𝓛 is relative to
   Eigen::MatrixXd SA;                ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
   ConstraintMatrix Ahat;             ///< A_i (6 × capacity), updated in place from A_N down to A_0
   /// U_0, acceleration energy of bias forces and torques: the report's U (not

@@ -4,7 +4,10 @@
 
 #include <Eigen/Core>
 
+#include "zwang/configuration.hpp"
+#include "zwang/model.hpp"
 #include "zwang/status.hpp"
+#include "zwang/workspace.hpp"
 
 namespace zwang::internal {
 
@@ -28,5 +31,32 @@ inline Status checkFinite(const char* name, const Eigen::MatrixBase<Derived>& x)
                            x.derived().data()[k], static_cast<long>(k));
   return {};
 }
+
+// The state checks of every algorithm, for q (nq() entries) and the vectors of
+// nv() entries (q̇, q̈, τ). A model without quaternions checks q inline: the
+// hot path pays for no call and no extra Status (each one zeroes its 240-byte
+// message); a quaternion's norm goes to checkConfiguration. The size messages
+// name the base's share when there is one ("… the model has nv = 9 (3 base
+// velocity coordinates + 6 joint DOFs)").
+Status velocitySizeMismatch(const Model& model, const char* name, Eigen::Index size);
+inline Status checkStateConfiguration(const Model& model, const VectorRef& q) {
+  return model.nq() == model.nv() && model.nv() == model.dof() ? checkVector("q", q, model.nq())
+                                                               : checkConfiguration(model, q);
+}
+inline Status checkVelocityVector(const Model& model, const char* name, const VectorRef& x) {
+  if (x.size() != model.nv()) return velocitySizeMismatch(model, name, x.size());
+  return checkVector(name, x, model.nv());  // the size holds: only the finiteness message can come back
+}
+
+// A workspace made for a model with the same joints but another base (its H
+// and τ are nv × nv and nv) must be refused before anything is written:
+// Workspace::dof() alone cannot tell a fixed arm from the same arm floating.
+inline bool workspaceFitsModel(const Model& model, const Workspace& ws) {
+  return ws.tau.size() == model.nv() && ws.H.rows() == model.nv() && ws.H.cols() == model.nv() &&
+         static_cast<int>(ws.S.size()) == model.bodyCount();
+}
+// The ModelMismatch status for a workspace that does not fit (names both nv),
+// or SizeMismatch for a workspace that fits whose H or τ a user resized.
+Status workspaceMismatch(const Model& model, const Workspace& ws);
 
 }  // namespace zwang::internal

@@ -2,7 +2,6 @@
 // (src/dynamics/popov_vereshchagin.cpp holds each stage, next to the report's lines).
 #include "zwang/hybrid_dynamics.hpp"
 
-#include "dynamics/floating_base.hpp"
 #include "dynamics/popov_vereshchagin.hpp"
 
 namespace zwang {
@@ -20,7 +19,7 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   balance(task, ws);                                               // lines 23–25
   outwardAccelerations(model, task, ws, out.qdd);                  // lines 26–30
   ws.kinematics.stage = KinematicsStage::Accelerations;
-  if (model.hasFloatingBase()) out.base_acceleration_world = baseClassicalAcceleration(task, ws);
+  out.base_acceleration_world = baseClassicalAcceleration(model, ws);
   taskResidual(task, ws);  // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(task.solverColumns()), out.tau_constraint);

@@ -1,7 +1,6 @@
 #include "zwang/kinematics.hpp"
 
 #include "dynamics/checks.hpp"
-#include "dynamics/floating_base.hpp"
 #include "dynamics/sweeps.hpp"
 
 namespace zwang {
@@ -9,27 +8,45 @@ namespace internal {
 
 void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia) {
-  const bool with_velocity = qd.size() == model.dof();
-  for (int i = 1; i <= model.dof(); ++i) {
-    const auto b = static_cast<std::size_t>(i);
-    const auto p = static_cast<std::size_t>(model.parent(i));
-    const Joint& joint = model.joint(i - 1);
-    const Transform& X = ws.Xworld[b] = joint.transform(q[i - 1]) * ws.Xworld[p];  // line 4: ⁱX₀
-    // S_i in base coordinates: [p × a; a] (revolute) or [a; 0] (prismatic),
-    // a = ᵂR_i axis, p the body origin.
-    const Vec3 a = X.E.transpose() * joint.axis;
-    if (joint.isRevolute())
-      ws.S[b] << X.r.cross(a), a;
-    else
-      ws.S[b] << a, Vec3::Zero();
-    if (with_inertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
+  // Joint by joint (the one place a joint's type matters: its transform), then
+  // DOF by DOF: body k + 1 takes the joint's child pose and DOF k's axis.
+  const bool with_velocity = qd.size() == model.nv();
+  const std::vector<Dof>& dofs = model.dofs();
+  for (const Joint& joint : model.allJoints()) {
+    const int first = joint.v_index + 1, last = joint.v_index + joint.nv();
+    const auto p = static_cast<std::size_t>(model.parent(first));
+    const Transform X = joint.transform(q.data() + joint.q_index) * ws.Xworld[p];  // line 4: ⁱX₀
+    Vec6 vJ_child = Vec6::Zero(), vJ_joint_frame = Vec6::Zero();  // S q̇ by the frame its axes are fixed in
+    for (int i = first; i <= last; ++i) {
+      const auto b = static_cast<std::size_t>(i);
+      const Dof& dof = dofs[b - 1];
+      ws.Xworld[b] = X;
+      // S_i in base coordinates: [p × a; a] (a rotation) or [a; 0] (a
+      // translation), a = ᵂR axis, p the body origin.
+      const Vec3 a = dof.in_joint_frame ? Vec3((joint.placement * ws.Xworld[p]).E.transpose() * dof.axis)
+                                        : Vec3(X.E.transpose() * dof.axis);
+      if (dof.rotation)
+        ws.S[b] << X.r.cross(a), a;
+      else
+        ws.S[b] << a, Vec3::Zero();
+      if (with_inertia) ws.I[b] = i == last ? spatial::inverseTransformInertia(X, model.inertia(i)) : RigidInertia{};
+      if (with_velocity) {
+        const Vec6 vJ = ws.S[b] * qd[i - 1];
+        ws.v[b] = ws.v[static_cast<std::size_t>(model.parent(i))] + vJ;  // line 5
+        (dof.in_joint_frame ? vJ_joint_frame : vJ_child) += vJ;
+        ws.c[b].setZero();
+      } else {
+        ws.v[b].setZero();
+        ws.c[b].setZero();
+      }
+    }
+    // Line 6 on the joint's last body: Ẍ_bias = Ṡ q̇, where an axis fixed in a
+    // body moving with Ẋ turns as Ṡ = Ẋ × S (the child's for most, the
+    // parent's for a planar joint's x and y).
     if (with_velocity) {
-      const Vec6 vJ = ws.S[b] * qd[i - 1];
-      ws.v[b] = ws.v[p] + vJ;                       // line 5
-      ws.c[b] = spatial::crossMotion(ws.v[b], vJ);  // line 6: Ṡ_i q̇_i = Ẋ_i × S_i q̇_i
-    } else {
-      ws.v[b].setZero();
-      ws.c[b].setZero();
+      const auto b = static_cast<std::size_t>(last);
+      ws.c[b] = spatial::crossMotion(ws.v[b], vJ_child);
+      if (!vJ_joint_frame.isZero(0.0)) ws.c[b] += spatial::crossMotion(ws.v[p], vJ_joint_frame);
     }
   }
 }
@@ -37,7 +54,7 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
 void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws) {
   for (const Task::AppliedWrench& w : task.wrenches()) {
     const int body = model.frame(w.frame).body;
-    if (body == 0 && !model.hasFloatingBase()) continue;  // a wrench on the fixed base moves nothing
+    if (body == 0) continue;  // a wrench on the world (a fixed base) moves nothing
     ws.Fbias[static_cast<std::size_t>(body)] -= wrenchInBase(model, ws, w.frame, w.expressed, w.value);
   }
 }
@@ -51,7 +68,7 @@ Status checkWorkspace(const Model& model, const Workspace& ws) noexcept {
   if (ws.dof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
                          model.dof());
-  if (!internal::workspaceFitsBase(model, ws)) return internal::workspaceBaseMismatch(model, ws);
+  if (!internal::workspaceFitsModel(model, ws)) return internal::workspaceMismatch(model, ws);
   return {};
 }
 
@@ -111,27 +128,15 @@ Vec6 velocityAtPoint(const Vec6& m, const Vec3& p) {
   return out;
 }
 
-// J's columns after forwardKinematics, compiled once per kind of base: on a
-// fixed base nvb is the constant 0 and the base's columns vanish, so its code
-// (and time) is the one from before floating bases.
-template <bool kFloating>
+// J's columns after forwardKinematics: column k is the frame-origin velocity
+// of a unit rate of DOF k, S_{k+1} seen at the frame origin p, for the DOFs
+// that move it: those on the path from its body to the world.
 void jacobianColumns(const Model& model, const Workspace& ws, int frame, Expressed expressed,
                      Eigen::Ref<Eigen::MatrixXd>& J) {
-  // Column nvb + j: the frame-origin velocity of a unit rate of joint j,
-  // S_{j+1} (base coordinates) seen at the frame origin p, for the joints
-  // that move it: those on the path from its body to the base.
-  const int nvb = kFloating ? model.baseVelocitySize() : 0;
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   J.setZero();
   for (int i = model.frame(frame).body; i >= 1; i = model.parent(i))
-    J.col(nvb + i - 1) = express(X, expressed, velocityAtPoint(ws.S[static_cast<std::size_t>(i)], X.r));
-  // A floating base moves every frame: its columns, in the user's velocity
-  // coordinates (a free base's v_B = [v; ω] in base axes), seen the same way.
-  if (kFloating) {
-    Matrix6Xmax S_base;
-    internal::baseMotionColumns(model, ws, S_base);
-    for (int k = 0; k < nvb; ++k) J.col(k) = express(X, expressed, velocityAtPoint(S_base.col(k), X.r));
-  }
+    J.col(i - 1) = express(X, expressed, velocityAtPoint(ws.S[static_cast<std::size_t>(i)], X.r));
 }
 
 }  // namespace
@@ -144,18 +149,8 @@ Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<con
   if (qd.size() != 0)
     if (Status s = internal::checkVelocityVector(model, "qd", qd); !s) return s;
   ws.kinematics.model = &model;
-  const KinematicsStage held = qd.size() != 0 ? KinematicsStage::Velocities : KinematicsStage::Poses;
-  if (!model.hasFloatingBase()) {  // the joints' vectors are the whole state
-    internal::outwardKinematics(model, q, qd, ws, false);
-    ws.kinematics.stage = held;
-    return {};
-  }
-  // The base joint first (its pose and velocity are every body's start), then the joints.
-  const int n = model.dof(), nqb = model.baseConfigurationSize(), nvb = model.baseVelocitySize();
-  const bool moving = qd.size() == model.nv();
-  internal::baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, false);
-  internal::outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, false);
-  ws.kinematics.stage = held;
+  internal::outwardKinematics(model, q, qd, ws, false);
+  ws.kinematics.stage = qd.size() != 0 ? KinematicsStage::Velocities : KinematicsStage::Poses;
   return {};
 }
 
@@ -190,20 +185,17 @@ Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const E
                      Expressed expressed, Eigen::Ref<Eigen::MatrixXd> J) noexcept {
   ws.kinematics.stage = KinematicsStage::None;  // until forwardKinematics below computes the poses
   if (J.rows() != 6 || J.cols() != model.nv()) {
-    if (!model.hasFloatingBase())
+    if (model.baseVelocitySize() == 0)
       return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",
-                           static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.dof());
+                           static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.nv());
     return Status::error(StatusCode::SizeMismatch,
-                         "Jacobian output is %ldx%ld, expected 6x%d (nv = %d base velocity coordinates + %d joints)",
+                         "Jacobian output is %ldx%ld, expected 6x%d (nv = %d base velocity coordinates + %d joint DOFs)",
                          static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.nv(), model.baseVelocitySize(),
                          model.dof());
   }
   if (Status s = checkFrame(model, frame); !s) return s;
   if (Status s = forwardKinematics(model, ws, q); !s) return s;
-  if (model.hasFloatingBase())
-    jacobianColumns<true>(model, ws, frame, expressed, J);
-  else
-    jacobianColumns<false>(model, ws, frame, expressed, J);
+  jacobianColumns(model, ws, frame, expressed, J);
   return {};
 }
 

@@ -24,10 +24,13 @@
 //    its body and the opposite on its parent (jointPieceInBodyForm). Its ν is
 //    the coupling torque the mechanism carries; the motor torques the leader
 //    carries are folded onto it at the end (carryMimicTorques);
-//  * a floating base (free or planar): body 0 moves, joined to the world by an
-//    unactuated joint of k coordinates; each sweep ends (or starts) with that
-//    joint's step (src/dynamics/floating_base.cpp). The state vectors put the
-//    base's coordinates first: the stages below index the joints' part.
+//  * joints of any type (model.hpp): one body per DOF, so a joint of nv DOFs
+//    is nv steps of the sweeps, its first nv − 1 bodies without inertia. Each
+//    step is the report's one-DOF step, and together they are the block step
+//    with the joint's nv × nv D_i and nv-vector u_i: the pivots D of the steps
+//    are the LDLᵀ factor of that D. A floating base is the root's joint (free
+//    or planar), visited like any other; body 0 is the world. Entry k of q̇,
+//    τ and q̈ belongs to body k + 1.
 #include "dynamics/popov_vereshchagin.hpp"
 
 #include "zwang/configuration.hpp"
@@ -38,7 +41,6 @@
 
 #include "dynamics/balance.hpp"
 #include "dynamics/checks.hpp"
-#include "dynamics/floating_base.hpp"
 #include "dynamics/sweeps.hpp"
 
 namespace zwang::internal {
@@ -53,24 +55,23 @@ namespace {
 // Allowed: the rounding of a·q + b and what an integrator's steps add to it
 // (1e-9 of the terms' size; Model::followLeaders sets the entries exactly).
 Status checkMimicState(const Model& model, const VectorRef& q_all, const VectorRef& qd_all) {
-  const auto q = q_all.tail(model.dof());
-  const auto qd = qd_all.tail(model.dof());
   for (const int m : model.mimicJoints()) {
     const Joint& joint = model.joint(m);
     const Mimic& law = joint.mimic;
-    const char* leader = model.joint(law.leader).name.c_str();
-    const double q_law = law.multiplier * q[law.leader] + law.offset;
-    if (std::abs(q[m] - q_law) > 1e-9 * (1.0 + std::abs(q[m]) + std::abs(q_law) + std::abs(law.offset)))
+    const Joint& leader_joint = model.joint(law.leader);
+    const char* leader = leader_joint.name.c_str();
+    const double q_m = q_all[joint.q_index], q_law = law.multiplier * q_all[leader_joint.q_index] + law.offset;
+    if (std::abs(q_m - q_law) > 1e-9 * (1.0 + std::abs(q_m) + std::abs(q_law) + std::abs(law.offset)))
       return Status::error(StatusCode::MimicMismatch,
                            "joint '%s' mimics '%s' (q = %g·q_leader + %g): q is %.17g, the law gives %.17g "
                            "(set by Model::followLeaders, Python follow_leaders, CLI \"follow_leaders\": true)",
-                           joint.name.c_str(), leader, law.multiplier, law.offset, q[m], q_law);
-    const double qd_law = law.multiplier * qd[law.leader];
-    if (std::abs(qd[m] - qd_law) > 1e-9 * (1.0 + std::abs(qd[m]) + std::abs(qd_law)))
+                           joint.name.c_str(), leader, law.multiplier, law.offset, q_m, q_law);
+    const double qd_m = qd_all[joint.v_index], qd_law = law.multiplier * qd_all[leader_joint.v_index];
+    if (std::abs(qd_m - qd_law) > 1e-9 * (1.0 + std::abs(qd_m) + std::abs(qd_law)))
       return Status::error(StatusCode::MimicMismatch,
                            "joint '%s' mimics '%s' (multiplier %g): qd is %.17g, the law gives %.17g "
                            "(set by Model::followLeaders, Python follow_leaders, CLI \"follow_leaders\": true)",
-                           joint.name.c_str(), leader, law.multiplier, qd[m], qd_law);
+                           joint.name.c_str(), leader, law.multiplier, qd_m, qd_law);
   }
   return {};
 }
@@ -106,8 +107,8 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
                          "task has %d constraint rows, the workspace was made for at most %d", task.constraintRows(),
                          ws.constraintCapacity());
   if (Status s = checkBalanceOptions(task.balance); !s) return s;
-  if (Status s = checkConfiguration(model, q); !s) return s;  // size, finite, a free base's unit quaternion
-  if (!workspaceFitsBase(model, ws)) return workspaceBaseMismatch(model, ws);
+  if (Status s = checkStateConfiguration(model, q); !s) return s;  // size, finite, unit quaternions
+  if (!workspaceFitsModel(model, ws)) return workspaceMismatch(model, ws);
   if (Status s = checkVelocityVector(model, "qd", qd); !s) return s;
   if (Status s = checkVelocityVector(model, "tau", tau); !s) return s;
   if (Status s = checkSolutionSizes(model, ws.solution); !s) return s;
@@ -180,10 +181,10 @@ void relativeConstraintInBodyForm(const Model& model, const Task& task, const Ta
 // with F·S = 1 would differ by a force the joint itself transmits: same motion, same ν.
 void jointPieceInBodyForm(const Model& model, const Task& task, const Task::ConstraintGroup& g, int col,
                           Workspace& ws) {
-  const int body = g.joint + 1;
+  const int body = bodyOfDof(g.dof);  // the body the DOF moves (g.body is this side's: it or its parent)
   const Vec6& S = ws.S[at(body)];
   Vec6 F;
-  if (model.joint(g.joint).isRevolute())
+  if (model.dofs()[at(g.dof)].rotation)
     F << Vec3::Zero(), S.tail<3>();
   else
     F << S.head<3>(), ws.Xworld[at(body)].r.cross(S.head<3>());
@@ -202,7 +203,7 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
   const std::vector<int>& user_row = task.solverRowToUserRow();
   int col = 0;
   for (const Task::ConstraintGroup& g : task.groups()) {
-    if (g.joint >= 0) {
+    if (g.dof >= 0) {
       jointPieceInBodyForm(model, task, g, col++, ws);
       continue;
     }
@@ -232,13 +233,10 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
 }  // namespace
 
 void outwardSweep(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd, Workspace& ws) {
-  const int n = model.dof(), nqb = model.baseConfigurationSize(), nvb = model.baseVelocitySize();
   const bool moving = qd.size() == model.nv();
-  const bool floating = model.hasFloatingBase();
-  if (floating) baseKinematics(model, q.head(nqb), moving ? qd.head(nvb) : qd.head(0), ws, true);  // lines 3–6, base
-  outwardKinematics(model, q.tail(n), moving ? qd.tail(n) : qd.head(0), ws, true);                 // lines 3–6
+  outwardKinematics(model, q, qd, ws, true);  // lines 3–6
   ws.kinematics = {moving ? KinematicsStage::Velocities : KinematicsStage::Poses, &model};
-  for (int i = floating ? 0 : 1; i <= n; ++i)
+  for (int i = 1; i <= model.nv(); ++i)
     ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);  // line 7, without F_ext
   applyExternalWrenches(model, task, ws);                                           // line 7: − F_ext
   // Lines 8–9 (I^A_i = I_i, F^A_i = F_bias,i) are folded into the inward
@@ -246,10 +244,9 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
   constraintsInBodyForm(model, task, ws);
 }
 
-Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau_all, Workspace& ws) {
-  const int N = model.dof();
-  const bool floating = model.hasFloatingBase();
-  const auto tau = tau_all.tail(N);
+Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
+  const int N = model.nv();
+  const std::vector<Dof>& dofs = model.dofs();
   const int m = task.solverColumns();
   ws.U.head(m).setZero();  // U_N = 0
   ws.L_scale.head(m).setZero();
@@ -261,17 +258,17 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau_al
       ws.IA[at(i)] = ws.I[at(i)].matrix();
       ws.FA[at(i)] = ws.Fbias[at(i)];
     }
-    const Joint& joint = model.joint(i - 1);
+    const Dof& dof = dofs[at(i - 1)];
     const Vec6& S = ws.S[at(i)];
     const Mat6& IA = ws.IA[at(i)];
     const Vec6& c = ws.c[at(i)];
     Vec6& IAS = ws.IAS[at(i)];
     IAS.noalias() = IA * S;
-    const double D = joint.rotor_inertia + S.dot(IAS);  // line 13
+    const double D = dof.rotor_inertia + S.dot(IAS);  // line 13
     ws.D[at(i)] = D;
     if (!(D > 1e-300))
       return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)",
-                           joint.name.c_str(), D);
+                           dof.name.c_str(), D);
     Vec6 pA = ws.FA[at(i)];
     pA.noalias() += IA * c;                   // F^A + I^A Ẍ_bias
     const double u = tau[i - 1] - S.dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
@@ -301,7 +298,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau_al
     // F^a_i. The first child to arrive (the last in depth-first order: its
     // subtree ends where p's does) starts p's sums from I_p and F_bias,p.
     const int p = model.parent(i);
-    if (p > 0 || floating) {  // a fixed base takes nothing
+    if (p > 0) {  // the world takes nothing
       Mat6& IA_parent = ws.IA[at(p)];
       const Vec6 IAS_D = IAS * inverse_D;
       if (model.subtreeEnd(i) == model.subtreeEnd(p)) {
@@ -314,7 +311,6 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau_al
       }
     }
   }
-  if (floating) return baseInward(model, task, tau_all.head(model.baseVelocitySize()), ws);  // lines 13–21, base
   return {};
 }
 
@@ -391,16 +387,9 @@ void balance(const Task& task, Workspace& ws) {
   report.rank = std::max(0, report.rank - task.mimicRows());  // ≥ 0 even should rounding lose a mimic row
 }
 
-void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd_all) {
-  ws.a_world = gravityAcceleration(task.gravity);
-  if (model.hasFloatingBase()) {  // lines 28–29 for the base joint
-    baseAcceleration(model, task, ws);
-    publishBaseAcceleration(model, ws, ws.qdd_base, qdd_all.head(model.baseVelocitySize()));
-  } else {
-    ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
-  }
-  auto qdd = qdd_all.tail(model.dof());
-  for (int i = 1; i <= model.dof(); ++i) {
+void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
+  ws.a_world = ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  for (int i = 1; i <= model.nv(); ++i) {
     const Vec6& a_parent = ws.a[at(model.parent(i))];
     const int first = task.firstColumn(i), k = task.activeColumns(i) - first;
     const double constraint = ws.SA.col(i).segment(first, k).dot(ws.nu.segment(first, k));  // Sᵀ A_i ν
@@ -409,43 +398,18 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   }
 }
 
-void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd_all) {
+void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd) {
   ws.a_world = ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
-  if (model.hasFloatingBase()) ws.a[0] += baseTrueAcceleration(model, ws, qdd_all.head(model.baseVelocitySize()));
-  const auto qdd = qdd_all.tail(model.dof());
-  for (int i = 1; i <= model.dof(); ++i)
+  for (int i = 1; i <= model.nv(); ++i)
     ws.a[at(i)] = ws.a[at(model.parent(i))] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];  // line 29
 }
 
+Vec6 baseClassicalAcceleration(const Model& model, const Workspace& ws) {
+  const auto b = at(model.baseBody());  // the world's, zero, on a fixed base
+  return classicalAtPoint(ws.a[b] - ws.a_world, ws.v[b], ws.Xworld[b].r);
+}
+
 namespace {
-// The base's share of δU (line 20), (S₀ᵀA₀)ᵀ D₀⁻¹ δu₀ = (D₀⁻¹ S₀ᵀA₀)ᵀ δu₀
-// (D₀ is symmetric): the main pass's D₀⁻¹ S₀ᵀA₀, with no further solve.
-void baseShareOfU(const Model& model, const Workspace& ws, int m, const Eigen::Ref<const Eigen::MatrixXd>& du_base,
-                  Eigen::Ref<Eigen::MatrixXd> dU) {
-  const int kb = model.baseVelocitySize();
-  dU.noalias() += ws.SA_base_D.topLeftCorner(kb, m).transpose() * du_base.topRows(kb);
-}
-
-// The base joint's step of the outward pass (lines 28–29) for W columns from
-// c0: δq̈₀ = D₀⁻¹(δu₀ + S₀ᵀA₀ δν), published per column, and δẌ₀ = S₀ δq̈₀
-// (the world's acceleration is fixed) into `da0` (W × 6, a column per
-// component). Row j of `du0` and of `dq` holds base coordinate j of the W
-// columns.
-template <int W>
-void baseLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, const UnitTorqueScratch& s,
-               const double* du0, Eigen::Ref<Eigen::MatrixXd> dqdd, double* da0) {
-  const int kb = model.baseVelocitySize(), m = task.solverColumns();
-  double q[6 * W];
-  using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
-  for (int j = 0; j < kb; ++j) {
-    Eigen::Map<Lanes> row(q + j * W);
-    row = Eigen::Map<const Lanes>(du0 + j * W);
-    for (int r = 0; r < m; ++r) row += ws.SA_base(j, r) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
-  }
-  baseSolveLanesInPlace<W>(model, ws, q);
-  baseMotionLanes<W>(model, ws, q, da0, dqdd.block(0, c0, kb, W));
-}
-
 // Line 25 for W columns as lanes: x ← 𝓛⁻¹ x with 𝓛 = C Cᵀ (a regular
 // balance's Cholesky factor), x the W × m block at `lanes` (leading dimension
 // `stride`; row w: column w's right-hand side). Forward and backward
@@ -475,16 +439,10 @@ template <int W>
 void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, bool solve_balance,
                   UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
   using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
-  const int N = model.dof(), m = task.solverColumns(), kb = model.baseVelocitySize();
-  double du0[6 * W];  // δu₀ of a floating base, row-major kb × W
-  for (int j = 0; j < kb; ++j) Eigen::Map<Lanes>(du0 + j * W) = s.du_base.template block<1, W>(j, c0).transpose();
+  const int N = model.nv(), m = task.solverColumns();
   auto dnu_lanes = s.dnu_lanes.topLeftCorner(W, m);  // SᵀA δν: whole lanes per row
   if (solve_balance) {
-    dnu_lanes = s.dU.block(0, c0, m, W).transpose();  // −δU₀ of the joints, then of the base (baseShareOfU)
-    for (int r = 0; r < m; ++r) {
-      Eigen::Map<Lanes> x(dnu_lanes.col(r).data());
-      for (int j = 0; j < kb; ++j) x -= ws.SA_base_D(j, r) * Eigen::Map<const Lanes>(du0 + j * W);
-    }
+    dnu_lanes = s.dU.block(0, c0, m, W).transpose();  // −δU₀
     balanceSolveLanes<W>(ws.balance_factorisation.factor, m, dnu_lanes.data(), s.dnu_lanes.outerStride());
     dnu.middleCols(c0, W) = dnu_lanes.transpose();
   } else {
@@ -492,10 +450,7 @@ void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eig
   }
   double* da = s.da.data();
   const Eigen::Index da_stride = s.da.outerStride();
-  if (kb > 0)
-    baseLanes<W>(model, task, ws, c0, s, du0, dqdd, da);
-  else
-    for (int e = 0; e < 6 * W; ++e) da[e] = 0.0;  // a fixed base: δẌ₀ = 0
+  for (int e = 0; e < 6 * W; ++e) da[e] = 0.0;  // the world: δẌ₀ = 0
   for (int i = 1; i <= N; ++i) {
     Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
     const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
@@ -506,7 +461,7 @@ void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eig
     const Vec6& IAS = ws.IAS[at(i)];
     for (int e = 0; e < 6; ++e) dq -= IAS[e] * Eigen::Map<const Lanes>(parent + e * W);
     dq *= ws.inverse_D[at(i)];
-    dqdd.template block<1, W>(kb + i - 1, c0) = dq.transpose();
+    dqdd.template block<1, W>(i - 1, c0) = dq.transpose();
     const Vec6& S = ws.S[at(i)];
     double* child = da + i * da_stride;
     for (int e = 0; e < 6; ++e) Eigen::Map<Lanes>(child + e * W) = Eigen::Map<const Lanes>(parent + e * W) + S[e] * dq;
@@ -514,17 +469,17 @@ void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eig
 }
 }  // namespace
 
-void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
+void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& dofs,
                        UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
   // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
   // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
-  // Column c is zero except on the path from its joint's body s_c to the
-  // base, so the inward sweep at body i works on the columns whose body lies
-  // in i's subtree [i, subtreeEnd(i)): a contiguous run of c, since the joints
+  // Column c is zero except on the path from its DOF's body s_c to the
+  // world, so the inward sweep at body i works on the columns whose body lies
+  // in i's subtree [i, subtreeEnd(i)): a contiguous run of c, since the DOFs
   // ascend. dF.col(c) carries δF^a from the path's last body to the next.
-  const int N = model.dof();
+  const int N = model.nv();
   const int m = task.solverColumns();
-  const auto k = static_cast<Eigen::Index>(joints.size());
+  const auto k = static_cast<Eigen::Index>(dofs.size());
   auto du = s.du.leftCols(k);
   auto dU = s.dU.topLeftCorner(m, k);
   auto dF = s.dF.leftCols(k);
@@ -532,13 +487,13 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   dF.setZero();              // du is written where it is read: on each body's run of columns
   Eigen::Index c_begin = k;  // the first column with its joint's body ≥ i: falls with i
   for (int i = N; i >= 1; --i) {
-    while (c_begin > 0 && bodyOfJoint(joints[static_cast<std::size_t>(c_begin - 1)]) >= i) --c_begin;
+    while (c_begin > 0 && bodyOfDof(dofs[static_cast<std::size_t>(c_begin - 1)]) >= i) --c_begin;
     const int end = model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: k)
-    const Eigen::Index c_end = k == 0 || end > bodyOfJoint(joints.back())
+    const Eigen::Index c_end = k == 0 || end > bodyOfDof(dofs.back())
                                    ? k
-                                   : std::lower_bound(joints.begin(), joints.end(), end, [](int j, int b) {
-                                       return bodyOfJoint(j) < b;
-                                     }) - joints.begin();
+                                   : std::lower_bound(dofs.begin(), dofs.end(), end, [](int d, int b) {
+                                       return bodyOfDof(d) < b;
+                                     }) - dofs.begin();
     s.run_begin[i] = c_begin;
     s.run_end[i] = c_end;
     const Vec6& S = ws.S[at(i)];
@@ -546,20 +501,16 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
     const double inverse_D = ws.inverse_D[at(i)];
     const int first = task.firstColumn(i), ki = task.activeColumns(i);
     for (Eigen::Index c = c_begin; c < c_end; ++c) {
-      const double du_ic = (bodyOfJoint(joints[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
+      const double du_ic = (bodyOfDof(dofs[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
       du(i, c) = du_ic;
       const double du_D = du_ic * inverse_D;
       for (int r = first; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
       dF.col(c) += IAS * du_D;                                          // lines 17–18
     }
   }
-  if (model.hasFloatingBase())  // every column's δF^a has reached body 0
-    baseUnitTorques(model, ws, dF, s.du_base.leftCols(k));
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
-  // outward pass's lanes, a block of columns at a time, with the base's share
-  // of δU added there; else here, all at once.
+  // outward pass's lanes, a block of columns at a time; else here, all at once.
   const bool solve_in_lanes = !task.hasRelative() && !ws.balance_factorisation.by_eigen;
-  if (model.hasFloatingBase() && !solve_in_lanes) baseShareOfU(model, ws, m, s.du_base.leftCols(k), dU);
   dU *= -1.0;                // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
@@ -593,13 +544,14 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
 }
 
-void jointsOutsideLimits(const Model& model, const VectorRef& q_all, Solution& out) {
-  const auto q = q_all.tail(model.dof());
+void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out) {
   out.joints_outside_limits = 0;
   out.first_joint_outside_limits = -1;
-  for (int j = 0; j < model.dof(); ++j) {
-    const Joint& joint = model.joint(j);
-    if (q[j] >= joint.lower && q[j] <= joint.upper) continue;
+  const std::vector<Joint>& joints = model.joints();
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
+    const Joint& joint = joints[at(j)];  // a multi-DOF joint has no limits: ±∞
+    const double q_j = q[joint.q_index];
+    if (q_j >= joint.lower && q_j <= joint.upper) continue;
     if (out.joints_outside_limits++ == 0) out.first_joint_outside_limits = j;
   }
 }
@@ -669,20 +621,8 @@ void taskResidual(const Task& task, Workspace& ws) {
   report.consistent = met;
 }
 
-namespace {
-// A floating base's share of τ_c: the wrench its children carry into it plus
-// its own columns', on the base coordinates.
-void baseConstraintForce(const Model& model, const Task& task, const Workspace& ws, const VectorRef& nu_solver,
-                         const Vec6& from_children, Eigen::Ref<Eigen::VectorXd> tau_c_base) {
-  const int k_beyond = task.activeColumns(1), k = task.activeColumns(0);
-  Vec6 F0 = from_children;
-  F0.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
-  baseGeneralizedForce(model, ws, F0, tau_c_base);
-}
-}  // namespace
-
 void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_all,
-                       Eigen::Ref<Eigen::VectorXd> tau_c_all) {
+                       Eigen::Ref<Eigen::VectorXd> tau_c) {
   // The motors give every constraint force but the contacts' (the
   // environment's): those columns count with ν = 0 here.
   const int columns = task.solverColumns();
@@ -696,11 +636,9 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   // projected on each joint: the physical torque (docs/solver.md, "Constraint torques: why not eq. 4.4").
   // On a tree each body carries its own wrenches and its children's: the
   // body's slot of `carried` collects them, then passes them to the parent.
-  const int N = model.dof();
-  const int kb = model.baseVelocitySize();
-  auto tau_c = tau_c_all.tail(N);
+  const int N = model.nv();
   if (task.solverColumns() == 0) {
-    tau_c_all.setZero();
+    tau_c.setZero();
     return;
   }
   if (model.isChain()) {  // one running sum from the tip inward
@@ -710,7 +648,6 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
       carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
       tau_c[i - 1] = ws.S[at(i)].dot(carried);
     }
-    if (kb > 0) baseConstraintForce(model, task, ws, nu_solver, carried, tau_c_all.head(kb));
     return;
   }
   std::vector<Vec6>& carried = ws.constraint_wrench;
@@ -718,18 +655,13 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
     const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
     carried[at(i)].noalias() = ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
   }
-  Vec6 into_base = Vec6::Zero();
   for (int i = N; i >= 1; --i) {
     tau_c[i - 1] = ws.S[at(i)].dot(carried[at(i)]);
-    if (model.parent(i) > 0)
-      carried[at(model.parent(i))] += carried[at(i)];
-    else
-      into_base += carried[at(i)];
+    if (model.parent(i) > 0) carried[at(model.parent(i))] += carried[at(i)];  // the world takes the rest
   }
-  if (kb > 0) baseConstraintForce(model, task, ws, nu_solver, into_base, tau_c_all.head(kb));
 }
 
-double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd_all, const VectorRef& tau_all,
+double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
                      const Workspace& ws) {
   // Z with true accelerations and gravity as a force (the physical Gauss
   // function; the gravity-shifted sweep's version differs by a constant):
@@ -737,12 +669,9 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd_
   // in 3-vector pieces: with y = ½a + [−g; 0] = [y_l; y_a] and a = [a_l; α],
   // I y = [m y_l − h × y_a; h × y_l + Ī y_a].
   const Vec3& g = task.gravity;
-  const int kb = model.baseVelocitySize();
-  const auto qdd = qdd_all.tail(model.dof());
-  const auto tau = tau_all.tail(model.dof());
-  // A floating base: body 0's terms, and −τ_baseᵀ q̈_base (conjugate coordinates).
-  double Z = kb > 0 ? -tau_all.head(kb).dot(qdd_all.head(kb)) : 0.0;
-  for (int i = kb > 0 ? 0 : 1; i <= model.dof(); ++i) {
+  const std::vector<Dof>& dofs = model.dofs();
+  double Z = 0.0;
+  for (int i = 1; i <= model.nv(); ++i) {
     const RigidInertia& I = ws.I[at(i)];
     const Vec6& a_sweep = ws.a[at(i)];
     const Vec3 a_lin = a_sweep.head<3>() + g;  // true acceleration: sweep − [−g; 0]
@@ -752,9 +681,8 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd_
     const Vec6& F = ws.Fbias[at(i)];
     Z += a_lin.dot(I.mass * y_lin - I.h.cross(y_ang) + F.head<3>()) +
          alpha.dot(I.h.cross(y_lin) + I.Ibar * y_ang + F.tail<3>());
-    if (i == 0) continue;  // the base: no joint terms of its own beyond −τ_baseᵀ q̈_base
     const double qdd_i = qdd[i - 1];
-    Z += (0.5 * model.joint(i - 1).rotor_inertia * qdd_i - tau[i - 1]) * qdd_i;
+    Z += (0.5 * dofs[at(i - 1)].rotor_inertia * qdd_i - tau[i - 1]) * qdd_i;
   }
   return Z;
 }
@@ -770,15 +698,15 @@ void publishNu(const Task& task, Workspace& ws) {
   }
 }
 
-void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control_all) {
-  auto tau_control = tau_control_all.tail(model.dof());
+void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control) {
   // Power-equivalent: a torque τ_m at the mimic joint moves the robot as
   // a·τ_m at its leader does (q̇_m = a·q̇_l), the difference being a coupling
   // torque the mechanism supplies. So the leader's motor carries it.
   for (const int m : model.mimicJoints()) {
-    const Mimic& law = model.joint(m).mimic;
-    tau_control[law.leader] += law.multiplier * tau_control[m];
-    tau_control[m] = 0.0;
+    const Joint& joint = model.joint(m);
+    const int v_leader = model.joint(joint.mimic.leader).v_index;
+    tau_control[v_leader] += joint.mimic.multiplier * tau_control[joint.v_index];
+    tau_control[joint.v_index] = 0.0;
   }
 }
 

@@ -8,17 +8,17 @@
 #include "zwang/status.hpp"
 #include "zwang/workspace.hpp"
 
+#include "dynamics/checks.hpp"
+
 namespace zwang::internal {
 
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
 using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 
-// The body joint j moves (joint j − 1 moves body j: 0 is the fixed base), and
-// that joint's articulated inertia D (line 13) after the inward sweep.
-inline int bodyOfJoint(int joint) { return joint + 1; }
-inline double jointInertia(const Workspace& ws, int joint) {
-  return ws.D[static_cast<std::size_t>(bodyOfJoint(joint))];
-}
+// The body DOF k (entry k of v) moves (body 0 is the world), and that DOF's
+// articulated inertia D (line 13: its pivot of the joint's D) after the inward sweep.
+inline int bodyOfDof(int dof) { return dof + 1; }
+inline double dofInertia(const Workspace& ws, int dof) { return ws.D[static_cast<std::size_t>(bodyOfDof(dof))]; }
 
 // Input checks shared by every solve (the balance options included).
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
@@ -43,6 +43,10 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
 // Line 29 alone: Ẍ (into ws.a) from a known q̈.
 void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd);
 
+// After the accelerations: the base's classical acceleration [p̈; ω̇] of its
+// origin, world axes (zero on a fixed base: the world's).
+Vec6 baseClassicalAcceleration(const Model& model, const Workspace& ws);
+
 // Scratch of unitTorqueColumns, sized once for up to `dof` columns.
 struct UnitTorqueScratch {
   // The outward pass takes the columns this many at a time, side by side:
@@ -50,7 +54,6 @@ struct UnitTorqueScratch {
   static constexpr int kLanes = 8;
   UnitTorqueScratch(int dof, int bodies, int capacity)
       : du(bodies, dof),
-        du_base(6, dof),
         dU(capacity, dof),
         dF(6, dof),
         da(6 * kLanes, bodies),
@@ -58,7 +61,6 @@ struct UnitTorqueScratch {
         run_begin(bodies),
         run_end(bodies) {}
   Eigen::MatrixXd du;         // bodies × k: δu_i per unit torque
-  Eigen::MatrixXd du_base;    // 6 × k: δu₀ of a floating base per unit torque
   Eigen::MatrixXd dU;         // capacity × k: δU₀ per unit torque
   Matrix6X dF;                // 6 × k: δF^A carried inward per unit torque
   Eigen::MatrixXd da;         // column i: body i's δẌ for up to kLanes columns (kLanes × 6, column-major)
@@ -69,13 +71,12 @@ struct UnitTorqueScratch {
 };
 
 // k extra right-hand sides through the same sweeps, all at once: column c is
-// a unit torque at joint joints[c] (ascending), everything else zero. Gives
-// δν (dnu: solver columns × k) and δq̈ = ∂q̈/∂τ_joint (dqdd: nv × k, a
-// floating base's rows first). Needs inwardSweep and balance first.
+// a unit torque at DOF dofs[c] (entries of v, ascending), everything else
+// zero. Gives δν (dnu: solver columns × k) and δq̈ = ∂q̈/∂τ_dof (dqdd: nv × k). Needs inwardSweep and balance first.
 // O((N + m²)·k): the sensitivity K_Θ of the friction extension. The inward
 // pass visits only each column's path to the base; the balance solve and the
 // outward pass take up to kLanes columns side by side.
-void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& joints,
+void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& dofs,
                        UnitTorqueScratch& scratch, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd);
 
 // The joints whose q lies outside their limits, into the solution (a warning).

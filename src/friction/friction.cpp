@@ -22,7 +22,6 @@
 #include <limits>
 
 #include "dynamics/checks.hpp"
-#include "dynamics/floating_base.hpp"
 #include "dynamics/popov_vereshchagin.hpp"
 #include "friction/friction_scratch.hpp"
 #include "qp/box_qp.hpp"
@@ -45,6 +44,16 @@ namespace {
 using namespace internal;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// The friction vectors (FrictionOptions, FrictionResult) have one entry per
+// DOF below the root: entry j is DOF baseVelocitySize() + j of v. The root
+// joint of a floating base is unactuated: no friction unknowns.
+int dofOfEntry(const Model& model, int j) { return model.baseVelocitySize() + j; }
+const Dof& frictionDof(const Model& model, int j) {
+  return model.dofs()[static_cast<std::size_t>(dofOfEntry(model, j))];
+}
+// The friction entry of a one-DOF joint (a mimic joint or its leader).
+int entryOfJoint(const Model& model, int joint) { return model.joint(joint).v_index - model.baseVelocitySize(); }
+
 Status checkOptions(const Model& model, const FrictionOptions& o) {
   const int n = model.dof();
   const struct {
@@ -59,7 +68,7 @@ Status checkOptions(const Model& model, const FrictionOptions& o) {
       if (!std::isfinite(ov.v[j]) || ov.v[j] < 0.0)
         return Status::error(StatusCode::BadOption,
                              "friction override '%s' for joint '%s' is %g (must be finite and >= 0)", ov.name,
-                             model.joint(static_cast<int>(j)).name.c_str(), ov.v[j]);
+                             frictionDof(model, static_cast<int>(j)).name.c_str(), ov.v[j]);
   }
   if (!(o.velocity_tolerance >= 0.0) || !std::isfinite(o.velocity_tolerance))
     return Status::error(StatusCode::BadOption, "velocity_tolerance %g must be finite and >= 0", o.velocity_tolerance);
@@ -109,39 +118,43 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
                                 FrictionScratch& fs, FrictionResult& fr) {
   const int n = model.dof();
   for (int j = 0; j < n; ++j) {
-    const Joint& joint = model.joint(j);
-    fs.breakaway[j] = options.breakaway.size() ? options.breakaway[j] : joint.breakaway_friction;
-    fs.kinetic[j] = options.kinetic.size() ? options.kinetic[j] : joint.kinetic_friction;
-    fs.viscous[j] = options.viscous.size() ? options.viscous[j] : joint.viscous_friction;
+    const Dof& dof = frictionDof(model, j);
+    fs.breakaway[j] = options.breakaway.size() ? options.breakaway[j] : dof.breakaway_friction;
+    fs.kinetic[j] = options.kinetic.size() ? options.kinetic[j] : dof.kinetic_friction;
+    fs.viscous[j] = options.viscous.size() ? options.viscous[j] : dof.viscous_friction;
+    fs.is_mimic[j] = 0;
   }
   // A mimic joint moves with its leader (q̇_m = a·q̇_l, sticks when it sticks),
   // and its friction torque acts on the motion as a times it at the leader:
   // the two boxes add, f_l + |a|·f_m (likewise kinetic), and viscous b_l + a²·b_m.
   // The leader carries it all; the mimic joint is not in the stuck set.
-  for (const int m : model.mimicJoints()) {
-    const Mimic& law = model.joint(m).mimic;
+  for (const int mimic : model.mimicJoints()) {
+    const Mimic& law = model.joint(mimic).mimic;
     const double a = law.multiplier;
-    fs.breakaway[law.leader] += std::abs(a) * fs.breakaway[m];
-    fs.kinetic[law.leader] += std::abs(a) * fs.kinetic[m];
-    fs.viscous[law.leader] += a * a * fs.viscous[m];
+    const int m = entryOfJoint(model, mimic), l = entryOfJoint(model, law.leader);
+    fs.breakaway[l] += std::abs(a) * fs.breakaway[m];
+    fs.kinetic[l] += std::abs(a) * fs.kinetic[m];
+    fs.viscous[l] += a * a * fs.viscous[m];
     fs.breakaway[m] = fs.kinetic[m] = fs.viscous[m] = 0.0;
+    fs.is_mimic[m] = 1;
   }
   fr.stuck.clear();
   fr.limit_impact = false;
   fr.impact_joint = -1;
   fs.tau_effective = tau;
   fr.tau_friction.setZero();
-  // The joints' entries of the state vectors follow a floating base's.
-  const int iq = model.baseConfigurationSize(), iv = model.baseVelocitySize();
   for (int j = 0; j < n; ++j) {
-    const Joint& joint = model.joint(j);
-    if (joint.mimic.active()) {  // friction and limits are its leader's (above)
+    if (fs.is_mimic[j]) {  // friction and limits are its leader's (above)
       fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
       continue;
     }
-    const double qj = q[iq + j], qdj = qd[iv + j];
-    const bool at_lower = options.joint_limits && qj <= joint.lower + options.limit_tolerance;
-    const bool at_upper = options.joint_limits && qj >= joint.upper - options.limit_tolerance;
+    const int v = dofOfEntry(model, j);
+    const Dof& dof = model.dofs()[static_cast<std::size_t>(v)];
+    // Limits belong to one-DOF joints (a multi-DOF joint's are ±∞: never at one).
+    const bool limited = options.joint_limits && (std::isfinite(dof.lower) || std::isfinite(dof.upper));
+    const double qj = limited ? q[model.joint(dof.joint).q_index] : 0.0, qdj = qd[v];
+    const bool at_lower = limited && qj <= dof.lower + options.limit_tolerance;
+    const bool at_upper = limited && qj >= dof.upper - options.limit_tolerance;
     if (std::abs(qdj) <= options.velocity_tolerance) {
       const auto a = static_cast<Eigen::Index>(fr.stuck.size());
       fr.stuck.push_back(j);
@@ -150,7 +163,7 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
       fr.state[static_cast<std::size_t>(j)] = JointState::Stick;
     } else {
       fr.tau_friction[j] = -fs.kinetic[j] * (qdj > 0 ? 1.0 : -1.0) - fs.viscous[j] * qdj;
-      fs.tau_effective[iv + j] += fr.tau_friction[j];
+      fs.tau_effective[v] += fr.tau_friction[j];
       fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
       if ((at_lower && qdj < 0) || (at_upper && qdj > 0)) {
         fr.limit_impact = true;  // it needs an impulse to stop: reported, not modelled
@@ -172,8 +185,11 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   balance(task, ws);
   outwardAccelerations(model, task, ws, fs.qdd0);
   fs.nu0.head(m) = ws.nu.head(m);
+  fs.stuck_dofs.clear();  // reserved for every DOF: no allocation
+  for (const int j : stuck) fs.stuck_dofs.push_back(dofOfEntry(model, j));
   if (k > 0)
-    unitTorqueColumns(model, task, ws, stuck, fs.unit_torques, fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k));
+    unitTorqueColumns(model, task, ws, fs.stuck_dofs, fs.unit_torques, fs.dnu.topLeftCorner(m, k),
+                      fs.dqdd.leftCols(k));
   return {};
 }
 
@@ -188,16 +204,9 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
 // to the base (line 29, every motion in the world frame).
 Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const FrictionScratch& fs, Eigen::Index a,
                              int body) {
-  const int kb = model.baseVelocitySize();
   Vec6 terms = Vec6::Zero();
   for (int l = model.parent(body); l > 0; l = model.parent(l))
-    terms += ws.S[static_cast<std::size_t>(l)].cwiseAbs() * std::abs(fs.dqdd(kb + l - 1, a));
-  if (model.hasFloatingBase()) {  // δẌ₀ = S₀ δq̈₀ (a free base's published in its own frame)
-    const auto base = fs.dqdd.col(a).head(kb);
-    const Vec6 base_motion =
-        model.baseType() == BaseType::Free ? baseTrueAcceleration(model, ws, base) : Vec6(ws.S_base * base);
-    terms += base_motion.cwiseAbs();
-  }
+    terms += ws.S[static_cast<std::size_t>(l)].cwiseAbs() * std::abs(fs.dqdd(l - 1, a));
   return terms;
 }
 
@@ -205,7 +214,7 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
                FrictionScratch& fs) {
   for (std::size_t b = 0; b < stuck.size(); ++b) {
     const auto a = static_cast<Eigen::Index>(b);
-    const int i = bodyOfJoint(stuck[b]);
+    const int i = bodyOfDof(dofOfEntry(model, stuck[b]));
     const auto at_i = static_cast<std::size_t>(i);
     const int first = task.firstColumn(i), count = task.activeColumns(i) - first;
     const auto SA = ws.SA.col(i).segment(first, count).cwiseAbs();
@@ -246,7 +255,8 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
   double curvature_scale = 0.0;
   if (k > 0) {
     double min_D = kInf;
-    for (Eigen::Index a = 0; a < k; ++a) min_D = std::min(min_D, jointInertia(ws, stuck[static_cast<std::size_t>(a)]));
+    for (Eigen::Index a = 0; a < k; ++a)
+      min_D = std::min(min_D, dofInertia(ws, dofOfEntry(model, stuck[static_cast<std::size_t>(a)])));
     curvature_scale = std::max(1.0 / min_D, fs.dqdd.leftCols(k).cwiseAbs().maxCoeff());
     // The task's part of ∂q̈/∂μ, Sᵀ A δν / D, is a sum of terms of size
     // |SᵀA|·|δν|/D, which an ill-conditioned balance makes large while their
@@ -381,11 +391,10 @@ double frictionStates(const Model& model, const Eigen::VectorXd& qdd_all, double
 // ---- Joint position limits: a stop the task pushes into makes g unbounded.
 Status limitInfeasible(const Model& model, const QpReport& report, const std::vector<int>& stuck,
                        const FrictionScratch& fs) {
-  const int j = stuck[static_cast<std::size_t>(report.unbounded_index)];
-  const Joint& joint = model.joint(j);
+  const Dof& dof = frictionDof(model, stuck[static_cast<std::size_t>(report.unbounded_index)]);
   const bool lower = !std::isfinite(fs.lo[report.unbounded_index]);
-  return Status::error(StatusCode::Infeasible, "the task drives joint '%s' into its %s limit (%g)", joint.name.c_str(),
-                       lower ? "lower" : "upper", lower ? joint.lower : joint.upper);
+  return Status::error(StatusCode::Infeasible, "the task drives joint '%s' into its %s limit (%g)", dof.name.c_str(),
+                       lower ? "lower" : "upper", lower ? dof.lower : dof.upper);
 }
 
 }  // namespace
@@ -438,14 +447,15 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
 
   motionAtMaximiser(model, task, k, ws, fs);
   ws.kinematics.stage = KinematicsStage::Accelerations;  // those of q̈* (the sweep's were q̈(0)'s)
-  if (model.hasFloatingBase()) out.base_acceleration_world = baseClassicalAcceleration(task, ws);
+  out.base_acceleration_world = baseClassicalAcceleration(model, ws);
   taskResidual(task, ws);
   publishNu(task, ws);
   constraintTorques(model, task, ws, ws.nu.head(m), out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   const double mu_dot_qdd = frictionStates(model, out.qdd, acc_tolerance, fs, fr);
   for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader
-    fr.state[static_cast<std::size_t>(j)] = fr.state[static_cast<std::size_t>(model.joint(j).mimic.leader)];
+    fr.state[static_cast<std::size_t>(entryOfJoint(model, j))] =
+        fr.state[static_cast<std::size_t>(entryOfJoint(model, model.joint(j).mimic.leader))];
   // g(μ*) = Z₀(q̈*) + μ*ᵀ W q̈* = Z with the joint torques τ − kinetic − Wᵀμ (eq. 5.7).
   fr.gauss_dual = gaussFunction(model, task, out.qdd, fs.tau_joint, ws);
   out.gauss = fr.gauss_dual - mu_dot_qdd;

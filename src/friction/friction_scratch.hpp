@@ -35,12 +35,17 @@ struct FrictionScratch {
         tau_constraint_first(nv),
         tau_control_first(nv),
         choice(dof, capacity, nv),
-        tau_joint(nv) {}
+        tau_joint(nv) {
+    is_mimic.assign(static_cast<std::size_t>(dof), 0);
+    stuck_dofs.reserve(static_cast<std::size_t>(dof));
+  }
 
   // The model of friction, per joint (the options' overrides, else the model's)
   Eigen::VectorXd breakaway, kinetic, viscous;  // f_j, f_c,j, b_j
   Eigen::VectorXd tau_effective;                // τ − kinetic friction of the moving joints
   Eigen::VectorXd lo, hi;                       // Λ on Θ₀ (±∞ where a limit stop pushes)
+  std::vector<char> is_mimic;                   // per entry: a mimic joint's (its leader carries its friction)
+  std::vector<int> stuck_dofs;                  // Θ₀ as entries of v (the sweeps' DOFs)
 
   // ∂q̈/∂μ in the same sweeps
   Eigen::VectorXd qdd0;            // q̈(μ = 0)

@@ -10,7 +10,7 @@ namespace zwang {
 Task::Task(const Model& model)
     : dof_(model.dof()),
       frames_(static_cast<int>(model.frames().size())),
-      fixed_base_mass_(model.hasFloatingBase() ? 0.0 : model.inertia(0).mass) {
+      fixed_base_mass_(model.inertia(0).mass) {  // the world's: zero under a floating base
   for (const Frame& f : model.frames()) {
     frame_names_.push_back(f.name);
     frame_bodies_.push_back(f.body);
@@ -19,10 +19,11 @@ Task::Task(const Model& model)
     subtree_end_.push_back(model.subtreeEnd(b));
     body_frames_.push_back(model.bodyFrame(b));
   }
-  for (int j = 0; j < model.dof(); ++j) {
-    joint_bodies_parent_.push_back(model.parentBodyOfJoint(j));
-    joint_names_.push_back(model.joint(j).name);
+  for (const Joint& joint : model.joints()) {
+    joint_dofs_.emplace_back(joint.v_index, joint.nv());
+    joint_names_.push_back(joint.name);
   }
+  for (int v = 0; v < model.nv(); ++v) dof_parent_bodies_.push_back(model.parent(v + 1));
   addMimicRows(model);
   reorder();
 }
@@ -33,16 +34,16 @@ void Task::addMimicRows(const Model& model) {
   for (const int m : model.mimicJoints()) {
     const Mimic& law = model.joint(m).mimic;
     const struct {
-      int joint;
+      int dof;
       double coefficient;
-    } pieces[] = {{m, 1.0}, {law.leader, -law.multiplier}};
+    } pieces[] = {{model.joint(m).v_index, 1.0}, {model.joint(law.leader).v_index, -law.multiplier}};
     for (const auto& piece : pieces) {
       if (piece.coefficient == 0.0) continue;  // a = 0: the mimic joint is held at its offset
       for (const bool parent_side : {false, true}) {
-        const int body = parent_side ? model.parentBodyOfJoint(piece.joint) : piece.joint + 1;
+        const int body = parent_side ? model.parent(piece.dof + 1) : piece.dof + 1;
         ConstraintGroup g{model.bodyFrame(body), body, Expressed::World, mimic_rows_, 1, ConstraintMatrix()};
         g.reference_side = parent_side;
-        g.joint = piece.joint;
+        g.dof = piece.dof;
         g.coefficient = piece.coefficient;
         g.mimic_row = true;
         groups_.push_back(g);
@@ -133,21 +134,27 @@ int Task::addRelativeConstraint(const std::string& frame, const std::string& ref
 }
 
 int Task::addJointConstraint(int joint) {
-  if (joint < 0 || joint >= dof_)
+  const auto joints = static_cast<int>(joint_dofs_.size());
+  if (joint < 0 || joint >= joints)
     throw ModelError("task: joint index " + std::to_string(joint) + " out of range (the model has " +
-                     std::to_string(dof_) + " joints)");
-  const int row = constraintRows();
-  growTargets(1);  // first: it may refuse, and the task stays as it was
-  for (const bool parent_side : {false, true}) {
-    const int body = parent_side ? joint_bodies_parent_[static_cast<std::size_t>(joint)] : joint + 1;
-    ConstraintGroup g{body_frames_[static_cast<std::size_t>(body)], body, Expressed::World, row, 1, ConstraintMatrix()};
-    g.reference_side = parent_side;
-    g.joint = joint;
-    g.coefficient = 1.0;
-    groups_.push_back(g);
+                     std::to_string(joints) + " joints)");
+  const int first_row = constraintRows();
+  const auto [v_index, nv] = joint_dofs_[static_cast<std::size_t>(joint)];
+  growTargets(nv);  // first: it may refuse, and the task stays as it was
+  for (int k = 0; k < nv; ++k) {  // one row per DOF, in order
+    const int dof = v_index + k;
+    for (const bool parent_side : {false, true}) {
+      const int body = parent_side ? dof_parent_bodies_[static_cast<std::size_t>(dof)] : dof + 1;
+      ConstraintGroup g{body_frames_[static_cast<std::size_t>(body)], body, Expressed::World, first_row + k, 1,
+                        ConstraintMatrix()};
+      g.reference_side = parent_side;
+      g.dof = dof;
+      g.coefficient = 1.0;
+      groups_.push_back(g);
+    }
   }
   reorder();
-  return row;
+  return first_row;
 }
 
 int Task::addJointConstraint(const std::string& joint) {
@@ -176,7 +183,7 @@ ModelWarning fixedBaseContact(const std::string& frame, const std::string& base_
 int Task::addContact(int frame, const ConstraintMatrix& A, Expressed expressed) {
   const int first = addConstraint(frame, A, expressed);
   for (ConstraintGroup& g : groups_)
-    if (!g.mimic_row && g.joint < 0 && g.first_row == first) g.contact = true;
+    if (!g.mimic_row && g.dof < 0 && g.first_row == first) g.contact = true;
   reorder();
   const bool warned = std::any_of(warnings_.begin(), warnings_.end(),
                                   [](const ModelWarning& w) { return w.code == WarningCode::FixedBaseContact; });
@@ -222,7 +229,7 @@ void Task::reorder() {
       contact_column_.push_back(g.contact ? 1 : 0);
     }
   has_contacts_ = std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.contact; });
-  const auto bodies = static_cast<std::size_t>(dof_ + 1);
+  const std::size_t bodies = subtree_end_.size();
   active_.assign(bodies + 1, 0);  // active_[N + 1] = 0: no body beyond the last
   for (std::size_t body = 0; body <= bodies; ++body)
     for (const ConstraintGroup& g : groups_)

@@ -1681,8 +1681,7 @@ TEST_CASE("info: every joint with its type, nq, nv, q_index and v_index; the roo
   }
 }
 
-// Hidden until the core's sweeps run on multi-DOF joints (issue #25, "sweeps per DOF").
-TEST_CASE("solve: multi-DOF joints by name, the solution's dofs; the tool and the library agree", "[golden][.]") {
+TEST_CASE("solve: multi-DOF joints by name, the solution's dofs; the tool and the library agree", "[golden]") {
   const Json s = solve(problem("multi_joint.json"));
   CHECK(s["joints"] == Json::array({"j1", "float", "j2", "slide"}));
   CHECK(s["dofs"] == Json::array({"j1", "float.vx", "float.vy", "float.vz", "float.wx", "float.wy", "float.wz", "j2",

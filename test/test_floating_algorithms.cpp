@@ -153,7 +153,7 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
     for (std::size_t l = 0; l < p.spec.links.size(); ++l) {
       const int f = model.frameIndex(p.spec.links[l].name);
       ++frames;
-      if (model.frame(f).body == 0) ++base_frames;
+      if (model.frame(f).body == model.baseBody()) ++base_frames;
       const Eigen::Isometry3d& T = kin.poses[l];
       Eigen::Isometry3d pose;
       REQUIRE(framePose(model, ws, f, pose));

@@ -100,7 +100,7 @@ TEST_CASE("solo12 and the humanoid load with each base type", "[urdf][floating]"
     for (const Model* m : {&fixed, &free, &planar}) {
       CHECK(m->dof() == robot.dof);
       CHECK(m->frames().size() == fixed.frames().size());
-      CHECK(m->inertia(0).mass >= robot.base_link_mass);
+      CHECK(m->inertia(m->baseBody()).mass >= robot.base_link_mass);
       CHECK(totalMass(*m) == Approx(totalMass(fixed)).epsilon(1e-15));
     }
     CHECK(fixed.nq() == robot.dof);
@@ -113,16 +113,19 @@ TEST_CASE("solo12 and the humanoid load with each base type", "[urdf][floating]"
     CHECK(planar.basePlacement().r.isZero(0.0));
     std::printf("%s: %d joints; nq/nv fixed %d/%d, free %d/%d, planar %d/%d; base mass %.9g kg of %.9g kg\n",
                 robot.file, fixed.dof(), fixed.nq(), fixed.nv(), free.nq(), free.nv(), planar.nq(), planar.nv(),
-                free.inertia(0).mass, totalMass(free));
+                free.inertia(free.baseBody()).mass, totalMass(free));
   }
-  // solo12's base_link has its own inertial, and nothing is welded to it: body 0 is exactly that link.
+  // solo12's base_link has its own inertial, and nothing is welded to it: the base body is exactly that link.
   const Model solo = loadUrdfFile(kModels + "/solo12.urdf", withBase(BaseType::Free));
-  CHECK(solo.inertia(0).mass == 1.16115091);
-  CHECK(solo.inertia(0).inertiaAboutCom().diagonal().isApprox(Vec3(0.00578574, 0.01938108, 0.02476124), 1e-14));
+  CHECK(solo.inertia(solo.baseBody()).mass == 1.16115091);
+  CHECK(solo.inertia(solo.baseBody())
+            .inertiaAboutCom()
+            .diagonal()
+            .isApprox(Vec3(0.00578574, 0.01938108, 0.02476124), 1e-14));
   // The humanoid's base_link is massless; BODY (27 kg) is welded to it.
   const Model humanoid = loadUrdfFile(kModels + "/simple_humanoid.urdf", withBase(BaseType::Free));
-  CHECK(humanoid.inertia(0).mass == 27.0);
-  CHECK(humanoid.frame(humanoid.frameIndex("BODY")).body == 0);
+  CHECK(humanoid.inertia(humanoid.baseBody()).mass == 27.0);
+  CHECK(humanoid.frame(humanoid.frameIndex("BODY")).body == humanoid.baseBody());
 }
 
 TEST_CASE("the root link's own inertia is body 0's, fixed base too", "[urdf][floating]") {
@@ -195,7 +198,7 @@ TEST_CASE("the model may start at the floating joint's child link, or below it",
   CHECK(body.dof() == 0);
   CHECK(body.nq() == 7);
   CHECK(body.nv() == 6);
-  CHECK(body.inertia(0).mass == 2.0);
+  CHECK(body.inertia(body.baseBody()).mass == 2.0);
   // The same body without the joint, given a base by the option.
   const std::string bare = R"(<robot name="box"><link name="box"><inertial><mass value="2"/>
     <inertia ixx="1" ixy="0" ixz="0" iyy="2" iyz="0" izz="3"/></inertial></link></robot>)";

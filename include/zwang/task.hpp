@@ -227,9 +227,9 @@ class Task {
   bool has_contacts_ = false;
   std::vector<char> contact_column_;
   std::vector<std::pair<int, int>> joint_dofs_;  // per joint, its v_index and nv (copied from the model)
-  std::vector<int> dof_parent_bodies_;            // per DOF, the parent of the body it moves
-  std::vector<int> body_frames_;          // per body, its frame
-  std::vector<Mimic> mimic_laws_;         // the law of each mimic row (its mimic joint below)
+  std::vector<int> dof_parent_bodies_;           // per DOF, the parent of the body it moves
+  std::vector<int> body_frames_;                 // per body, its frame
+  std::vector<Mimic> mimic_laws_;                // the law of each mimic row (its mimic joint below)
   std::vector<int> mimic_joint_of_row_;
   std::vector<AppliedWrench> wrenches_;
   Eigen::VectorXd b_;

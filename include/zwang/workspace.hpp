@@ -189,8 +189,8 @@ class Workspace {
   std::vector<double> D;          ///< D_i = d_i + S_iᵀ I^A_i S_i (a joint's D: these pivots are its LDLᵀ factor)
   std::vector<double> inverse_D;  ///< 1 / D_i (the sweeps multiply)
   std::vector<double> u;          ///< τ_i − S_iᵀ(F^A_bias,i + I^A_i Ẍ_bias,i)
-  Eigen::MatrixXd SA;                ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
-  ConstraintMatrix Ahat;             ///< A_i (6 × capacity), updated in place from A_N down to A_0
+  Eigen::MatrixXd SA;             ///< column i: (S_iᵀ A_i)ᵀ, capacity × bodies
+  ConstraintMatrix Ahat;          ///< A_i (6 × capacity), updated in place from A_N down to A_0
   /// U_0, acceleration energy of bias forces and torques: the report's U (not
   /// Featherstone's or Pinocchio's U = I^A S, which is IAS here).
   Eigen::VectorXd U;

@@ -2,13 +2,17 @@
 
 namespace zwang::internal {
 
+const char* jointDofsWord(const Model& model) {
+  return model.dof() == static_cast<int>(model.joints().size()) ? "joints" : "joint DOFs";
+}
+
 Status velocitySizeMismatch(const Model& model, const char* name, Eigen::Index size) {
   if (model.baseVelocitySize() == 0 && model.nv() == static_cast<int>(model.joints().size()))  // one-DOF joints
     return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %d joints", name,
                          static_cast<long>(size), model.nv());
-  return Status::error(StatusCode::SizeMismatch,
-                       "%s has %ld entries, the model has nv = %d (%d base velocity coordinates + %d joint DOFs)", name,
-                       static_cast<long>(size), model.nv(), model.baseVelocitySize(), model.dof());
+  return Status::error(
+      StatusCode::SizeMismatch, "%s has %ld entries, the model has nv = %d (%d base velocity coordinates + %d %s)",
+      name, static_cast<long>(size), model.nv(), model.baseVelocitySize(), model.dof(), jointDofsWord(model));
 }
 
 Status workspaceMismatch(const Model& model, const Workspace& ws) {

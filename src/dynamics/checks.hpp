@@ -38,6 +38,8 @@ inline Status checkFinite(const char* name, const Eigen::MatrixBase<Derived>& x)
 // message); a quaternion's norm goes to checkConfiguration. The size messages
 // name the base's share when there is one ("… the model has nv = 9 (3 base
 // velocity coordinates + 6 joint DOFs)").
+// "joints" when every joint below the root has one DOF, else "joint DOFs": what dof() counts.
+const char* jointDofsWord(const Model& model);
 Status velocitySizeMismatch(const Model& model, const char* name, Eigen::Index size);
 inline Status checkStateConfiguration(const Model& model, const VectorRef& q) {
   return model.nq() == model.nv() && model.nv() == model.dof() ? checkVector("q", q, model.nq())

@@ -189,9 +189,9 @@ Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const E
       return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",
                            static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.nv());
     return Status::error(StatusCode::SizeMismatch,
-                         "Jacobian output is %ldx%ld, expected 6x%d (nv = %d base velocity coordinates + %d joint DOFs)",
+                         "Jacobian output is %ldx%ld, expected 6x%d (nv = %d base velocity coordinates + %d %s)",
                          static_cast<long>(J.rows()), static_cast<long>(J.cols()), model.nv(), model.baseVelocitySize(),
-                         model.dof());
+                         model.dof(), internal::jointDofsWord(model));
   }
   if (Status s = checkFrame(model, frame); !s) return s;
   if (Status s = forwardKinematics(model, ws, q); !s) return s;

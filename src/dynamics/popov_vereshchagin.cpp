@@ -107,7 +107,7 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
                          "task has %d constraint rows, the workspace was made for at most %d", task.constraintRows(),
                          ws.constraintCapacity());
   if (Status s = checkBalanceOptions(task.balance); !s) return s;
-  if (Status s = checkStateConfiguration(model, q); !s) return s;  // size, finite, unit quaternions
+  if (Status s = checkConfiguration(model, q); !s) return s;  // size, finite (naming the joint), unit quaternions
   if (!workspaceFitsModel(model, ws)) return workspaceMismatch(model, ws);
   if (Status s = checkVelocityVector(model, "qd", qd); !s) return s;
   if (Status s = checkVelocityVector(model, "tau", tau); !s) return s;
@@ -267,8 +267,8 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     const double D = dof.rotor_inertia + S.dot(IAS);  // line 13
     ws.D[at(i)] = D;
     if (!(D > 1e-300))
-      return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)",
-                           dof.name.c_str(), D);
+      return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)", dof.name.c_str(),
+                           D);
     Vec6 pA = ws.FA[at(i)];
     pA.noalias() += IA * c;                   // F^A + I^A Ẍ_bias
     const double u = tau[i - 1] - S.dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
@@ -489,11 +489,10 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   for (int i = N; i >= 1; --i) {
     while (c_begin > 0 && bodyOfDof(dofs[static_cast<std::size_t>(c_begin - 1)]) >= i) --c_begin;
     const int end = model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: k)
-    const Eigen::Index c_end = k == 0 || end > bodyOfDof(dofs.back())
-                                   ? k
-                                   : std::lower_bound(dofs.begin(), dofs.end(), end, [](int d, int b) {
-                                       return bodyOfDof(d) < b;
-                                     }) - dofs.begin();
+    const Eigen::Index c_end =
+        k == 0 || end > bodyOfDof(dofs.back()) ? k : std::lower_bound(dofs.begin(), dofs.end(), end, [](int d, int b) {
+                                                       return bodyOfDof(d) < b;
+                                                     }) - dofs.begin();
     s.run_begin[i] = c_begin;
     s.run_end[i] = c_end;
     const Vec6& S = ws.S[at(i)];

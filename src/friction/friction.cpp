@@ -188,8 +188,7 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
   fs.stuck_dofs.clear();  // reserved for every DOF: no allocation
   for (const int j : stuck) fs.stuck_dofs.push_back(dofOfEntry(model, j));
   if (k > 0)
-    unitTorqueColumns(model, task, ws, fs.stuck_dofs, fs.unit_torques, fs.dnu.topLeftCorner(m, k),
-                      fs.dqdd.leftCols(k));
+    unitTorqueColumns(model, task, ws, fs.stuck_dofs, fs.unit_torques, fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k));
   return {};
 }
 
@@ -204,9 +203,15 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
 // to the base (line 29, every motion in the world frame).
 Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const FrictionScratch& fs, Eigen::Index a,
                              int body) {
-  Vec6 terms = Vec6::Zero();
-  for (int l = model.parent(body); l > 0; l = model.parent(l))
-    terms += ws.S[static_cast<std::size_t>(l)].cwiseAbs() * std::abs(fs.dqdd(l - 1, a));
+  // A joint's motion S δq̈ is one term, however many DOFs it has (its DOFs
+  // share a body: their parts are the components of one motion).
+  Vec6 terms = Vec6::Zero(), joint_motion = Vec6::Zero();
+  for (int l = model.parent(body); l > 0; l = model.parent(l)) {
+    joint_motion += ws.S[static_cast<std::size_t>(l)] * fs.dqdd(l - 1, a);
+    if (model.dofs()[static_cast<std::size_t>(l - 1)].index_in_joint > 0) continue;
+    terms += joint_motion.cwiseAbs();
+    joint_motion.setZero();
+  }
   return terms;
 }
 
@@ -233,7 +238,7 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
 QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
                       const FrictionOptions& options, double acc_scale, FrictionScratch& fs) {
   const auto k = static_cast<Eigen::Index>(stuck.size());
-  const int iv = model.baseVelocitySize();  // the joints' rows of q̈ follow a floating base's
+  const int iv = dofOfEntry(model, 0);  // the friction entries' rows of q̈
   auto K = fs.K.topLeftCorner(k, k);
   for (Eigen::Index a = 0; a < k; ++a) fs.qdd0_stuck[a] = fs.qdd0[iv + stuck[static_cast<std::size_t>(a)]];
   {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers: k² of them)
@@ -265,8 +270,10 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
     // without this term, 1e-14 with it, found by test_mimic).
     const int m = task.solverColumns();
     if (m > 0)
-      curvature_scale = std::max(curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
-                                                      ws.SA.topRows(m).cwiseAbs().maxCoeff() / min_D);
+      curvature_scale = std::max(
+          curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
+                               ws.SA.block(0, bodyOfDof(dofOfEntry(model, 0)), m, model.dof()).cwiseAbs().maxCoeff() /
+                               min_D);  // over the DOFs friction acts on
   }
   termSizes(model, task, ws, stuck, fs);
   const double tolerance = options.kkt_tolerance * acc_scale;
@@ -296,7 +303,7 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
   carryMimicTorques(model, fs.tau_control_first);
   for (Eigen::Index a = 0; a < k; ++a) {
     const int j = stuck[static_cast<std::size_t>(a)];
-    fs.effort_offset[a] = fs.tau_control_first[model.baseVelocitySize() + j] - fs.mu[a];
+    fs.effort_offset[a] = fs.tau_control_first[dofOfEntry(model, j)] - fs.mu[a];
     fs.margin_limit[a] = options.margin * fs.breakaway[j];
   }
 }
@@ -362,7 +369,7 @@ void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index k, Wor
 // joints feel; returns Σ μ*_j q̈*_j (the dual's term beyond Z).
 double frictionStates(const Model& model, const Eigen::VectorXd& qdd_all, double acc_tolerance, FrictionScratch& fs,
                       FrictionResult& fr) {
-  const int iv = model.baseVelocitySize();
+  const int iv = dofOfEntry(model, 0);
   const auto qdd = qdd_all.tail(model.dof());
   fr.mu.setZero();
   fs.tau_joint = fs.tau_effective;  // the torques the joints feel: τ − kinetic − Wᵀμ
@@ -418,7 +425,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   if (k < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
   for (Eigen::Index a = 0; a < k; ++a)         // μ_j enters as the torque −μ_j
     fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);
-  const int iv = model.baseVelocitySize();
+  const int iv = dofOfEntry(model, 0);
 
   // The acceleration scale, of the stuck joints only (a light, fast joint
   // elsewhere in the chain must not set it): their accelerations q̈_Θ(0).

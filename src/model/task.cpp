@@ -140,13 +140,13 @@ int Task::addJointConstraint(int joint) {
                      std::to_string(joints) + " joints)");
   const int first_row = constraintRows();
   const auto [v_index, nv] = joint_dofs_[static_cast<std::size_t>(joint)];
-  growTargets(nv);  // first: it may refuse, and the task stays as it was
+  growTargets(nv);                // first: it may refuse, and the task stays as it was
   for (int k = 0; k < nv; ++k) {  // one row per DOF, in order
     const int dof = v_index + k;
     for (const bool parent_side : {false, true}) {
       const int body = parent_side ? dof_parent_bodies_[static_cast<std::size_t>(dof)] : dof + 1;
-      ConstraintGroup g{body_frames_[static_cast<std::size_t>(body)], body, Expressed::World, first_row + k, 1,
-                        ConstraintMatrix()};
+      ConstraintGroup g{
+          body_frames_[static_cast<std::size_t>(body)], body, Expressed::World, first_row + k, 1, ConstraintMatrix()};
       g.reference_side = parent_side;
       g.dof = dof;
       g.coefficient = 1.0;

@@ -255,17 +255,18 @@ void bindModel(py::module_& m) {
           },
           "list of (code, message): what was doubtful in the data ('point_mass', 'placeholder_inertia', ...)")
       .def_property_readonly(
-          "base_mass", [](const Model& model) { return model.inertia(0).mass; },
+          "base_mass", [](const Model& model) { return model.inertia(model.baseBody()).mass; },
           "mass of body 0, the root link and the links welded to it [kg]: in the dynamics when the base floats, "
           "not on a fixed base")
       .def_property_readonly(
           "mass",
           [](const Model& model) {
     double mass = 0.0;
-    for (int b = 1; b < model.bodyCount(); ++b) mass += model.inertia(b).mass;
+    for (int b = 1; b < model.bodyCount(); ++b)
+      if (b != model.baseBody()) mass += model.inertia(b).mass;
     return mass;
           },
-          "total mass of the moving bodies [kg]")
+          "total mass of the bodies beyond the base [kg] (base_mass is the base's)")
       .def(
           "with_rotor_inertia",
           [](const Model& model, py::handle values) {

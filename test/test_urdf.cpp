@@ -429,18 +429,22 @@ TEST_CASE("error: unknown root or tip, tip not below root", "[urdf][errors]") {
                       Contains("<string>") && Contains("'l1'") && Contains("'sensor'") && Contains("no moving joint"));
 }
 
-TEST_CASE("error: floating and planar joints on the chain", "[urdf][errors]") {
-  // Below the root they are refused (at the root they are the base: test_urdf_floating).
+TEST_CASE("floating and planar joints on the chain are free and planar joints", "[urdf][errors]") {
+  // Below the root they are joints of the model (issue #25; at the root they are the base: test_urdf_floating).
   const auto below = [](const std::string& type) {
     return arm(kJointBody, kInertial,
                "<joint name=\"j2\" type=\"" + type +
                    R"("><parent link="l1"/><child link="l2"/><axis xyz="0 0 1"/></joint><link name="l2">)" + kInertial +
                    "</link>");
   };
-  REQUIRE_THROWS_WITH(loadUrdfString(below("floating")), Contains("<string>") && Contains("joint 'j2'") &&
-                                                             Contains("floating") && Contains("not supported"));
-  REQUIRE_THROWS_WITH(loadUrdfString(below("planar")),
-                      Contains("joint 'j2'") && Contains("planar") && Contains("not supported"));
+  const Model floating = loadUrdfString(below("floating"));
+  REQUIRE(floating.joints().size() == 2);
+  CHECK(floating.joint(1).type == JointType::Free);
+  CHECK(floating.nv() == 7);
+  const Model planar = loadUrdfString(below("planar"));
+  REQUIRE(planar.joints().size() == 2);
+  CHECK(planar.joint(1).type == JointType::Planar);
+  CHECK(planar.nq() == 4);
   // Off the chain it is fine (it is not part of the model).
   const std::string extra = R"(<joint name="free" type="floating"><parent link="base"/><child link="ball"/></joint>
       <link name="ball">)" + kInertial +

@@ -1,9 +1,9 @@
 // Floating bases from URDF (issue #15): UrdfOptions::base on files without a
 // root joint (models/solo12.urdf, models/simple_humanoid.urdf), a floating or
 // planar root joint in the file ("world → base_link"), the root link's own
-// inertia in body 0, and the errors: a floating joint below the root, a base
-// option on a file that floats already, a planar axis that is not the joint
-// frame's z.
+// inertia in body 0, a floating joint below the root (a free joint, issue
+// #25), and the errors: a base option on a file that floats already, a planar
+// root joint's axis that is not the joint frame's z.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -264,22 +264,26 @@ TEST_CASE("a free robot at rest under gravity falls at g", "[urdf][floating]") {
   }
 }
 
-TEST_CASE("errors: floating joints off the root, a base on a floating file, a planar axis", "[urdf][floating]") {
+TEST_CASE("floating joints off the root; errors: a base on a floating file, a planar axis", "[urdf][floating]") {
   const std::string solo = readText(kModels + "/solo12.urdf");
   // A floating joint below the root.
   std::string below = solo;
   const std::string knee = R"(<joint name="FL_KFE" type="revolute">)";
   REQUIRE(below.find(knee) != std::string::npos);
   below.replace(below.find(knee), knee.size(), R"(<joint name="FL_KFE" type="floating">)");
-  REQUIRE_THROWS_WITH(loadUrdfString(below), Contains("joint 'FL_KFE'") && Contains("type floating is not supported") &&
-                                                 Contains("only a root joint"));
-  REQUIRE_THROWS_WITH(loadUrdfString(below, withBase(BaseType::Free)), Contains("joint 'FL_KFE'"));
-  // A root link with a floating joint and another joint: not a root joint, refused where it is loaded.
+  // … is a free joint of the model (issue #25: test_urdf_joints).
+  const Model free_knee = loadUrdfString(below, withBase(BaseType::Free));
+  CHECK(free_knee.joint(free_knee.jointIndex("FL_KFE")).type == JointType::Free);
+  CHECK(free_knee.nv() == 6 + 11 + 6);
+  // A root link with a floating joint and another joint: not a root joint, a free joint below the fixed root.
   const std::string two = insertAfterRobot(
       solo,
       rootJoint("floating", "base_link") +
           R"(<joint name="table_joint" type="fixed"><parent link="world"/><child link="table"/></joint><link name="table"/>)");
-  REQUIRE_THROWS_WITH(loadUrdfString(two), Contains("joint 'root_joint'") && Contains("not supported"));
+  const Model table = loadUrdfString(two);
+  CHECK(table.baseType() == BaseType::Fixed);
+  CHECK(table.joint(0).name == "root_joint");
+  CHECK(table.joint(0).type == JointType::Free);
   // A base option on a file that floats already.
   const std::string floating = insertAfterRobot(solo, rootJoint("floating", "base_link"));
   REQUIRE_THROWS_WITH(loadUrdfString(floating, withBase(BaseType::Free)),

@@ -196,8 +196,10 @@ enum class WarningCode {
   PlaceholderInertia,  ///< rotational inertia too small for the mass (a body denser than osmium)
   TriangleInequality,  ///< principal moments with a + b < c (no real body has them)
   PlaceholderLimits,   ///< <limit lower == upper, effort == velocity == 0>: read as "no limits"
-  MassBeyondTip,       ///< links behind a moving joint below the tip carry mass the chain ignores
-  MassOffChain,        ///< links behind a moving joint off the chain (a side branch) carry mass it ignores
+  /// a <limit> on a floating or planar URDF joint, ignored: a multi-DOF joint has no limits in zwang
+  IgnoredLimits,
+  MassBeyondTip,  ///< links behind a moving joint below the tip carry mass the chain ignores
+  MassOffChain,   ///< links behind a moving joint off the chain (a side branch) carry mass it ignores
   /// that mass was attached to the tip body (UrdfOptions::attach_beyond_tip); a note, strict mode lets it pass
   PayloadAttached,
   /// a mimic joint was locked (UrdfOptions::mimic = MimicJoints::Lock); a note, strict mode lets it pass
@@ -345,9 +347,13 @@ class ModelBuilder {
   /// own inertia. The parent is the body of `parent_frame` (default: the last
   /// body added). Joints are added depth first: the parent must be the last
   /// body added or one of its ancestors (ModelError otherwise), so that every
-  /// subtree is a contiguous range of bodies.
+  /// subtree is a contiguous range of bodies. `child_placement` is the child
+  /// link's frame relative to the joint's child frame, ᶜX_body (identity: the
+  /// same frame); `child_inertia` is given in the link's frame. The URDF loader
+  /// turns a planar joint's frame so its z is the URDF axis and gives the link
+  /// back its own orientation this way.
   ModelBuilder& addJoint(const Joint& joint, const std::string& child_frame, const RigidInertia& child_inertia,
-                         const std::string& parent_frame = "");
+                         const std::string& parent_frame = "", const Transform& child_placement = Transform{});
   /// Attach a frame rigidly to an existing frame (a fixed URDF joint); its
   /// inertia (given in the new frame) is merged into the parent body.
   ModelBuilder& addFixedFrame(const std::string& name, const std::string& parent_frame, const Transform& placement,

@@ -56,8 +56,21 @@ enum class MimicJoints {
 ///   quaternion] puts the base where the URDF draws it). Planar: the joint
 ///   frame (`<origin>`) is the plane (Model::basePlacement()), its `<axis>`
 ///   must be its z axis, `0 0 1` (ModelError otherwise, saying how to turn
-///   the origin instead). A `floating` or `planar` joint anywhere else, among
-///   the joints loaded, is a ModelError naming it.
+///   the origin instead).
+/// * A `floating` or `planar` joint anywhere else is a joint of the model
+///   (issue #25): JointType::Free (q = [x, y, z, q_w, q_x, q_y, q_z] of the
+///   child link in the joint frame, the URDF `<origin>`) or JointType::Planar
+///   (q = [x, y, ψ]). URDF moves a planar joint's child in the plane normal to
+///   its `<axis>`: zwang turns the joint frame by the shortest rotation that
+///   takes its z onto the axis (about z × axis; a half turn about x for −z),
+///   so x and y are along that rotation's images of the joint frame's x and y
+///   and ψ turns about the axis; the child link keeps the URDF's orientation
+///   (its frame is placed on the joint's child body by the inverse rotation).
+///   `<dynamics>` friction and damping apply to each DOF (a box per DOF);
+///   a `<limit>` on such a joint is ignored with an IgnoredLimits warning
+///   (which of its coordinates would it bound? strict mode refuses it). Such
+///   a joint is locked (beyond the tip, or as a locked mimic joint) at its
+///   origin; a locked position for it is a ModelError.
 /// * Otherwise `base` may give the root link a free-flyer or a planar joint
 ///   (the world's x-y plane) for the many legged-robot URDFs that leave it out.
 /// * The root link's own `<inertial>` is body 0's (with the links welded to

@@ -59,28 +59,41 @@ void printTable(const std::vector<std::vector<std::string>>& rows) {
 // The base (body 0: the root and every link welded to it): a fixed base never
 // moves, so its mass does not enter the dynamics; a floating one's does.
 // Either way it is shown apart from the bodies the joints move.
+// The base link's body is Model::baseBody() (0 on a fixed base; a floating
+// base's root joint moves it).
 struct Masses {
   double moving = 0.0, base = 0.0;
   explicit Masses(const Model& model) : base(model.inertia(model.baseBody()).mass) {
-    for (int b = 1; b < model.bodyCount(); ++b) moving += model.inertia(b).mass;
+    for (int b = model.baseBody() + 1; b < model.bodyCount(); ++b) moving += model.inertia(b).mass;
   }
 };
 
 std::string bodyLink(const Model& model, int body) { return model.frame(model.bodyFrame(body)).name; }
 
-// The joint that moves joint j's parent body (−1: it hangs from the base).
-int parentJoint(const Model& model, int j) { return model.parentBodyOfJoint(j) - 1; }
+// The joint (index in joints()) that moves joint j's parent body; −1: it hangs from the base.
+int parentJoint(const Model& model, int j) {
+  const int body = model.parentBodyOfJoint(j);
+  return body <= model.baseBody() ? -1 : model.dofs()[static_cast<std::size_t>(body - 1)].joint;
+}
 
 Json infoJson(const Model& model, const std::string& path) {
+  // Every joint in the order of q and v: a floating base's root joint first (it hangs from the world, body 0).
   Json joints = Json::array();
-  for (int k = 0; k < model.dof(); ++k) {
-    const Joint& j = model.joint(k);
-    const int parent = parentJoint(model, k);
+  const int roots = static_cast<int>(model.allJoints().size() - model.joints().size());
+  for (int a = 0; a < static_cast<int>(model.allJoints().size()); ++a) {
+    const Joint& j = model.allJoints()[static_cast<std::size_t>(a)];
+    const int k = a - roots;  // index in joints(), −1 for the root joint
+    const int parent = k < 0 ? -1 : parentJoint(model, k);
     joints.push_back({{"name", j.name},
                       {"parent", parent < 0 ? Json(nullptr) : Json(model.joint(parent).name)},
-                      {"parent_body", model.parentBodyOfJoint(k)},
+                      {"parent_body", k < 0 ? 0 : model.parentBodyOfJoint(k)},
+                      {"body", j.body()},
                       {"type", toString(j.type)},
-                      {"axis", {j.axis.x(), j.axis.y(), j.axis.z()}},
+                      {"nq", j.nq()},
+                      {"nv", j.nv()},
+                      {"q_index", j.q_index},
+                      {"v_index", j.v_index},
+                      {"axis", j.nv() == 1 ? Json({j.axis.x(), j.axis.y(), j.axis.z()}) : Json(nullptr)},
                       {"lower", finiteOrNull(j.lower)},
                       {"upper", finiteOrNull(j.upper)},
                       {"effort_limit", finiteOrNull(j.effort_limit)},
@@ -94,6 +107,8 @@ Json infoJson(const Model& model, const std::string& path) {
                                                          {"offset", j.mimic.offset}})
                                                  : Json(nullptr)}});
   }
+  Json dofs = Json::array();
+  for (const Dof& d : model.dofs()) dofs.push_back(d.name);
   Json frames = Json::array();
   for (const Frame& f : model.frames())
     frames.push_back({{"name", f.name}, {"body", f.body}, {"body_link", bodyLink(model, f.body)}});
@@ -113,8 +128,13 @@ Json infoJson(const Model& model, const std::string& path) {
                          {"y_axis", vec(axes.col(1))},
                          {"normal", vec(axes.col(2))}};
   }
-  Json rest = {{"chain", model.isChain()},       {"joints", std::move(joints)}, {"frames", std::move(frames)},
-               {"moving_mass", mass.moving},     {"base_mass", mass.base},      {"total_mass", mass.moving + mass.base},
+  Json rest = {{"chain", model.isChain()},
+               {"joints", std::move(joints)},
+               {"dofs", std::move(dofs)},
+               {"frames", std::move(frames)},
+               {"moving_mass", mass.moving},
+               {"base_mass", mass.base},
+               {"total_mass", mass.moving + mass.base},
                {"warnings", std::move(warnings)}};
   for (auto& item : rest.items()) out[item.key()] = std::move(item.value());
   return out;
@@ -129,14 +149,23 @@ std::string triple(const Vec3& v) {
 }
 
 void printInfoTable(const Model& model, const std::string& path) {
-  std::printf("%s: %d moving joint%s%s, %zu frames (%s)\n", model.name().c_str(), model.dof(),
-              model.dof() == 1 ? "" : "s", model.isChain() ? "" : " in a tree", model.frames().size(), path.c_str());
+  const int joints = static_cast<int>(model.joints().size());
+  std::printf("%s: %d moving joint%s%s, %zu frames (%s)\n", model.name().c_str(), joints, joints == 1 ? "" : "s",
+              model.isChain() ? "" : " in a tree", model.frames().size(), path.c_str());
   if (!model.hasFloatingBase()) {
-    std::printf("base: fixed (nq = nv = %d)\n", model.dof());
+    if (model.nq() == model.nv())
+      std::printf("base: fixed (nq = nv = %d)\n", model.nv());
+    else
+      std::printf("base: fixed (nq = %d, nv = %d)\n", model.nq(), model.nv());
   } else {
-    const int n = model.dof(), cq = model.baseConfigurationSize(), cv = model.baseVelocitySize();
-    std::printf("base: %s, link %s (q: %d base coordinates + %d joint%s = nq %d; v: %d + %d = nv %d)\n",
-                toString(model.baseType()), model.frame(0).name.c_str(), cq, n, n == 1 ? "" : "s", model.nq(), cv, n,
+    const int cq = model.baseConfigurationSize(), cv = model.baseVelocitySize();
+    const int nq = model.nq() - cq, nv = model.nv() - cv;
+    // One-DOF joints: one coordinate each; else the joints' coordinates, of so many joints.
+    const std::string of =
+        nq == joints ? std::to_string(joints) + (joints == 1 ? " joint" : " joints")
+                     : std::to_string(nq) + " of " + std::to_string(joints) + (joints == 1 ? " joint" : " joints");
+    std::printf("base: %s, link %s (q: %d base coordinates + %s = nq %d; v: %d + %d = nv %d)\n",
+                toString(model.baseType()), model.frame(0).name.c_str(), cq, of.c_str(), model.nq(), cv, nv,
                 model.nv());
     if (model.baseType() == BaseType::Planar)
       std::printf("  moving in the plane through %s with normal %s (x axis %s)\n",
@@ -147,10 +176,10 @@ void printInfoTable(const Model& model, const std::string& path) {
   std::printf("\njoints\n");
   std::vector<std::vector<std::string>> rows{{"#", "name", "parent", "type", "axis", "lower", "upper", "effort",
                                               "velocity", "breakaway", "kinetic", "viscous", "rotor_inertia"}};
-  for (int k = 0; k < model.dof(); ++k) {
+  for (int k = 0; k < static_cast<int>(model.joints().size()); ++k) {
     const Joint& j = model.joint(k);
-    char axis[64];
-    std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
+    char axis[64] = "-";  // a multi-DOF joint has none
+    if (j.nv() == 1) std::snprintf(axis, sizeof axis, "(%g, %g, %g)", j.axis.x(), j.axis.y(), j.axis.z());
     const int parent = parentJoint(model, k);
     rows.push_back({std::to_string(k), j.name, parent < 0 ? "(base)" : model.joint(parent).name, toString(j.type), axis,
                     cell(j.lower), cell(j.upper), cell(j.effort_limit), cell(j.velocity_limit),
@@ -174,12 +203,12 @@ void printInfoTable(const Model& model, const std::string& path) {
   const Masses mass(model);
   if (model.hasFloatingBase())
     std::printf(
-        "\nmoving mass %s kg (bodies 1-%d), base mass %s kg (body 0: the root link and the links welded to "
+        "\nmoving mass %s kg (bodies %d-%d), base mass %s kg (body %d: the root link and the links welded to "
         "it; it floats: in the dynamics)\n",
-        cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
+        cell(mass.moving).c_str(), model.baseBody() + 1, model.nv(), cell(mass.base).c_str(), model.baseBody());
   else
     std::printf("\nmoving mass %s kg (bodies 1-%d), base mass %s kg (welded to the fixed base, not in the dynamics)\n",
-                cell(mass.moving).c_str(), model.dof(), cell(mass.base).c_str());
+                cell(mass.moving).c_str(), model.nv(), cell(mass.base).c_str());
   const std::size_t warnings = model.warnings().size();
   if (warnings > 0) std::printf("%zu warning%s (on stderr)\n", warnings, warnings == 1 ? "" : "s");
   std::printf("units: rad, m, N·m or N (friction, effort), N·m·s/rad (viscous), kg·m² or kg (rotor inertia)\n");

@@ -49,9 +49,9 @@ ConstraintSpec parseJointRow(const JsonReader& in, const Json& value, const std:
   c.path = path;
   c.joint = in.string(value["joint"], childPath(path, "joint"));
   if (c.joint.empty()) in.fail(childPath(path, "joint"), "is empty (name the joint whose acceleration is held)");
-  c.acceleration = value.contains("acceleration")
-                       ? in.numbers(value["acceleration"], childPath(path, "acceleration"), 1, "the joint's q̈")
-                       : Eigen::VectorXd::Zero(1);
+  // One per DOF of the joint (checked against the model in jointRowIndex); absent: zeros.
+  if (value.contains("acceleration"))
+    c.acceleration = in.numbers(value["acceleration"], childPath(path, "acceleration"));
   return c;
 }
 
@@ -198,6 +198,26 @@ BaseSpec parseBase(const JsonReader& in, const Json& value, const std::string& p
   return b;
 }
 
+// "q", "qd", "tau": an array, or an object of joint name → number or array.
+JointValues parseJointValues(const JsonReader& in, const Json& value, const std::string& path) {
+  JointValues v;
+  if (!value.is_object()) {
+    if (!value.is_array())
+      in.fail(path, "expected an array (the joints' entries in the model's order) or an object (by joint name), got " +
+                        describe(value));
+    v.array = in.numbers(value, path);
+    return v;
+  }
+  for (const auto& item : value.items()) {
+    const std::string entry = childPath(path, item.key());
+    if (item.value().is_number())
+      v.named.emplace_back(item.key(), Eigen::VectorXd::Constant(1, in.number(item.value(), entry)));
+    else
+      v.named.emplace_back(item.key(), in.numbers(item.value(), entry));
+  }
+  return v;
+}
+
 // Per-joint overrides must be non-negative.
 Eigen::VectorXd nonNegative(const JsonReader& in, const Json& value, const std::string& path) {
   Eigen::VectorXd v = in.numbers(value, path);
@@ -212,15 +232,106 @@ std::string jointList(const Model& model) {
   return list;
 }
 
+// True when every joint below the root has one DOF (the per-joint arrays are then one per joint).
+bool oneDofJoints(const Model& model) { return model.dof() == static_cast<int>(model.joints().size()); }
+
+// The names of the DOFs below the root, for messages.
+std::string dofList(const Model& model) {
+  std::string list;
+  for (std::size_t k = static_cast<std::size_t>(model.baseVelocitySize()); k < model.dofs().size(); ++k)
+    list += (list.empty() ? "" : ", ") + model.dofs()[k].name;
+  return list;
+}
+
+// The coordinates of a joint's q, for messages ("" for a one-DOF joint).
+const char* coordinateNames(JointType type) {
+  switch (type) {
+    case JointType::Spherical: return "qw, qx, qy, qz";
+    case JointType::Planar: return "x, y, yaw";
+    case JointType::Free: return "x, y, z, qw, qx, qy, qz";
+    default: return "";
+  }
+}
+
+// What an array of the joints' q (configuration) or v (velocity) entries holds, for messages.
+std::string layout(const Model& model, bool configuration) {
+  if (oneDofJoints(model)) return "one per moving joint: " + jointList(model);
+  if (!configuration) return "one per DOF: " + dofList(model);
+  std::string list;
+  for (const Joint& joint : model.joints()) {
+    list += (list.empty() ? "" : ", ") + joint.name;
+    if (joint.nq() > 1) list += std::string(" ") + toString(joint.type) + " [" + coordinateNames(joint.type) + "]";
+  }
+  return "the joints' coordinates in order: " + list;
+}
+
+// The index in joints() of the joint called `name` at `path`; unknown: the error names the model's joints
+// (and where a floating base's state goes, for its root joint).
+int jointIndexAt(const JsonReader& in, const Model& model, const std::string& name, const std::string& path,
+                 const std::string& what) {
+  for (int k = 0; k < static_cast<int>(model.joints().size()); ++k)
+    if (model.joint(k).name == name) return k;
+  if (model.hasFloatingBase() && name == model.allJoints().front().name)
+    in.fail(path, "names the root joint of the " + std::string(toString(model.baseType())) +
+                      " base: its state goes in \"base\"");
+  in.fail(path,
+          "unknown joint \"" + printable(name, 60) + "\"" + what + " (the model's joints: " + jointList(model) + ")");
+}
+
 // The joint of a joint row, named in the error with the model's joints when unknown.
 int jointRowIndex(const JsonReader& in, const Model& model, const ConstraintSpec& c) {
-  const std::string path = childPath(c.path, "joint");
-  int j = -1;
-  for (int k = 0; k < model.dof(); ++k)
-    if (model.joint(k).name == c.joint) j = k;
-  if (j < 0)
-    in.fail(path, "unknown joint \"" + printable(c.joint, 60) + "\" (the model's joints: " + jointList(model) + ")");
+  const int j = jointIndexAt(in, model, c.joint, childPath(c.path, "joint"), "");
+  const Joint& joint = model.joint(j);
+  if (c.acceleration.size() != 0 && c.acceleration.size() != joint.nv()) {
+    std::string dofs;
+    for (int k = 0; k < joint.nv(); ++k)
+      dofs += (k ? ", " : "") + model.dofs()[static_cast<std::size_t>(joint.v_index + k)].name;
+    in.fail(childPath(c.path, "acceleration"), "has " + std::to_string(c.acceleration.size()) +
+                                                   (c.acceleration.size() == 1 ? " entry" : " entries") +
+                                                   ", expected " + std::to_string(joint.nv()) +
+                                                   " (one per DOF of joint '" + joint.name + "': " + dofs + ")");
+  }
   return j;
+}
+
+// The joints' entries of "q" (configuration) or "qd"/"tau" (velocity) into `full` (the model's vector, a
+// floating base's entries first), over the defaults already there.
+void placeJointValues(const JsonReader& in, const Model& model, const JointValues& values, const char* key,
+                      bool configuration, Eigen::VectorXd& full) {
+  const int base = configuration ? model.baseConfigurationSize() : model.baseVelocitySize();
+  const long n = (configuration ? model.nq() : model.nv()) - base;
+  if (values.array) {
+    const Eigen::VectorXd& v = *values.array;
+    if (v.size() != n) {
+      // A floating base's coordinates go in "base", not in front of the joints' as in the library.
+      const bool with_base = model.hasFloatingBase() && (v.size() == model.nq() || v.size() == model.nv());
+      in.fail(key, "has " + std::to_string(v.size()) + (v.size() == 1 ? " entry" : " entries") + ", expected " +
+                       std::to_string(n) + " (" + layout(model, configuration) + ")" +
+                       (with_base ? "; the base's state goes in \"base\", not here" : ""));
+    }
+    full.tail(n) = v;
+    return;
+  }
+  for (const auto& [name, v] : values.named) {
+    const std::string path = childPath(key, name);
+    const Joint& joint = model.joint(jointIndexAt(in, model, name, path, ""));
+    const int size = configuration ? joint.nq() : joint.nv();
+    if (v.size() != size) {
+      std::string what = "one number";
+      if (size > 1) {
+        what = std::to_string(size) + " numbers: ";
+        if (configuration) {
+          what += coordinateNames(joint.type);
+        } else {
+          for (int k = 0; k < size; ++k)
+            what += (k ? ", " : "") + model.dofs()[static_cast<std::size_t>(joint.v_index + k)].name;
+        }
+      }
+      in.fail(path, "has " + std::to_string(v.size()) + (v.size() == 1 ? " entry" : " entries") + ", expected " + what +
+                        " (joint '" + joint.name + "' is " + toString(joint.type) + ")");
+    }
+    full.segment(configuration ? joint.q_index : joint.v_index, size) = v;
+  }
 }
 
 }  // namespace
@@ -252,10 +363,7 @@ Problem readProblem(const std::string& file) {
   if (doc.contains("follow_leaders")) p.follow_leaders = in.boolean(doc["follow_leaders"], "follow_leaders");
   if (doc.contains("gravity")) p.gravity = Vec3(in.numbers(doc["gravity"], "gravity", 3, "gx, gy, gz"));
   for (const char* key : {"q", "qd", "tau"})
-    if (doc.contains(key)) {
-      Eigen::VectorXd v = in.numbers(doc[key], key);
-      (key[1] == '\0' ? p.q : key[1] == 'd' ? p.qd : p.tau) = std::move(v);
-    }
+    if (doc.contains(key)) (key[1] == '\0' ? p.q : key[1] == 'd' ? p.qd : p.tau) = parseJointValues(in, doc[key], key);
   if (doc.contains("rotor_inertia")) p.rotor_inertia = nonNegative(in, doc["rotor_inertia"], "rotor_inertia");
   if (doc.contains("breakaway")) p.breakaway = nonNegative(in, doc["breakaway"], "breakaway");
   if (doc.contains("wrenches")) {
@@ -306,25 +414,18 @@ BoundProblem bindProblem(const Problem& p) {
   if (p.follow_leaders && model.mimicJoints().empty())
     in.fail("follow_leaders", std::string("has no effect: the model has no mimic joints") +
                                   (p.lock_mimic ? " (\"lock_mimic\": true welded them)" : ""));
-  const int n = model.dof();
-  const std::string per_joint = "one per moving joint: " + jointList(model);
-  auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key) {
+  const int joints = static_cast<int>(model.joints().size());
+  auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key, long n, bool per_joint) {
     if (!v || v->size() == n) return;
-    // A floating base's coordinates go in "base", not in front of the joints' as in the library.
-    const bool with_base = model.hasFloatingBase() && (v->size() == model.nq() || v->size() == model.nv());
     in.fail(key, "has " + std::to_string(v->size()) + (v->size() == 1 ? " entry" : " entries") + ", expected " +
-                     std::to_string(n) + " (" + per_joint + ")" +
-                     (with_base ? "; the base's state goes in \"base\", not here" : ""));
+                     std::to_string(n) + " (" +
+                     (per_joint ? "one per moving joint: " + jointList(model) : layout(model, false)) + ")");
   };
-  checkLength(p.q, "q");
-  checkLength(p.qd, "qd");
-  checkLength(p.tau, "tau");
-  checkLength(p.rotor_inertia, "rotor_inertia");
-  checkLength(p.breakaway, "breakaway");
-
+  checkLength(p.rotor_inertia, "rotor_inertia", joints, true);  // a joint's rotor inertia applies to each of its DOFs
+  checkLength(p.breakaway, "breakaway", model.dof(), false);
   if (p.rotor_inertia) {
     ModelBuilder builder(model);
-    for (int j = 0; j < n; ++j) {
+    for (int j = 0; j < joints; ++j) {
       try {
         builder.setRotorInertia(model.joint(j).name, (*p.rotor_inertia)[j]);
       } catch (const ModelError& e) {
@@ -340,16 +441,22 @@ BoundProblem bindProblem(const Problem& p) {
 
   BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, {}, {}};
   const Model& m = b.model;
-  // The base's coordinates first, then the joints' (docs/conventions.md, "Floating base").
-  const auto stack = [n](const Eigen::VectorXd& base, const std::optional<Eigen::VectorXd>& joints) {
-    Eigen::VectorXd full = Eigen::VectorXd::Zero(base.size() + n);
-    full.head(base.size()) = base;
-    if (joints) full.tail(n) = *joints;
-    return full;
-  };
-  b.q = stack(p.base.q, p.q);
-  b.qd = stack(p.base.v, p.qd);
-  b.tau = stack(p.base.force, p.tau);
+  // The base's coordinates first, then the joints' (docs/conventions.md, "Floating base"). Unset entries:
+  // zero, each quaternion the identity (a free base's from "base").
+  b.q = Eigen::VectorXd::Zero(m.nq());
+  b.qd = Eigen::VectorXd::Zero(m.nv());
+  b.tau = Eigen::VectorXd::Zero(m.nv());
+  for (const Joint& joint : m.joints())
+    if (joint.type == JointType::Spherical || joint.type == JointType::Free)
+      b.q[joint.q_index + (joint.type == JointType::Free ? 3 : 0)] = 1.0;  // w first
+  b.q.head(p.base.q.size()) = p.base.q;
+  b.qd.head(p.base.v.size()) = p.base.v;
+  b.tau.head(p.base.force.size()) = p.base.force;
+  placeJointValues(in, m, p.q, "q", true, b.q);
+  placeJointValues(in, m, p.qd, "qd", false, b.qd);
+  placeJointValues(in, m, p.tau, "tau", false, b.tau);
+  for (const ConstraintSpec& c : p.constraints)  // joint rows: every joint known, one target per DOF
+    if (!c.joint.empty()) (void)jointRowIndex(in, m, c);
   if (p.follow_leaders) m.followLeaders(b.q, b.qd);  // the followers' entries of "q" and "qd" are replaced
   b.task = std::make_unique<Task>(m);
   Task& task = *b.task;
@@ -371,8 +478,11 @@ BoundProblem bindProblem(const Problem& p) {
   try {
     for (const ConstraintSpec& c : p.constraints) {
       int first;
+      Eigen::VectorXd targets = c.acceleration;
       if (!c.joint.empty()) {
-        first = task.addJointConstraint(jointRowIndex(in, m, c));
+        const int j = jointRowIndex(in, m, c);
+        first = task.addJointConstraint(j);  // one row per DOF of the joint
+        if (targets.size() == 0) targets = Eigen::VectorXd::Zero(m.joint(j).nv());
       } else {
         const int f = frameIndex(c.frame, c.path);
         first = c.contact ? task.addContact(f, c.A, c.expressed)
@@ -380,7 +490,7 @@ BoundProblem bindProblem(const Problem& p) {
                     ? task.addConstraint(f, c.A, c.expressed)
                     : task.addRelativeConstraint(f, frameIndex(c.relative_to, c.path, "relative_to"), c.A, c.expressed);
       }
-      task.targets().segment(first, c.acceleration.size()) = c.acceleration;
+      task.targets().segment(first, targets.size()) = targets;
     }
     for (const WrenchSpec& w : p.wrenches) {
       const int f = frameIndex(w.frame, w.path);

@@ -44,6 +44,15 @@ struct BaseSpec {
   Eigen::VectorXd force;            // "force": τ of the base, 6 or 3 entries (default 0)
 };
 
+// "q", "qd" or "tau": the joints' entries (below a floating base's root
+// joint) as one array in the model's order, or by joint name (a number for a
+// one-DOF joint, an array of its nq or nv entries for a multi-DOF one).
+struct JointValues {
+  std::optional<Eigen::VectorXd> array;                        // the array form
+  std::vector<std::pair<std::string, Eigen::VectorXd>> named;  // the object form, in file order
+  bool present() const { return array.has_value() || !named.empty(); }
+};
+
 // The problem as written, checked for everything that does not need the model.
 struct Problem {
   std::string file;        // the problem file, as given on the command line
@@ -55,7 +64,8 @@ struct Problem {
   bool lock_mimic = false;         // "lock_mimic": weld the mimic joints (MimicJoints::Lock)
   bool follow_leaders = false;  // "follow_leaders": each mimic joint's q, qd from its leader's (Model::followLeaders)
   std::optional<Vec3> gravity;
-  std::optional<Eigen::VectorXd> q, qd, tau, rotor_inertia, breakaway;
+  JointValues q, qd, tau;
+  std::optional<Eigen::VectorXd> rotor_inertia, breakaway;
   std::vector<WrenchSpec> wrenches;
   std::vector<ConstraintSpec> constraints;
   FrictionSpec friction;

@@ -62,7 +62,12 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
   Json joints = Json::array();
   for (const Joint& joint : model.joints()) joints.push_back(joint.name);
   out["joints"] = std::move(joints);
-  // Per joint; a floating base's entries (they come first) go to "base".
+  // The entries of the per-DOF arrays below: a one-DOF joint's name, "<joint>.<coordinate>" for a multi-DOF one.
+  Json dofs = Json::array();
+  for (std::size_t k = static_cast<std::size_t>(model.baseVelocitySize()); k < model.dofs().size(); ++k)
+    dofs.push_back(model.dofs()[k].name);
+  out["dofs"] = std::move(dofs);
+  // Per DOF; a floating base's entries (they come first) go to "base".
   const int n = model.dof(), nb = model.baseVelocitySize();
   out["qdd"] = array(s.qdd.tail(n));
   out["tau_constraint"] = array(s.tau_constraint.tail(n));

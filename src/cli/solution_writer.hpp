@@ -8,7 +8,8 @@
 
 namespace zwang::cli {
 
-// Keys, in this order: joints, qdd, tau_constraint, tau_control (per joint),
+// Keys, in this order: joints, dofs (the names of the per-DOF entries), qdd,
+// tau_constraint, tau_control (per DOF below the root),
 // base (only for a floating base: its type, acceleration, acceleration_world,
 // tau_constraint, tau_control), nu, gauss, friction (only when
 // `with_friction`), status, frames. Numbers are written

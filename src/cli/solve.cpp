@@ -12,15 +12,16 @@ namespace {
 
 // A configuration outside the joint limits is solved as given (the limits
 // matter to the friction solver only at a stop); it is said once per joint.
-// `q` has the base's coordinates first; "q[j]" is the problem's (per joint).
+// `q` has the base's coordinates first; "q[k]" is the problem's (the joints'
+// coordinates). Only one-DOF joints have limits.
 void warnOutsideLimits(const std::string& file, const Model& model, const Eigen::VectorXd& q) {
   const int base = model.baseConfigurationSize();
-  for (int j = 0; j < model.dof(); ++j) {
-    const Joint& joint = model.joint(j);
-    const double qj = q[base + j];
+  for (const Joint& joint : model.joints()) {
+    if (joint.nq() != 1) continue;
+    const double qj = q[joint.q_index];
     if (std::isnan(qj) || (qj >= joint.lower && qj <= joint.upper)) continue;  // NaN: the solve refuses it
     std::fprintf(stderr, "zwang: warning: %s: q[%d] = %g puts joint '%s' outside its limits [%g, %g]\n", file.c_str(),
-                 j, qj, printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
+                 joint.q_index - base, qj, printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
   }
 }
 

@@ -100,6 +100,7 @@ const char* toString(WarningCode code) {
     case WarningCode::PlaceholderInertia: return "placeholder_inertia";
     case WarningCode::TriangleInequality: return "triangle_inequality";
     case WarningCode::PlaceholderLimits: return "placeholder_limits";
+    case WarningCode::IgnoredLimits: return "ignored_limits";
     case WarningCode::MassBeyondTip: return "mass_beyond_tip";
     case WarningCode::MassOffChain: return "mass_off_chain";
     case WarningCode::PayloadAttached: return "payload_attached";
@@ -220,7 +221,8 @@ void checkJointType(const std::string& where, Joint& joint) {
 }  // namespace
 
 ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& child_frame,
-                                     const RigidInertia& child_inertia, const std::string& parent_frame) {
+                                     const RigidInertia& child_inertia, const std::string& parent_frame,
+                                     const Transform& child_placement) {
   const std::string where = "joint '" + joint_in.name + "'";
   if (joint_in.name.empty()) throw ModelError("a moving joint needs a name");
   for (const Joint& j : model_.joints_)
@@ -241,6 +243,7 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
   Joint joint = joint_in;
   checkJointType(where, joint);
   if (!finite(joint.placement)) throw ModelError(where + ": origin is not finite");
+  if (!finite(child_placement)) throw ModelError(where + ": child link placement is not finite");
   const struct {
     const char* field;
     double value;
@@ -268,8 +271,11 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
 
   model_.joints_.push_back(joint);
   model_.link_parents_.push_back(parent_link);
-  model_.link_inertias_.push_back(child_inertia);
-  model_.frames_.push_back(Frame{child_frame, 0, Transform{}});
+  // The link's inertia in the body frame (left bit for bit as given when the frames coincide).
+  const bool same_frame = child_placement.E.isIdentity(0.0) && child_placement.r.isZero(0.0);
+  model_.link_inertias_.push_back(same_frame ? child_inertia
+                                             : spatial::inverseTransformInertia(child_placement, child_inertia));
+  model_.frames_.push_back(Frame{child_frame, 0, child_placement});
   model_.frame_links_.push_back(link);
   model_.link_frames_.push_back(static_cast<int>(model_.frames_.size()) - 1);
   return *this;

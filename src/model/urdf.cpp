@@ -523,7 +523,28 @@ void readLimits(const Reporter& report, const urdf::Joint& uj, Joint& joint, std
   joint.upper = lim.upper;
 }
 
-// The zwang joint for a moving URDF joint, every field checked.
+// The rotation that turns a URDF planar joint's frame so that its z is the
+// joint's <axis> (unit): the shortest one, about z × axis (a half turn about x
+// for −z). Its x and y span the plane of motion.
+Mat3 planeRotation(const Vec3& axis) {
+  if (axis == Vec3::UnitZ()) return Mat3::Identity();
+  if (axis.x() == 0.0 && axis.y() == 0.0) return Vec3(1.0, -1.0, -1.0).asDiagonal();  // −z: half turn about x
+  return Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), axis).toRotationMatrix();
+}
+
+// The child link's frame relative to the zwang joint's child frame, ᶜX_body:
+// identity except for a planar joint whose axis is not z (planeRotation turns
+// the joint frame, the link keeps the URDF's orientation).
+Transform linkPlacementOf(const urdf::Joint& uj) {
+  if (uj.type != urdf::Joint::PLANAR) return Transform{};
+  const Vec3 axis = vectorOf(uj.axis);
+  if (!axis.allFinite() || axis.norm() < 1e-9) return Transform{};  // makeJoint refuses it
+  return Transform::rotation(planeRotation(axis.normalized()).transpose());
+}
+
+// The zwang joint for a moving URDF joint, every field checked. A floating
+// joint is a Free joint, a planar one a Planar joint whose frame is turned so
+// that its z is the URDF <axis> (the plane's normal; linkPlacementOf).
 Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<std::string, double>& rotor,
                 std::vector<ModelWarning>& warnings) {
   const std::string who = "joint '" + uj.name + "'";
@@ -533,32 +554,46 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
     case urdf::Joint::REVOLUTE: joint.type = JointType::Revolute; break;
     case urdf::Joint::CONTINUOUS: joint.type = JointType::Continuous; break;
     case urdf::Joint::PRISMATIC: joint.type = JointType::Prismatic; break;
-    case urdf::Joint::FLOATING:
-    case urdf::Joint::PLANAR:
-      report.fail(who + " (parent '" + uj.parent_link_name + "', child '" + uj.child_link_name + "'): type " +
-                  typeName(uj.type) +
-                  " is not supported here: only a root joint can have more than one degree of freedom (the only "
-                  "joint of the URDF's root link, which becomes the robot's floating base); the other joints must "
-                  "be revolute, continuous, prismatic or fixed");
+    case urdf::Joint::FLOATING: joint.type = JointType::Free; break;
+    case urdf::Joint::PLANAR: joint.type = JointType::Planar; break;
     default:
       report.fail(who + " (parent '" + uj.parent_link_name + "', child '" + uj.child_link_name + "'): type " +
-                  typeName(uj.type) + " is not supported (only revolute, continuous, prismatic and fixed joints are)");
+                  typeName(uj.type) +
+                  " is not supported (only revolute, continuous, prismatic, planar, floating and fixed joints are)");
   }
 
   joint.placement = placementOf(uj);
   if (!joint.placement.E.allFinite() || !joint.placement.r.allFinite()) report.fail(who + ": <origin> is not finite");
 
-  joint.axis = vectorOf(uj.axis);
-  if (!joint.axis.allFinite()) report.fail(who + ": <axis> xyz is not finite");
-  if (joint.axis.norm() < 1e-9)
-    report.fail(who + ": <axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " + fmt(uj.axis.z) +
-                "\" is zero (it must give the joint's direction)");
-  joint.axis.normalize();
+  if (joint.type != JointType::Free) {  // urdfdom reads no axis for a floating joint
+    Vec3 axis = vectorOf(uj.axis);
+    if (!axis.allFinite()) report.fail(who + ": <axis> xyz is not finite");
+    if (axis.norm() < 1e-9)
+      report.fail(who + ": <axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " + fmt(uj.axis.z) +
+                  "\" is zero (it must give the joint's direction" +
+                  (joint.type == JointType::Planar ? ", here the normal of the plane)" : ")"));
+    axis.normalize();
+    if (joint.type == JointType::Planar)
+      joint.placement = Transform::rotation(planeRotation(axis)) * joint.placement;  // the plane's frame
+    else
+      joint.axis = axis;
+  }
 
-  if (uj.limits) readLimits(report, uj, joint, warnings);
-  if (joint.type == JointType::Continuous) {
-    joint.lower = -kInf;
-    joint.upper = kInf;
+  if (joint.nv() > 1) {
+    // A <limit> cannot say which of the joint's coordinates it bounds (and
+    // mixes forces and torques): read as none, as other loaders do, but said.
+    if (uj.limits)
+      warnings.push_back(
+          {WarningCode::IgnoredLimits, who + ": <limit> on a " + typeName(uj.type) + " joint ignored (lower " +
+                                           fmt(uj.limits->lower) + ", upper " + fmt(uj.limits->upper) + ", effort " +
+                                           fmt(uj.limits->effort) + ", velocity " + fmt(uj.limits->velocity) +
+                                           "): zwang's multi-DOF joints have no position, effort or velocity limits"});
+  } else {
+    if (uj.limits) readLimits(report, uj, joint, warnings);
+    if (joint.type == JointType::Continuous) {
+      joint.lower = -kInf;
+      joint.upper = kInf;
+    }
   }
 
   if (uj.dynamics) {
@@ -636,8 +671,12 @@ ModelWarning mimicLockedNote(const urdf::Joint& uj, double q, const UrdfOptions&
 }
 
 // ᶜX_p of a joint locked at position q (revolute and continuous turn about the
-// axis, prismatic slides along it; other types stay at their origin).
+// axis, prismatic slides along it). A floating or planar joint is locked at
+// its origin: one number cannot place it, so any other is refused.
 Transform lockedPlacement(const Reporter& report, const urdf::Joint& uj, double q) {
+  if ((uj.type == urdf::Joint::FLOATING || uj.type == urdf::Joint::PLANAR) && q != 0.0)
+    report.fail("joint '" + uj.name + "': a " + typeName(uj.type) + " joint cannot be locked at q = " + fmt(q) +
+                " (one number cannot place it); it is locked at its origin: give it no locked position");
   if (q == 0.0 ||
       (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS && uj.type != urdf::Joint::PRISMATIC))
     return placementOf(uj);
@@ -863,7 +902,7 @@ void addChain(const Reporter& report, ModelBuilder& builder, Placement& placemen
       placement.tip_body.clear();
       const Joint joint = makeJoint(report, uj, rotor, placement.warnings);
       const RigidInertia inertia = linkInertia(report, *link, on_base);
-      report.builder([&] { builder.addJoint(joint, link->name, inertia, uj.parent_link_name); });
+      report.builder([&] { builder.addJoint(joint, link->name, inertia, uj.parent_link_name, linkPlacementOf(uj)); });
     } else if (isLockedMimic(uj, options)) {
       addLockedMimic(report, builder, placement, uj, *link, on_base, options);
     } else {
@@ -911,7 +950,7 @@ void addTree(const Reporter& report, ModelBuilder& builder, Placement& placement
       on_base = false;
       const Joint joint = makeJoint(report, uj, rotor, placement.warnings);
       const RigidInertia inertia = linkInertia(report, child, on_base);
-      report.builder([&] { builder.addJoint(joint, child.name, inertia, uj.parent_link_name); });
+      report.builder([&] { builder.addJoint(joint, child.name, inertia, uj.parent_link_name, linkPlacementOf(uj)); });
       moving.push_back(uj.name);
     } else if (isLockedMimic(uj, options)) {
       addLockedMimic(report, builder, placement, uj, child, on_base, options);

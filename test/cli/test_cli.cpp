@@ -155,8 +155,9 @@ TEST_CASE("No friction section: the plain solver, no friction key", "[golden]") 
   // the keys, in the documented order
   std::vector<std::string> keys;
   for (const auto& item : s.items()) keys.push_back(item.key());
-  CHECK(keys ==
-        std::vector<std::string>{"joints", "qdd", "tau_constraint", "tau_control", "nu", "gauss", "status", "frames"});
+  CHECK(keys == std::vector<std::string>{"joints", "dofs", "qdd", "tau_constraint", "tau_control", "nu", "gauss",
+                                         "status", "frames"});
+  CHECK(s["dofs"] == s["joints"]);  // one-DOF joints: a DOF is named as its joint
   // friction disabled explicitly: the same
   const Json d = solve(problem("arm_friction_disabled.json"));
   CHECK_FALSE(d.contains("friction"));
@@ -670,6 +671,17 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_contact_relative.json",
        {": constraints[0].contact: is true with \"relative_to\"", "a contact is a link against the environment"}},
       {"err_follow_leaders_no_mimic.json", {": follow_leaders: has no effect: the model has no mimic joints"}},
+      {"err_q_joint_size.json",
+       {": q.float: has 3 entries, expected 7 numbers: x, y, z, qw, qx, qy, qz (joint 'float' is free)"}},
+      {"err_q_multi_length.json",
+       {": q: has 4 entries, expected 12 (the joints' coordinates in order: j1, float free [x, y, z, qw, qx, qy, qz], "
+        "j2, slide planar [x, y, yaw])"}},
+      {"err_q_root_joint.json",
+       {": q.root_joint: names the root joint of the planar base: its state goes in \"base\""}},
+      {"err_qd_unknown_joint.json", {": qd.elbow: unknown joint \"elbow\" (the model's joints: j1, float, j2, slide)"}},
+      {"err_joint_row_dofs.json",
+       {": constraints[0].acceleration: has 1 entry, expected 6 (one per DOF of joint 'float': float.vx, float.vy, "
+        "float.vz, float.wx, float.wy, float.wz)"}},
   };
   for (const Case& c : cases) {
     SECTION(c.file) {
@@ -1030,7 +1042,7 @@ TEST_CASE("info: table and JSON", "[info]") {
     REQUIRE(free.exit_code == 0);
     CHECK(contains(free.out,
                    "base: free, link base_link (q: 7 base coordinates + 12 joints = nq 19; v: 6 + 12 = nv 18)"));
-    CHECK(contains(free.out, "base mass 1.16115 kg (body 0: the root link and the links welded to it; it floats"));
+    CHECK(contains(free.out, "base mass 1.16115 kg (body 6: the root link and the links welded to it; it floats"));
     const Json j = parse(run({"info", solo, "--base=free", "--json"}).out);
     CHECK(j["base_type"] == "free");
     CHECK(j["nq"] == 19);
@@ -1606,4 +1618,89 @@ TEST_CASE("Model warnings on stderr, strict mode, the CLI's option names, UTF-8"
     CHECK(r.exit_code == 2);
     CHECK(contains(r.err, "unknown option '--\xC3\xA9t\xC3\xA9\\xFF'"));
   }
+}
+
+// ---------------------------------------------------------------------------
+// Joints of any type (issue #25): floating and planar URDF joints below the root.
+
+TEST_CASE("info: every joint with its type, nq, nv, q_index and v_index; the root joint first", "[info]") {
+  SECTION("a fixed base with a free and a planar joint below it") {
+    const Run r = run({"info", problem("multi_joint.urdf"), "--json"});
+    REQUIRE(r.exit_code == 0);
+    const Json j = parse(r.out);
+    CHECK(j["nq"] == 12);
+    CHECK(j["nv"] == 11);
+    CHECK(j["dof"] == 11);
+    struct Expected {
+      const char* name;
+      const char* type;
+      int nq, nv, q_index, v_index;
+    };
+    // Depth first, children by joint name: j1 (arm) → float (ball) → j2 (paddle), then slide (puck).
+    const Expected expected[] = {{"j1", "revolute", 1, 1, 0, 0},
+                                 {"float", "free", 7, 6, 1, 1},
+                                 {"j2", "continuous", 1, 1, 8, 7},
+                                 {"slide", "planar", 3, 3, 9, 8}};
+    REQUIRE(j["joints"].size() == 4);
+    for (std::size_t k = 0; k < 4; ++k) {
+      INFO(expected[k].name);
+      const Json& joint = j["joints"][k];
+      CHECK(joint["name"] == expected[k].name);
+      CHECK(joint["type"] == expected[k].type);
+      CHECK(joint["nq"] == expected[k].nq);
+      CHECK(joint["nv"] == expected[k].nv);
+      CHECK(joint["q_index"] == expected[k].q_index);
+      CHECK(joint["v_index"] == expected[k].v_index);
+    }
+    CHECK(j["joints"][1]["axis"].is_null());  // a multi-DOF joint has no axis
+    CHECK(j["joints"][2]["parent"] == "float");
+    CHECK(j["joints"][3]["viscous_friction"].get<double>() == 0.1);  // applies to each of its DOFs
+    const std::vector<std::string> dofs = j["dofs"].get<std::vector<std::string>>();
+    CHECK(dofs == std::vector<std::string>{"j1", "float.vx", "float.vy", "float.vz", "float.wx", "float.wy", "float.wz",
+                                           "j2", "slide.x", "slide.y", "slide.yaw"});
+    const Run table = run({"info", problem("multi_joint.urdf")});
+    REQUIRE(table.exit_code == 0);
+    for (const char* part : {"multi_joint: 4 moving joints in a tree", "base: fixed (nq = 12, nv = 11)",
+                             "float  j1      free", "moving mass 2 kg (bodies 1-11)"})
+      CHECK(contains(table.out, part));
+  }
+  SECTION("a floating base: its root joint first") {
+    const Json j = parse(run({"info", problem("planar_cart.urdf"), "--json"}).out);
+    REQUIRE(j["joints"].size() == 2);
+    CHECK(j["joints"][0]["name"] == "root_joint");
+    CHECK(j["joints"][0]["type"] == "planar");
+    CHECK(j["joints"][0]["nq"] == 3);
+    CHECK(j["joints"][0]["q_index"] == 0);
+    CHECK(j["joints"][0]["parent"].is_null());
+    CHECK(j["joints"][1]["name"] == "hinge");
+    CHECK(j["joints"][1]["q_index"] == 3);
+    CHECK(j["joints"][1]["v_index"] == 3);
+    CHECK(j["joints"][1]["parent"].is_null());  // it hangs from the base
+    CHECK(j["dofs"][0] == "root_joint.x");
+    CHECK(j["dofs"][3] == "hinge");
+  }
+}
+
+TEST_CASE("solve: multi-DOF joints by name, the solution's dofs; the tool and the library agree", "[golden]") {
+  const Json s = solve(problem("multi_joint.json"));
+  CHECK(s["joints"] == Json::array({"j1", "float", "j2", "slide"}));
+  CHECK(s["dofs"] == Json::array({"j1", "float.vx", "float.vy", "float.vz", "float.wx", "float.wy", "float.wz", "j2",
+                                  "slide.x", "slide.y", "slide.yaw"}));
+  REQUIRE(s["qdd"].size() == 11);
+  // The same problem through the library, its vectors written out by hand from multi_joint.json.
+  const zwang::Model model = zwang::loadUrdfFile(problem("multi_joint.urdf"));
+  const double c = 0.7071067811865476;
+  Eigen::VectorXd q(12), qd(11), tau(11);
+  q << 0.3, 0, 0, 0.1, c, 0, 0, c, 0, 0.1, -0.2, 0.5;
+  qd << 0, 0, 0.2, 0, 0.5, 0, 1, 2, 0, 0, 1;
+  tau << 1.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.01;
+  zwang::Task task(model);
+  task.targets()[task.addJointConstraint(model.jointIndex("j2"))] = 0.5;
+  zwang::Workspace ws(model, task);
+  REQUIRE(zwang::solveHybridDynamics(model, task, q, qd, tau, ws));
+  for (Eigen::Index k = 0; k < 11; ++k) {
+    INFO("qdd[" << k << "]");
+    CHECK(s["qdd"][static_cast<std::size_t>(k)].get<double>() == ws.solution.qdd[k]);  // the same solve, bit for bit
+  }
+  CHECK(s["qdd"][7].get<double>() == Approx(0.5).margin(1e-12));  // the joint row on j2
 }

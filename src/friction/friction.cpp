@@ -238,7 +238,7 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
 QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
                       const FrictionOptions& options, double acc_scale, FrictionScratch& fs) {
   const auto k = static_cast<Eigen::Index>(stuck.size());
-  const int iv = model.baseVelocitySize();  // the joints' rows of q̈ follow a floating base's
+  const int iv = dofOfEntry(model, 0);  // the friction entries' rows of q̈
   auto K = fs.K.topLeftCorner(k, k);
   for (Eigen::Index a = 0; a < k; ++a) fs.qdd0_stuck[a] = fs.qdd0[iv + stuck[static_cast<std::size_t>(a)]];
   {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers: k² of them)
@@ -303,7 +303,7 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
   carryMimicTorques(model, fs.tau_control_first);
   for (Eigen::Index a = 0; a < k; ++a) {
     const int j = stuck[static_cast<std::size_t>(a)];
-    fs.effort_offset[a] = fs.tau_control_first[model.baseVelocitySize() + j] - fs.mu[a];
+    fs.effort_offset[a] = fs.tau_control_first[dofOfEntry(model, j)] - fs.mu[a];
     fs.margin_limit[a] = options.margin * fs.breakaway[j];
   }
 }
@@ -369,7 +369,7 @@ void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index k, Wor
 // joints feel; returns Σ μ*_j q̈*_j (the dual's term beyond Z).
 double frictionStates(const Model& model, const Eigen::VectorXd& qdd_all, double acc_tolerance, FrictionScratch& fs,
                       FrictionResult& fr) {
-  const int iv = model.baseVelocitySize();
+  const int iv = dofOfEntry(model, 0);
   const auto qdd = qdd_all.tail(model.dof());
   fr.mu.setZero();
   fs.tau_joint = fs.tau_effective;  // the torques the joints feel: τ − kinetic − Wᵀμ
@@ -425,7 +425,7 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
   if (k < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
   for (Eigen::Index a = 0; a < k; ++a)         // μ_j enters as the torque −μ_j
     fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);
-  const int iv = model.baseVelocitySize();
+  const int iv = dofOfEntry(model, 0);
 
   // The acceleration scale, of the stuck joints only (a light, fast joint
   // elsewhere in the chain must not set it): their accelerations q̈_Θ(0).

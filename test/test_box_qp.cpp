@@ -1,6 +1,6 @@
 // The friction maximiser's internals (src/linalg/growing_cholesky.hpp,
-// src/qp/box_qp.hpp) against independent dense references computed
-// with Eigen: LDLT for the Cholesky updates, eigen-decompositions and the SVD
+// src/qp/box_qp.hpp, src/friction/friction_maximisers.hpp) against
+// independent dense references computed with Eigen: LDLT for the Cholesky updates, eigen-decompositions and the SVD
 // for the near null space, and brute-force enumeration of every active set
 // (3^k patterns, each solved by a complete orthogonal decomposition) for the
 // box QP. Fixed seeds; the worst values seen are printed.
@@ -17,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "friction/friction_maximisers.hpp"
 #include "linalg/growing_cholesky.hpp"
 #include "qp/box_qp.hpp"
 
@@ -26,9 +27,13 @@ using Eigen::VectorXi;
 using zwang::internal::boxQpActiveSet;
 using zwang::internal::boxQpKktResidual;
 using zwang::internal::boxQpProjectedGradient;
+using zwang::internal::EffortChange;
+using zwang::internal::flatDirections;
 using zwang::internal::GrowingCholesky;
 using zwang::internal::leastDistanceOnHyperplane;
 using zwang::internal::leastDistanceQp;
+using zwang::internal::leastEffortMaximiser;
+using zwang::internal::MaximiserChoiceScratch;
 using zwang::internal::nearNullSpace;
 using zwang::internal::QpReport;
 using zwang::internal::QpScratch;
@@ -1099,4 +1104,45 @@ TEST_CASE("least-distance problems on a slice of the box: primal and dual agains
       "least distance on a slice, %d draws (n ≤ 6, r = 1 and 2..n): objective above brute force / scale²: "
       "primal %.3g, dual %.3g (limit 1e-10); dual |vᵀμ − b|/scale %.3g; |dual − primal|/scale %.3g\n",
       draws, worst_primal, worst_dual, worst_plane, worst_agreement);
+}
+
+// Two flat joints (0, 2) whose couplings to a barely curved joint 1 are at
+// rounding (5e-16 of terms of size 1, against a curvature 1.3e-12 above the
+// flatness floor 1e-8 / (6 · 2e4) ≈ 8e-14), joint 1 on its bound. Moving a flat joint over
+// its whole box moves q̈ by 5e-16 · 2e4 = 1e-11, far inside the tolerance, so
+// e_0 and e_2 are the flat directions and the least effort ‖h + μ‖² on them
+// (EffortChange::Own) is μ_0 = −h_0, μ_2 = −h_2 with the rest as it was. A
+// null basis carrying joint 1 by coupling / curvature ≈ 4e-4 would pin them
+// on joint 1's bound.
+TEST_CASE("flat directions: a coupling at rounding does not tie a flat joint to a curved one on its bound",
+          "[box_qp][maximiser]") {
+  const int n = 6;
+  const double f = 1e4, acc_tolerance = 1e-8;
+  MatrixXd K = MatrixXd::Zero(n, n);
+  K(1, 1) = 1.3e-12;
+  K(0, 1) = K(1, 0) = 5e-16;
+  K(2, 1) = K(1, 2) = 5e-16;
+  K.bottomRightCorner(3, 3) << 1.5, 0.1, 0.0, 0.1, 1.2, -0.2, 0.0, -0.2, 0.9;
+  const VectorXd lo = VectorXd::Constant(n, -f), hi = VectorXd::Constant(n, f);
+  VectorXd mu(n);
+  mu << 0.0, f, 0.0, 1.0, -2.0, 3.0;
+  const VectorXd qdd0 = K * mu;  // q̈* = 0: every joint sticks
+  VectorXd h(n);
+  h << 40.0, 0.0, -0.5, 0.0, 0.0, 0.0;
+  MaximiserChoiceScratch scratch(n, n, n);
+  Eigen::Index ns = 0;
+  const VectorXd terms = VectorXd::Ones(n);  // K's entries are sums of terms of size 1
+  const Eigen::Index nullity = flatDirections(K, qdd0, mu, lo, hi, terms, acc_tolerance, scratch, ns);
+  REQUIRE(ns == n);
+  REQUIRE(nullity == 2);
+  const MatrixXd N = scratch.null_basis.topLeftCorner(n, nullity);
+  CAPTURE(N);
+  for (const int curved : {1, 3, 4, 5}) CHECK(N.row(curved).norm() <= 1e-12);  // rounding of the basis
+
+  const double mu_scale = 1e-9 * (1.0 + f);  // as the solver's
+  REQUIRE(leastEffortMaximiser(lo, hi, hi, h, ns, nullity, EffortChange::Own, n, mu_scale, 100, mu, scratch));
+  VectorXd least(n);
+  least << -40.0, f, 0.5, 1.0, -2.0, 3.0;
+  CAPTURE(mu.transpose(), least.transpose());
+  CHECK((mu - least).lpNorm<Eigen::Infinity>() <= 1e-12 * f);  // a few projections' rounding of numbers of size f
 }

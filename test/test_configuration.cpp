@@ -156,6 +156,23 @@ Model handModel(BaseType type) {
   return b.build();
 }
 
+// The model with a spherical, a planar and a free joint added below its last
+// link: every joint type in one tree.
+Model withEveryJointType(const Model& model) {
+  ModelBuilder b(model);
+  const RigidInertia I = RigidInertia::fromMassComInertia(1.0, Vec3(0.1, 0, 0), Eigen::Matrix3d::Identity() * 0.01);
+  std::string parent = model.frame(model.bodyFrame(model.bodyCount() - 1)).name;
+  for (const JointType type : {JointType::Spherical, JointType::Planar, JointType::Free}) {
+    Joint j;
+    j.type = type;
+    j.name = std::string("added_") + toString(type);
+    j.placement = Transform::translation(Vec3(0.1, 0, 0));
+    b.addJoint(j, "link_" + j.name, I, parent);
+    parent = "link_" + j.name;
+  }
+  return b.build();
+}
+
 bool contains(const char* message, const char* part) { return std::strstr(message, part) != nullptr; }
 
 }  // namespace
@@ -505,7 +522,7 @@ TEST_CASE("configuration: a fixed base is a plain vector", "[configuration]") {
 
 TEST_CASE("configuration: integrate in place gives what it gives out of place", "[configuration]") {
   for (const BaseType type : {BaseType::Fixed, BaseType::Free, BaseType::Planar}) {
-    const Model model = handModel(type);
+    const Model model = withEveryJointType(handModel(type));
     std::uint64_t state = 8;
     std::mt19937_64 rng(8);
     Eigen::VectorXd q = randomConfigurationOf(model, state), out(model.nq());
@@ -649,7 +666,7 @@ TEST_CASE("configuration: bad inputs give a Status naming the entry, and change 
 #ifdef ZWANG_CONFIGURATION_COUNT_ALLOCATIONS
 TEST_CASE("configuration: the helpers allocate nothing (also on errors)", "[configuration]") {
   for (const BaseType type : {BaseType::Fixed, BaseType::Free, BaseType::Planar}) {
-    const Model model = handModel(type);
+    const Model model = withEveryJointType(handModel(type));
     Eigen::VectorXd q0(model.nq()), q1(model.nq()), q(model.nq()), v(model.nv()), short_q(1);
     Eigen::VectorXd w = Eigen::VectorXd::Constant(model.nv(), 0.3);
     std::uint64_t state = 9;

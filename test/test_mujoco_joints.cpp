@@ -27,11 +27,17 @@
 //    frame]. With R = ⁰R_child and T = blockdiag(R, 1₃) on each free joint's six entries, the identity elsewhere:
 //      qvel = T v,  qacc = T v̇ + Ṫ v (Ṫ v = [R (ω × v_lin); 0]),  v̇ = T⁻¹ (qacc − Ṫ v),
 //      qfrc = T⁻ᵀ τ,  τ = Tᵀ qfrc_inverse,  H = Tᵀ M_mj T
-//    (the same power τᵀv and kinetic energy on both sides; support/mujoco_bridge.hpp derives it).
+//    (the same power τᵀv and kinetic energy on both sides; support/mujoco_bridge.hpp derives it);
+//  * armature on a free joint: both add it to the diagonal of the inertia matrix in their own coordinates, which for
+//    the translations differ: MuJoCo's acts on ṗ in world axes (a force a p̈ = a R (v̇_lin + ω × v_lin)), zwang's
+//    rotor inertia d on its child-frame v_lin (a force d v̇_lin, as Pinocchio's armature on a free-flyer). The same
+//    H, but MuJoCo's dynamics carry the extra a ω × v_lin on those entries (in our coordinates): the test adds it to
+//    τ before handing τ to mj_forward and takes it out of mj_inverse's answer (armatureCorrection). Rotations (ball
+//    joints, a free joint's ω) have the same coordinates on both sides: no correction.
 //
-// So that the comparison can fail, the last test case makes two plausible convention mistakes (a ball's ω read in
-// the joint frame instead of the child's; a free spec joint's linear qvel read in body axes) and requires each to be
-// seen far above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world
+// So that the comparison can fail, the last test case makes three plausible convention mistakes (a ball's ω read in
+// the joint frame instead of the child's; a free spec joint's linear qvel read in body axes; MuJoCo's armature on a
+// free joint taken as ours) and requires each to be seen far above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world
 // is MuJoCo's free base, in our coordinates; at rest, a ball joint is three hinges about the child's axes).
 #include <algorithm>
 #include <cmath>
@@ -70,6 +76,7 @@ enum class Conversion {
   Correct,
   BallRatesInJointFrame,  // a ball's qvel taken as ω in the joint (parent) frame: T block = the joint's rotation
   FreeJointLinearInBody,  // a free spec joint's linear qvel taken as body axes (T = 1 on it)
+  FreeArmatureAsOurs,     // MuJoCo's armature on a free joint's translations taken as zwang's (no correction)
 };
 
 // A random unit quaternion (w x y z), uniform on the sphere: a normalised Gaussian 4-vector.
@@ -317,9 +324,24 @@ Eigen::MatrixXd mujocoMassMatrix(const mjModel* m, const mjData* d, const std::v
   return M;
 }
 
+// The generalized force MuJoCo's armature adds to zwang's on each free spec joint's translations (file comment):
+// a ω × v_lin on those entries (our coordinates), 0 elsewhere.
+Eigen::VectorXd armatureCorrection(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& v) {
+  Eigen::VectorXd correction = Eigen::VectorXd::Zero(v.size());
+  Eigen::Index vi = base.nvBase();
+  for (const int k : spec.movingJoints()) {
+    const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
+    if (joint.isFree())
+      correction.segment<3>(vi) =
+          joint.reflectedInertia() * Eigen::Vector3d(v.segment<3>(vi + 3)).cross(Eigen::Vector3d(v.segment<3>(vi)));
+    vi += joint.nv();
+  }
+  return correction;
+}
+
 // The same quantities from MuJoCo for (spec, base), in our coordinates by `change`.
 Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const JointsProblem& p,
-                        const VelocityChange& change, bool check_conventions = true) {
+                        const VelocityChange& change, bool check_conventions = true, bool correct_armature = true) {
   const FloatingInput& in = p.input;
   const Mujoco mj(toMjcf(spec, in.gravity, base));
   const mjModel* m = mj.m();
@@ -328,10 +350,13 @@ Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const J
   if (check_conventions) checkMujocoConventions(p, m, map);
   Answers a;
 
-  // Forward: the state, τ as the generalized force T⁻ᵀ τ, the wrench at its body's COM.
+  // Forward: the state, τ (with the armature correction) as the generalized force T⁻ᵀ τ, the wrench at its body's
+  // COM.
+  const Eigen::VectorXd armature =
+      correct_armature ? armatureCorrection(spec, base, in.v) : Eigen::VectorXd::Zero(in.v.size());
   scatter(in.q, map.qpos, d->qpos);
   scatter(change.T * in.v, map.dof, d->qvel);
-  scatter(change.T.transpose().lu().solve(in.tau), map.dof, d->qfrc_applied);
+  scatter(change.T.transpose().lu().solve(in.tau + armature), map.dof, d->qfrc_applied);
   mj_kinematics(m, d);
   const std::vector<Eigen::Isometry3d> poses = mujocoLinkPoses(spec, m, d);
   addWrenchesToXfrc(spec, poses, in.wrenches, m, d);
@@ -347,12 +372,13 @@ Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const J
   scatter(change.T * p.qdd_inverse + change.Tdot_v, map.dof, d->qacc);
   mj_inverse(m, d);
   const std::vector<mjtNum> qfrc_wrenches = wrenchGeneralizedForces(spec, poses, in.wrenches, m, d);
-  a.tau = change.T.transpose() * (gather(d->qfrc_inverse, map.dof) - gather(qfrc_wrenches.data(), map.dof));
+  a.tau = change.T.transpose() * (gather(d->qfrc_inverse, map.dof) - gather(qfrc_wrenches.data(), map.dof)) - armature;
   return a;
 }
 
 Answers solveWithMujoco(const JointsProblem& p, Conversion conversion = Conversion::Correct) {
-  return solveWithMujoco(p.spec, p.base, p, velocityChange(p, conversion));
+  return solveWithMujoco(p.spec, p.base, p, velocityChange(p, conversion), true,
+                         conversion != Conversion::FreeArmatureAsOurs);
 }
 
 // max |x − y| / max(1, max |y|) over all entries of a matrix.
@@ -607,14 +633,17 @@ TEST_CASE("joint types: the MuJoCo comparison fails on a wrong velocity conventi
   // Each mistake on 20 random trees that have the joints it concerns: the least disagreement over them must stay far
   // above the tolerance, while the right conversion on the same trees stays within it.
   std::mt19937_64 rng(4712);
-  const Conversion mistakes[] = {Conversion::BallRatesInJointFrame, Conversion::FreeJointLinearInBody};
-  const char* names[] = {"ball omega read in the joint frame", "free joint's linear qvel read in body axes"};
-  for (int k = 0; k < 2; ++k) {
+  const Conversion mistakes[] = {Conversion::BallRatesInJointFrame, Conversion::FreeJointLinearInBody,
+                                 Conversion::FreeArmatureAsOurs};
+  const char* names[] = {"ball omega read in the joint frame", "free joint's linear qvel read in body axes",
+                         "MuJoCo's armature on a free joint's translations taken as ours"};
+  for (int k = 0; k < 3; ++k) {
     double least = 1e300, correct = 0.0;
     for (int trial = 0; trial < 20;) {
-      const JointsProblem p = randomJointsProblem(rng, k == 0 && trial % 2 == 0, k == 1 ? 1.0 : 0.0);
+      const JointsProblem p = randomJointsProblem(rng, k == 0 && trial % 2 == 0, k == 0 ? 0.0 : 1.0);
       bool concerned = false;
-      for (const JointSpec& joint : p.spec.joints) concerned |= k == 0 ? joint.isSpherical() : joint.isFree();
+      for (const JointSpec& joint : p.spec.joints)
+        concerned |= k == 0 ? joint.isSpherical() : joint.isFree() && (k == 1 || joint.reflectedInertia() > 0.0);
       if (!concerned) continue;
       ++trial;
       const Answers ours = solveWithZwang(p);

@@ -82,9 +82,13 @@ enum class JointType { Revolute, Continuous, Prismatic, Spherical, Planar, Free 
 /// names them), "spherical", "planar" or "free".
 const char* toString(JointType type);
 /// Entries of q for a joint of this type: 1, 1, 1, 4, 3, 7.
-int configurationSize(JointType type);
+constexpr int configurationSize(JointType type) {
+  return type == JointType::Spherical ? 4 : type == JointType::Planar ? 3 : type == JointType::Free ? 7 : 1;
+}
 /// Entries of v (q̇, τ, q̈) for a joint of this type: 1, 1, 1, 3, 3, 6.
-int velocitySize(JointType type);
+constexpr int velocitySize(JointType type) {
+  return type == JointType::Spherical || type == JointType::Planar ? 3 : type == JointType::Free ? 6 : 1;
+}
 
 /// A joint that follows another (URDF `<mimic>`): q = multiplier·q_leader +
 /// offset, so q̇ = multiplier·q̇_leader and q̈ = multiplier·q̈_leader. The

@@ -6,48 +6,88 @@
 namespace zwang {
 namespace internal {
 
+namespace {
+
+// A one-DOF joint (most joints, so the hot path): its body's pose, S, inertia,
+// velocity and bias in one step.
+void oneDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
+                      const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia,
+                      bool with_velocity) {
+  const int i = joint.v_index + 1;
+  const auto b = static_cast<std::size_t>(i);
+  const auto p = static_cast<std::size_t>(model.parent(i));
+  const Transform& X = ws.Xworld[b] = joint.transform(q[joint.q_index]) * ws.Xworld[p];  // line 4: ⁱX₀
+  // S_i in base coordinates: [p × a; a] (revolute) or [a; 0] (prismatic),
+  // a = ᵂR_i axis, p the body origin.
+  const Vec3 a = X.E.transpose() * joint.axis;
+  if (joint.isRevolute())
+    ws.S[b] << X.r.cross(a), a;
+  else
+    ws.S[b] << a, Vec3::Zero();
+  if (with_inertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
+  if (with_velocity) {
+    const Vec6 vJ = ws.S[b] * qd[i - 1];
+    ws.v[b] = ws.v[p] + vJ;                       // line 5
+    ws.c[b] = spatial::crossMotion(ws.v[b], vJ);  // line 6: Ṡ_i q̇_i = Ẋ_i × S_i q̇_i
+  } else {
+    ws.v[b].setZero();
+    ws.c[b].setZero();
+  }
+}
+
+// A joint of several DOFs: its nv bodies share the child's pose; body k + 1
+// takes DOF k's axis, the last the child's inertia and the joint's bias.
+void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
+                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia,
+                        bool with_velocity) {
+  const std::vector<Dof>& dofs = model.dofs();
+  const int first = joint.v_index + 1, last = joint.v_index + joint.nv();
+  const auto p = static_cast<std::size_t>(model.parent(first));
+  const Transform X = joint.transform(q.data() + joint.q_index) * ws.Xworld[p];  // line 4: ⁱX₀
+  const Transform X_joint_frame = joint.placement * ws.Xworld[p];
+  Vec6 vJ_child = Vec6::Zero(), vJ_joint_frame = Vec6::Zero();  // S q̇ by the frame its axes are fixed in
+  for (int i = first; i <= last; ++i) {
+    const auto b = static_cast<std::size_t>(i);
+    const Dof& dof = dofs[b - 1];
+    ws.Xworld[b] = X;
+    // S_i in base coordinates: [p × a; a] (a rotation) or [a; 0] (a
+    // translation), a = ᵂR axis, p the body origin.
+    const Vec3 a = (dof.in_joint_frame ? X_joint_frame.E : X.E).transpose() * dof.axis;
+    if (dof.rotation)
+      ws.S[b] << X.r.cross(a), a;
+    else
+      ws.S[b] << a, Vec3::Zero();
+    if (with_inertia) ws.I[b] = i == last ? spatial::inverseTransformInertia(X, model.inertia(i)) : RigidInertia{};
+    ws.c[b].setZero();
+    if (with_velocity) {
+      const Vec6 vJ = ws.S[b] * qd[i - 1];
+      ws.v[b] = ws.v[static_cast<std::size_t>(model.parent(i))] + vJ;  // line 5
+      (dof.in_joint_frame ? vJ_joint_frame : vJ_child) += vJ;
+    } else {
+      ws.v[b].setZero();
+    }
+  }
+  // Line 6 on the joint's last body: Ẍ_bias = Ṡ q̇, where an axis fixed in a
+  // body moving with Ẋ turns as Ṡ = Ẋ × S (the child's for most, the
+  // parent's for a planar joint's x and y).
+  if (with_velocity) {
+    const auto b = static_cast<std::size_t>(last);
+    ws.c[b] = spatial::crossMotion(ws.v[b], vJ_child) + spatial::crossMotion(ws.v[p], vJ_joint_frame);
+  }
+}
+
+}  // namespace
+
 void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia) {
-  // Joint by joint (the one place a joint's type matters: its transform), then
-  // DOF by DOF: body k + 1 takes the joint's child pose and DOF k's axis.
+  // Joint by joint: the one place a joint's type matters (its transform and
+  // its DOFs' axes); every other stage visits DOFs.
   const bool with_velocity = qd.size() == model.nv();
-  const std::vector<Dof>& dofs = model.dofs();
   for (const Joint& joint : model.allJoints()) {
-    const int first = joint.v_index + 1, last = joint.v_index + joint.nv();
-    const auto p = static_cast<std::size_t>(model.parent(first));
-    const Transform X = joint.transform(q.data() + joint.q_index) * ws.Xworld[p];  // line 4: ⁱX₀
-    Vec6 vJ_child = Vec6::Zero(), vJ_joint_frame = Vec6::Zero();  // S q̇ by the frame its axes are fixed in
-    for (int i = first; i <= last; ++i) {
-      const auto b = static_cast<std::size_t>(i);
-      const Dof& dof = dofs[b - 1];
-      ws.Xworld[b] = X;
-      // S_i in base coordinates: [p × a; a] (a rotation) or [a; 0] (a
-      // translation), a = ᵂR axis, p the body origin.
-      const Vec3 a = dof.in_joint_frame ? Vec3((joint.placement * ws.Xworld[p]).E.transpose() * dof.axis)
-                                        : Vec3(X.E.transpose() * dof.axis);
-      if (dof.rotation)
-        ws.S[b] << X.r.cross(a), a;
-      else
-        ws.S[b] << a, Vec3::Zero();
-      if (with_inertia) ws.I[b] = i == last ? spatial::inverseTransformInertia(X, model.inertia(i)) : RigidInertia{};
-      if (with_velocity) {
-        const Vec6 vJ = ws.S[b] * qd[i - 1];
-        ws.v[b] = ws.v[static_cast<std::size_t>(model.parent(i))] + vJ;  // line 5
-        (dof.in_joint_frame ? vJ_joint_frame : vJ_child) += vJ;
-        ws.c[b].setZero();
-      } else {
-        ws.v[b].setZero();
-        ws.c[b].setZero();
-      }
-    }
-    // Line 6 on the joint's last body: Ẍ_bias = Ṡ q̇, where an axis fixed in a
-    // body moving with Ẋ turns as Ṡ = Ẋ × S (the child's for most, the
-    // parent's for a planar joint's x and y).
-    if (with_velocity) {
-      const auto b = static_cast<std::size_t>(last);
-      ws.c[b] = spatial::crossMotion(ws.v[b], vJ_child);
-      if (!vJ_joint_frame.isZero(0.0)) ws.c[b] += spatial::crossMotion(ws.v[p], vJ_joint_frame);
-    }
+    if (joint.nv() == 1)
+      oneDofKinematics(model, joint, q, qd, ws, with_inertia, with_velocity);
+    else
+      multiDofKinematics(model, joint, q, qd, ws, with_inertia, with_velocity);
   }
 }
 

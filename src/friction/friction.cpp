@@ -439,10 +439,11 @@ Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<
 
   fr.indeterminate = false;
   Eigen::Index sticking = 0;
-  const Eigen::Index nullity = k > 0 && !report.unbounded
-                                   ? flatDirections(fs.K.topLeftCorner(k, k), fs.qdd0_stuck.head(k), fs.mu.head(k),
-                                                    fs.lo.head(k), fs.hi.head(k), acc_tolerance, fs.choice, sticking)
-                                   : 0;
+  const Eigen::Index nullity =
+      k > 0 && !report.unbounded
+          ? flatDirections(fs.K.topLeftCorner(k, k), fs.qdd0_stuck.head(k), fs.mu.head(k), fs.lo.head(k), fs.hi.head(k),
+                           fs.curvature_terms.head(k), acc_tolerance, fs.choice, sticking)
+          : 0;
   if (nullity > 0) {
     effortAtFirstMaximiser(model, task, tau, fr.stuck, options, ws, fs);
     const EffortChange change = effortAlongFlatDirections(model, task, fr.stuck, sticking, nullity, ws, fs);

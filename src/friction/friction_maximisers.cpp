@@ -16,6 +16,7 @@
 #include "friction/friction_maximisers.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <limits>
 
@@ -37,6 +38,14 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // rows hold their bounds to rounding (with 1e-10, a condition of 1e5 let the
 // pick leave the box by 1e-6 N·m on test_floating_friction's draws).
 constexpr double kSharedRidge = 1e-7;
+// A coupling K_ab of K_ΣΣ at or below this multiple of ε·√(t_a t_b) (t the
+// size of the terms each column is a sum of, an entry taken to the scale
+// √(t_a t_b) as roundingSlope does) is zero: the bound γ_k ≈ k·ε of a sum of
+// k ≤ 64 terms. Kept, it would make the flat directions move a barely curved
+// joint by coupling / curvature, any amount for rounding over a curvature
+// just above the floor, and that joint's bound would pin them short of the
+// least effort. Dropped, q̈ moves by no more than K's own rounding times μ.
+constexpr double kCouplingRounding = 64.0 * DBL_EPSILON;
 // Proximal passes (leastEffortWithSharedLoad): the ridge pulls the pick by
 // ε/(λ + ε) of its distance from the anchor along a curvature λ of BᵀB, and
 // each pass re-anchors at the last pick, so three passes leave 1e-12 of it
@@ -205,7 +214,8 @@ void leastEffortWithSharedLoad(Eigen::Index ns, Eigen::Index nullity, Eigen::Ind
 Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
                             const Eigen::Ref<const Eigen::VectorXd>& qdd0_stuck,
                             const Eigen::Ref<const Eigen::VectorXd>& mu, const Eigen::Ref<const Eigen::VectorXd>& lo,
-                            const Eigen::Ref<const Eigen::VectorXd>& hi, double acc_tolerance,
+                            const Eigen::Ref<const Eigen::VectorXd>& hi,
+                            const Eigen::Ref<const Eigen::VectorXd>& curvature_terms, double acc_tolerance,
                             MaximiserChoiceScratch& s, Eigen::Index& ns) {
   const Eigen::Index k = K.rows();
   auto qdd_star = s.qdd_star.head(k);
@@ -221,7 +231,13 @@ Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
   for (Eigen::Index b = 0; b < ns; ++b) {  // raw gathers of the lower triangle, all nearNullSpace reads
     const double* k_column = K.data() + sub[b] * K.outerStride();
     double* ks_column = K_sticking.data() + b * K_sticking.outerStride();
-    for (Eigen::Index a = b; a < ns; ++a) ks_column[a] = k_column[sub[a]];
+    ks_column[b] = k_column[sub[b]];
+    for (Eigen::Index a = b + 1; a < ns; ++a) {
+      const double coupling = k_column[sub[a]];
+      const bool rounding =
+          std::abs(coupling) <= kCouplingRounding * std::sqrt(curvature_terms[sub[a]] * curvature_terms[sub[b]]);
+      ks_column[a] = rounding ? 0.0 : coupling;
+    }
   }
   // Flat: a curvature that moves q̈ by at most the acceleration tolerance
   // across the box, shared among the ns directions.

@@ -84,12 +84,15 @@ struct MaximiserChoiceScratch {
 // Step 1: the sticking joints Σ (|q̈*_j| ≤ acc_tolerance) and the directions
 // of K_ΣΣ along which g is flat to within acc_tolerance over the whole box.
 // K (k × k), the QP's linear term qdd0_stuck (q̈_Θ(0)), its result mu and the
-// box Λ = [lo, hi] are on Θ₀. Returns the nullity (0: μ* is unique); fills
+// box Λ = [lo, hi] are on Θ₀, as curvature_terms (the size of the terms each
+// column of K is a sum of: a coupling at rounding of them is taken as zero).
+// Returns the nullity (0: μ* is unique); fills
 // s.sticking, s.null_basis and the count of sticking joints `ns`.
 Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
                             const Eigen::Ref<const Eigen::VectorXd>& qdd0_stuck,
                             const Eigen::Ref<const Eigen::VectorXd>& mu, const Eigen::Ref<const Eigen::VectorXd>& lo,
-                            const Eigen::Ref<const Eigen::VectorXd>& hi, double acc_tolerance,
+                            const Eigen::Ref<const Eigen::VectorXd>& hi,
+                            const Eigen::Ref<const Eigen::VectorXd>& curvature_terms, double acc_tolerance,
                             MaximiserChoiceScratch& s, Eigen::Index& ns);
 
 // Step 2, when flatDirections found a nullity > 0: (a) the smallest maximiser

@@ -21,30 +21,6 @@ const char* toString(JointType type) {
   return "unknown";
 }
 
-int configurationSize(JointType type) {
-  switch (type) {
-    case JointType::Revolute:
-    case JointType::Continuous:
-    case JointType::Prismatic: return 1;
-    case JointType::Spherical: return 4;
-    case JointType::Planar: return 3;
-    case JointType::Free: return 7;
-  }
-  return 0;
-}
-
-int velocitySize(JointType type) {
-  switch (type) {
-    case JointType::Revolute:
-    case JointType::Continuous:
-    case JointType::Prismatic: return 1;
-    case JointType::Spherical: return 3;
-    case JointType::Planar: return 3;
-    case JointType::Free: return 6;
-  }
-  return 0;
-}
-
 namespace {
 // The rotation a unit quaternion (w, x, y, z) makes: child axes in the joint frame.
 Mat3 rotationOfQuaternion(double w, double x, double y, double z) {

@@ -45,6 +45,8 @@ Eigen::Map<const Eigen::VectorXd> vectorArg(const char* name, py::handle value, 
 // Same, into a fixed-size vector with its length checked here.
 Vec3 vec3Arg(const char* name, py::handle value);
 Vec6 vec6Arg(const char* name, py::handle value);
+// A rows×cols real matrix (any dtype, any strides), its shape checked here.
+Eigen::MatrixXd matrixArg(const char* name, py::handle value, int rows, int cols);
 // A 6×m constraint matrix (a 6-vector is one column).
 ConstraintMatrix constraintMatrixArg(const char* name, py::handle value);
 // "reference" only where allow_reference (a relative constraint).

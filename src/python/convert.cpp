@@ -85,6 +85,25 @@ Eigen::Map<const Eigen::VectorXd> vectorArg(const char* name, py::handle value, 
   return {buffer.data(), n};
 }
 
+Eigen::MatrixXd matrixArg(const char* name, py::handle value, int rows, int cols) {
+  const py::array a = realArray(name, value);
+  if (a.ndim() != 2 || a.shape(0) != rows || a.shape(1) != cols)
+    raise(PyExc_ValueError, std::string(name) + ": expected a " + std::to_string(rows) + "×" + std::to_string(cols) +
+                                " matrix, got shape " + shapeText(a));
+  using RowMajor = py::array_t<double, py::array::c_style | py::array::forcecast>;
+  RowMajor converted = RowMajor::ensure(a);
+  if (!converted) {
+    PyErr_Clear();
+    raise(PyExc_TypeError,
+          std::string(name) + ": cannot convert dtype " + std::string(py::str(a.dtype())) + " to float64");
+  }
+  const auto view = converted.unchecked<2>();
+  Eigen::MatrixXd M(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) M(i, j) = view(i, j);
+  return M;
+}
+
 Vec3 vec3Arg(const char* name, py::handle value) { return fixedArg<3>(name, value); }
 Vec6 vec6Arg(const char* name, py::handle value) { return fixedArg<6>(name, value); }
 

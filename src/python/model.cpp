@@ -50,23 +50,49 @@ std::string jointNames(const Model& model) {
   return s;
 }
 
-// A per-joint array of a Joint field.
+int jointCount(const Model& model) { return static_cast<int>(model.joints().size()); }
+
+// The joint of DOF k below the root (entry nv − dof + k of qd).
+const Joint& jointOfDof(const Model& model, int k) {
+  return model.joint(model.dofs()[static_cast<std::size_t>(model.nv() - model.dof() + k)].joint);
+}
+
+// A per-DOF array of a Joint field (model.dof entries, in qd order below the
+// root: a multi-DOF joint's value once per DOF, as the solver's friction vectors).
 template <class F>
-py::array perJoint(const Model& model, F field) {
+py::array perDof(const Model& model, F field) {
   Eigen::VectorXd v(model.dof());
-  for (int j = 0; j < model.dof(); ++j) v[j] = field(model.joint(j));
+  for (int k = 0; k < model.dof(); ++k) v[k] = field(jointOfDof(model, k));
   return vectorCopy(v);
 }
 
-// Per-joint values for the builder's setters; length checked against the model.
+// Per-joint values for the builder's setters, one per joint or one per DOF
+// (model.dof entries, as the getters give them: the DOFs of one joint must
+// then agree, a joint has one value for all its DOFs).
 Eigen::VectorXd perJointArg(const Model& model, const char* name, py::handle value) {
   Eigen::VectorXd buffer;
-  Eigen::VectorXd v = vectorArg(name, value, buffer);
-  if (v.size() != model.dof())
+  const Eigen::VectorXd v = vectorArg(name, value, buffer);
+  const int joints = jointCount(model);
+  if (v.size() == joints) return v;
+  if (v.size() != model.dof()) {
+    const std::string dofs = model.dof() == joints ? "" : std::to_string(model.dof()) + " DOFs and ";
     raise(exceptions().model_error, std::string(name) + ": has " + std::to_string(v.size()) +
-                                        " entries, the model has " + std::to_string(model.dof()) + " joints (" +
+                                        " entries, the model has " + dofs + std::to_string(joints) + " joints (" +
                                         jointNames(model) + ")");
-  return v;
+  }
+  Eigen::VectorXd per_joint(joints);
+  const int below = model.nv() - model.dof();
+  for (int j = 0; j < joints; ++j) {
+    const Joint& joint = model.joint(j);
+    const int first = joint.v_index - below;
+    per_joint[j] = v[first];
+    for (int k = first + 1; k < first + joint.nv(); ++k)
+      if (v[k] != v[first])
+        raise(exceptions().model_error, std::string(name) + ": entries " + std::to_string(first) + "-" +
+                                            std::to_string(first + joint.nv() - 1) + " (the DOFs of joint '" +
+                                            joint.name + "') differ: a joint has one value for all its DOFs");
+  }
+  return per_joint;
 }
 
 py::array transformMatrix(const Eigen::Matrix3d& R, const Vec3& p) {
@@ -94,6 +120,44 @@ std::shared_ptr<Model> issueWarnings(std::shared_ptr<Model> model) {
   return model;
 }
 
+JointType jointTypeArg(const std::string& type) {
+  for (const JointType t : {JointType::Revolute, JointType::Continuous, JointType::Prismatic, JointType::Spherical,
+                            JointType::Planar, JointType::Free})
+    if (type == toString(t)) return t;
+  raise(PyExc_ValueError, "type: unknown joint type '" + type +
+                              "' (expected 'revolute', 'continuous', 'prismatic', 'spherical', 'planar' or 'free')");
+}
+
+// A 4×4 pose [R p; 0 0 0 1] of a frame in its parent (as Joint.placement and
+// Frame.placement give it); None is the identity. R must be a rotation.
+Transform poseArg(const char* name, py::handle value) {
+  if (value.is_none()) return Transform{};
+  const Eigen::Matrix4d T = matrixArg(name, value, 4, 4);
+  const Mat3 R = T.topLeftCorner<3, 3>();
+  // A rotation typed with 16 digits, or computed in float64, is orthonormal to
+  // a few 1e-16; 1e-9 still lets a 10-digit printout through.
+  const bool rotation =
+      T.allFinite() && (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-9 && R.determinant() > 0.0;
+  if (!rotation || T.row(3) != Eigen::RowVector4d(0, 0, 0, 1))
+    raise(PyExc_ValueError, std::string(name) +
+                                ": expected a finite 4×4 rigid transform [R p; 0 0 0 1] with R a rotation (orthonormal "
+                                "to 1e-9, determinant +1)");
+  return Transform::fromPose(R, T.topRightCorner<3, 1>());
+}
+
+// A link's inertia from its mass, centre of mass and 3×3 inertia about the
+// centre of mass (None: zero), in the link's frame; checked by the builder.
+RigidInertia inertiaArg(double mass, py::handle com, py::handle inertia) {
+  const Mat3 I = inertia.is_none() ? Mat3::Zero() : Mat3(matrixArg("inertia", inertia, 3, 3));
+  return RigidInertia::fromMassComInertia(mass, vec3Arg("com", com), I);
+}
+
+BaseType floatingBaseArg(const std::string& type) {
+  if (type == "free") return BaseType::Free;
+  if (type == "planar") return BaseType::Planar;
+  raise(PyExc_ValueError, "set_base: unknown base '" + type + "' (expected 'free' or 'planar')");
+}
+
 }  // namespace
 
 void bindModel(py::module_& m) {
@@ -101,9 +165,21 @@ void bindModel(py::module_& m) {
       .def_property_readonly("name", [](const Joint& j) { return j.name; })
       .def_property_readonly(
           "type", [](const Joint& j) { return std::string(toString(j.type)); },
-          "'revolute', 'continuous' or 'prismatic'")
+          "'revolute', 'continuous', 'prismatic', 'spherical', 'planar' or 'free' (docs/conventions.md, "
+          "\"Joint types\")")
+      .def_property_readonly("nq", &Joint::nq,
+                             "entries of q: 1 (revolute, continuous, prismatic), 4 (spherical), 3 (planar), 7 (free)")
       .def_property_readonly(
-          "axis", [](const Joint& j) { return vectorCopy(j.axis); }, "unit axis in the joint (child link) frame")
+          "nv", &Joint::nv,
+          "entries of qd, tau, qdd: 1 (revolute, continuous, prismatic), 3 (spherical), 3 (planar), 6 (free)")
+      .def_property_readonly(
+          "q_index", [](const Joint& j) { return j.q_index; }, "first entry of the joint's coordinates in q")
+      .def_property_readonly(
+          "v_index", [](const Joint& j) { return j.v_index; },
+          "first entry of its velocity coordinates in qd, tau, qdd")
+      .def_property_readonly(
+          "axis", [](const Joint& j) { return vectorCopy(j.axis); },
+          "unit axis in the joint (child link) frame (one-DOF joints)")
       .def_property_readonly("lower", [](const Joint& j) { return j.lower; })
       .def_property_readonly("upper", [](const Joint& j) { return j.upper; })
       .def_property_readonly("effort_limit", [](const Joint& j) { return j.effort_limit; })
@@ -127,10 +203,34 @@ void bindModel(py::module_& m) {
           "None, or (leader joint index, multiplier, offset) when the joint follows q = multiplier*q_leader + offset")
       .def("__repr__", &jointRepr);
 
+  py::class_<Dof>(m, "Dof",
+                  "One degree of freedom, entry k of qd (Model.dofs): a rotation about or a translation along one axis "
+                  "(read-only).")
+      .def_property_readonly(
+          "name", [](const Dof& d) { return d.name; }, "the joint's name, 'hip.wx' for a multi-DOF joint")
+      .def_property_readonly(
+          "joint", [](const Dof& d) { return d.joint; }, "index of its joint in Model.joints (-1: the root joint)")
+      .def_property_readonly("index_in_joint", [](const Dof& d) { return d.index_in_joint; })
+      .def_property_readonly(
+          "rotation", [](const Dof& d) { return d.rotation; }, "True: a rotation about axis; False: a translation")
+      .def_property_readonly(
+          "in_joint_frame", [](const Dof& d) { return d.in_joint_frame; },
+          "True: axis is fixed in the joint frame (a planar joint's x and y); False: in the child's")
+      .def_property_readonly("axis", [](const Dof& d) { return vectorCopy(d.axis); })
+      .def_property_readonly("rotor_inertia", [](const Dof& d) { return d.rotor_inertia; })
+      .def_property_readonly("breakaway_friction", [](const Dof& d) { return d.breakaway_friction; })
+      .def_property_readonly("kinetic_friction", [](const Dof& d) { return d.kinetic_friction; })
+      .def_property_readonly("viscous_friction", [](const Dof& d) { return d.viscous_friction; })
+      .def_property_readonly("lower", [](const Dof& d) { return d.lower; })
+      .def_property_readonly("upper", [](const Dof& d) { return d.upper; })
+      .def("__repr__", [](const Dof& d) { return "<zwang.Dof '" + d.name + "'>"; });
+
   py::class_<Frame>(m, "Frame", "A named frame (every URDF link), rigidly attached to a body.")
       .def_property_readonly("name", [](const Frame& f) { return f.name; })
       .def_property_readonly(
-          "body", [](const Frame& f) { return f.body; }, "0 is the base; joint j moves body j+1")
+          "body", [](const Frame& f) { return f.body; },
+          "the body it is attached to: 0 is the world (a fixed base), Model.base_body a floating base; DOF k moves "
+          "body k+1")
       .def_property_readonly(
           "placement",
           [](const Frame& f) { return transformMatrix(f.placement.rotationOfTarget(), f.placement.originOfTarget()); },
@@ -141,15 +241,17 @@ void bindModel(py::module_& m) {
   py::class_<Model, std::shared_ptr<Model>>(
       m, "Model", "An immutable kinematic tree or chain (zwang::Model). Make one with load_urdf().")
       .def_property_readonly("name", &Model::name)
-      .def_property_readonly("dof", &Model::dof, "number of moving joints")
+      .def_property_readonly("dof", &Model::dof,
+                             "degrees of freedom below the root: nv without a floating base's (the number of joints "
+                             "when every joint has one DOF); the length of the per-DOF arrays (friction, limits)")
       .def_property_readonly(
           "base_type", [](const Model& model) { return std::string(toString(model.baseType())); },
           "'fixed', 'free' (a free-flyer) or 'planar' (x, y, yaw in a plane): how body 0 is attached to the world")
       .def_property_readonly("nq", &Model::nq,
-                             "length of q: the base's coordinates (7 free, 3 planar, 0 fixed), then one per joint")
+                             "length of q: the base's coordinates (7 free, 3 planar, 0 fixed), then each joint's nq")
       .def_property_readonly("nv", &Model::nv,
-                             "length of qd, tau, qdd: the base's velocity coordinates (6 free, 3 planar), then one "
-                             "per joint")
+                             "length of qd, tau, qdd: the base's velocity coordinates (6 free, 3 planar), then each "
+                             "joint's nv")
       .def_property_readonly(
           "base_plane",
           [](const Model& model) -> py::object {
@@ -174,7 +276,14 @@ void bindModel(py::module_& m) {
     return names;
           })
       .def_property_readonly(
-          "joints", [](const Model& model) { return model.joints(); }, "list of Joint (copies)")
+          "joints", [](const Model& model) { return model.joints(); },
+          "list of Joint (copies): the joints below the root, in q order")
+      .def_property_readonly(
+          "all_joints", [](const Model& model) { return model.allJoints(); },
+          "list of Joint (copies): a floating base's root joint ('root_joint', free or planar) first, then joints")
+      .def_property_readonly(
+          "dofs", [](const Model& model) { return model.dofs(); },
+          "list of Dof (copies), one per entry of qd (model.nv): the root joint's first")
       .def_property_readonly(
           "frames", [](const Model& model) { return model.frames(); }, "list of Frame (copies)")
       .def(
@@ -200,14 +309,20 @@ void bindModel(py::module_& m) {
           py::arg("q"), py::arg("qd"),
           "copies of q (nq entries) and qd (nv) with each mimic joint's entries set from its leader's "
           "(q = a*q_leader + b, qd = a*qd_leader)")
-      .def_property_readonly("body_count", &Model::bodyCount, "dof + 1: the base (body 0) and one body per joint")
+      .def_property_readonly("body_count", &Model::bodyCount,
+                             "nv + 1: body 0 (the world, or a fixed base) and one body per DOF (DOF k moves body k+1)")
+      .def_property_readonly("base_body", &Model::baseBody,
+                             "the root link's body: 0 on a fixed base, 6 (free) or 3 (planar) on a floating one")
       .def_property_readonly("is_chain", &Model::isChain, "True when every body's parent is the body before it")
       .def_property_readonly(
           "parents",
           [](const Model& model) {
-    py::array_t<long> out(model.dof());
+    py::array_t<long> out(jointCount(model));
     auto v = out.mutable_unchecked<1>();
-    for (int j = 0; j < model.dof(); ++j) v(j) = model.parentBodyOfJoint(j) - 1;
+    for (int j = 0; j < jointCount(model); ++j) {
+      const int body = model.parentBodyOfJoint(j);  // body 0 or the root's: Dof::joint is −1
+      v(j) = body == 0 ? -1 : model.dofs()[static_cast<std::size_t>(body - 1)].joint;
+    }
     return out;
           },
           "per joint, the index of the joint that moves its parent body (-1: it hangs from the base)")
@@ -225,27 +340,27 @@ void bindModel(py::module_& m) {
           },
           py::arg("a"), py::arg("b"), "True when body a is body b or one of its ancestors")
       .def_property_readonly("lower",
-                             [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.lower; }); })
+                             [](const Model& model) { return perDof(model, [](const Joint& j) { return j.lower; }); })
       .def_property_readonly("upper",
-                             [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.upper; }); })
+                             [](const Model& model) { return perDof(model, [](const Joint& j) { return j.upper; }); })
       .def_property_readonly(
           "effort_limit",
-          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.effort_limit; }); })
+          [](const Model& model) { return perDof(model, [](const Joint& j) { return j.effort_limit; }); })
       .def_property_readonly(
           "velocity_limit",
-          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.velocity_limit; }); })
+          [](const Model& model) { return perDof(model, [](const Joint& j) { return j.velocity_limit; }); })
       .def_property_readonly(
           "breakaway_friction",
-          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.breakaway_friction; }); })
+          [](const Model& model) { return perDof(model, [](const Joint& j) { return j.breakaway_friction; }); })
       .def_property_readonly(
           "kinetic_friction",
-          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.kinetic_friction; }); })
+          [](const Model& model) { return perDof(model, [](const Joint& j) { return j.kinetic_friction; }); })
       .def_property_readonly(
           "viscous_friction",
-          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.viscous_friction; }); })
+          [](const Model& model) { return perDof(model, [](const Joint& j) { return j.viscous_friction; }); })
       .def_property_readonly(
           "rotor_inertia",
-          [](const Model& model) { return perJoint(model, [](const Joint& j) { return j.rotor_inertia; }); })
+          [](const Model& model) { return perDof(model, [](const Joint& j) { return j.rotor_inertia; }); })
       .def_property_readonly(
           "warnings",
           [](const Model& model) {
@@ -272,33 +387,117 @@ void bindModel(py::module_& m) {
           [](const Model& model, py::handle values) {
     const Eigen::VectorXd v = perJointArg(model, "rotor_inertia", values);
     ModelBuilder builder(model);
-    for (int j = 0; j < model.dof(); ++j) builder.setRotorInertia(model.joint(j).name, v[j]);
+    for (int j = 0; j < jointCount(model); ++j) builder.setRotorInertia(model.joint(j).name, v[j]);
     return std::make_shared<Model>(builder.build());
           },
-          py::arg("rotor_inertia"), "a copy with these reflected rotor inertias, one per joint")
+          py::arg("rotor_inertia"),
+          "a copy with these reflected rotor inertias, one per joint or one per DOF (model.dof entries; a joint's\n"
+          "DOFs must agree)")
       .def(
           "with_friction",
           [](const Model& model, py::handle breakaway, py::handle kinetic, py::handle viscous) {
     const Eigen::VectorXd f = perJointArg(model, "breakaway", breakaway);
     const Eigen::VectorXd fc = kinetic.is_none() ? f : perJointArg(model, "kinetic", kinetic);
-    Eigen::VectorXd b(model.dof());
-    for (int j = 0; j < model.dof(); ++j) b[j] = model.joint(j).viscous_friction;
+    Eigen::VectorXd b(jointCount(model));
+    for (int j = 0; j < jointCount(model); ++j) b[j] = model.joint(j).viscous_friction;
     if (!viscous.is_none()) b = perJointArg(model, "viscous", viscous);
     ModelBuilder builder(model);
-    for (int j = 0; j < model.dof(); ++j) builder.setFriction(model.joint(j).name, f[j], fc[j], b[j]);
+    for (int j = 0; j < jointCount(model); ++j) builder.setFriction(model.joint(j).name, f[j], fc[j], b[j]);
     return std::make_shared<Model>(builder.build());
           },
           py::arg("breakaway"), py::arg("kinetic") = py::none(), py::arg("viscous") = py::none(),
-          "a copy with these friction parameters, one per joint (kinetic defaults to breakaway, viscous to the\n"
-          "model's)")
+          "a copy with these friction parameters, one per joint or one per DOF (model.dof entries, as\n"
+          "model.breakaway_friction gives them; a joint's DOFs must agree; a box per DOF of that size); kinetic\n"
+          "defaults to breakaway, viscous to the model's")
       .def("__repr__", [](const Model& model) {
         const std::string base = model.hasFloatingBase() ? std::string(toString(model.baseType())) +
                                                                " base, nq=" + std::to_string(model.nq()) +
                                                                ", nv=" + std::to_string(model.nv()) + ", "
                                                          : std::string();
-        return "<zwang.Model '" + model.name() + "': " + base + std::to_string(model.dof()) + " joints (" +
+        return "<zwang.Model '" + model.name() + "': " + base + std::to_string(jointCount(model)) + " joints (" +
                jointNames(model) + "), " + std::to_string(model.frames().size()) + " frames>";
       });
+
+  py::class_<ModelBuilder>(m, "ModelBuilder",
+                           "Builds a Model joint by joint (zwang::ModelBuilder): any joint type anywhere in the tree,\n"
+                           "depth first. Each method returns the builder; build() returns the Model. Bad values raise\n"
+                           "ModelError naming the joint or link and the field.")
+      .def(py::init<std::string, std::string>(), py::arg("robot_name") = "robot", py::arg("base_frame") = "base",
+           "an empty tree: the fixed base alone, a frame called base_frame")
+      .def(py::init([](const Model& model) { return ModelBuilder(model); }), py::arg("model"),
+           "start from an existing model (to add joints below its last link)")
+      .def(
+          "add_joint",
+          [](ModelBuilder& b, const std::string& name, const std::string& type, const std::string& child,
+             const std::string& parent, py::handle axis, py::handle placement, double mass, py::handle com,
+             py::handle inertia, double lower, double upper, double effort_limit, double velocity_limit,
+             double rotor_inertia, double breakaway, double kinetic, double viscous) -> ModelBuilder& {
+            Joint joint;
+            joint.name = name;
+            joint.type = jointTypeArg(type);
+            joint.axis = vec3Arg("axis", axis);
+            joint.placement = poseArg("placement", placement);
+            joint.lower = lower;
+            joint.upper = upper;
+            joint.effort_limit = effort_limit;
+            joint.velocity_limit = velocity_limit;
+            joint.rotor_inertia = rotor_inertia;
+            joint.breakaway_friction = breakaway;
+            joint.kinetic_friction = kinetic;
+            joint.viscous_friction = viscous;
+            return b.addJoint(joint, child, inertiaArg(mass, com, inertia), parent);
+          },
+          py::arg("name"), py::arg("type"), py::arg("child"), py::kw_only(), py::arg("parent") = "",
+          py::arg("axis") = py::make_tuple(0.0, 0.0, 1.0), py::arg("placement") = py::none(), py::arg("mass") = 0.0,
+          py::arg("com") = py::make_tuple(0.0, 0.0, 0.0), py::arg("inertia") = py::none(),
+          py::arg("lower") = -std::numeric_limits<double>::infinity(),
+          py::arg("upper") = std::numeric_limits<double>::infinity(),
+          py::arg("effort_limit") = std::numeric_limits<double>::infinity(),
+          py::arg("velocity_limit") = std::numeric_limits<double>::infinity(), py::arg("rotor_inertia") = 0.0,
+          py::arg("breakaway_friction") = 0.0, py::arg("kinetic_friction") = 0.0, py::arg("viscous_friction") = 0.0,
+          py::return_value_policy::reference_internal,
+          "Add a moving joint of any type ('revolute', 'continuous', 'prismatic', 'spherical', 'planar', 'free')\n"
+          "whose child link is the new frame `child`, hanging from the frame `parent` (default: the last link\n"
+          "added; depth first: the last link or one of its ancestors). placement: 4×4 pose of the joint frame in\n"
+          "the parent link at q = 0 (None: identity); axis: one-DOF joints only. The child link's mass, com and\n"
+          "3×3 inertia about the com (None: zero) are in its frame. Rotor inertia and friction apply to each DOF\n"
+          "(a box per DOF); multi-DOF joints take no finite limits.")
+      .def(
+          "add_fixed_frame",
+          [](ModelBuilder& b, const std::string& name, const std::string& parent, py::handle placement, double mass,
+             py::handle com, py::handle inertia) -> ModelBuilder& {
+            return b.addFixedFrame(name, parent, poseArg("placement", placement), inertiaArg(mass, com, inertia));
+          },
+          py::arg("name"), py::arg("parent"), py::arg("placement") = py::none(), py::kw_only(), py::arg("mass") = 0.0,
+          py::arg("com") = py::make_tuple(0.0, 0.0, 0.0), py::arg("inertia") = py::none(),
+          py::return_value_policy::reference_internal,
+          "Weld a frame to `parent` (a fixed URDF joint) at `placement` (4×4); its inertia joins the parent's body.")
+      .def(
+          "add_base_link_inertia",
+          [](ModelBuilder& b, double mass, py::handle com, py::handle inertia) -> ModelBuilder& {
+            return b.addBaseLinkInertia(inertiaArg(mass, com, inertia));
+          },
+          py::arg("mass"), py::arg("com") = py::make_tuple(0.0, 0.0, 0.0), py::arg("inertia") = py::none(),
+          py::return_value_policy::reference_internal,
+          "Add the base link's own inertia (in the dynamics when the base floats).")
+      .def(
+          "set_base",
+          [](ModelBuilder& b, const std::string& type, py::handle plane) -> ModelBuilder& {
+            return b.setBase(floatingBaseArg(type), poseArg("plane", plane));
+          },
+          py::arg("type"), py::arg("plane") = py::none(), py::return_value_policy::reference_internal,
+          "Let the base float: 'free' or 'planar' (the root joint 'root_joint', unactuated); plane: a planar\n"
+          "base's plane, 4×4 pose in the world (None: the world's x-y plane).")
+      .def(
+          "set_mimic",
+          [](ModelBuilder& b, const std::string& joint, const std::string& leader, double multiplier,
+             double offset) -> ModelBuilder& { return b.setMimic(joint, leader, multiplier, offset); },
+          py::arg("joint"), py::arg("leader"), py::arg("multiplier") = 1.0, py::arg("offset") = 0.0,
+          py::return_value_policy::reference_internal,
+          "Make a one-DOF joint follow another: q = multiplier*q_leader + offset.")
+      .def(
+          "build", [](const ModelBuilder& b) { return issueWarnings(std::make_shared<Model>(b.build())); },
+          "the Model (ModelError when a moving body has no inertia to move); warnings as load_urdf issues them");
 
   m.def(
       "load_urdf",

@@ -255,16 +255,17 @@ void warnOnce(const std::shared_ptr<Model>& model, Result& r, const std::string&
 // out of the C++ solve, which must not allocate.
 // q[k] names the entry of the full q (a floating base's coordinates first).
 void warnOutsideLimits(const std::shared_ptr<Model>& model, const Eigen::Ref<const Eigen::VectorXd>& q, Result& r) {
-  const int base = model->baseConfigurationSize();
-  for (int j = 0; j < model->dof(); ++j) {
+  for (int j = 0; j < static_cast<int>(model->joints().size()); ++j) {
     const Joint& joint = model->joint(j);
-    const double qj = q[base + j];
+    if (joint.nq() != 1) continue;  // multi-DOF joints have no position limits
+    const double qj = q[joint.q_index];
     if (qj >= joint.lower && qj <= joint.upper) continue;
     char figures[120];
     std::snprintf(figures, sizeof figures, "%g puts joint '", qj);
     char limits[80];
     std::snprintf(limits, sizeof limits, "' outside its limits [%g, %g]", joint.lower, joint.upper);
-    warnOnce(model, r, kOutsideLimits, j, "q[" + std::to_string(base + j) + "] = " + figures + joint.name + limits);
+    warnOnce(model, r, kOutsideLimits, j,
+             "q[" + std::to_string(joint.q_index) + "] = " + figures + joint.name + limits);
   }
 }
 

@@ -3,7 +3,9 @@
 // friction with every joint stuck, friction under a 6-row tool constraint plus
 // an elbow row, and the plain constrained solver. The same on the dual-arm
 // tree, and on the humanoid with a free base (issue #15) standing on both
-// feet (two 6-row contacts) with friction on every joint. Every thread must
+// feet (two 6-row contacts) with friction on every joint, and on a two-arm tree
+// of spherical shoulders and wrists (issue #25: multi-DOF joints, a quaternion
+// per ball, friction on each DOF). Every thread must
 // produce bit-for-bit the outputs of a single-threaded run of the same sequence.
 //
 // Built twice: as an ordinary ctest test, and with ThreadSanitizer in .ci/run
@@ -21,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 
 #include "zwang/zwang.hpp"
@@ -77,6 +80,13 @@ struct Tasks {
       }
       friction.breakaway = Eigen::VectorXd::Constant(model.dof(), 5.0);
       friction.kinetic = friction.breakaway;
+    } else if (model.name() == "ball_arms") {  // the left hand held in the world, the hands held apart
+      constrained.addConstraint("left_hand", ConstraintMatrix::Identity(6, 3), Expressed::World);
+      constrained.addRelativeConstraint("left_hand", "right_hand", ConstraintMatrix::Identity(6, 3));
+      constrained.targets()[2] = 0.5;
+      home.setZero();
+      for (const Joint& joint : model.joints())  // balls at the identity (w = 1), elbows bent
+        home[joint.q_index] = joint.type == JointType::Spherical ? 1.0 : 0.5;
     } else if (model.name() == "panda") {
       constrained.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
       ConstraintMatrix elbow = ConstraintMatrix::Zero(6, 1);
@@ -103,7 +113,7 @@ struct Outcome {
 // A floating base's coordinates stay at home (the joints and τ vary).
 Outcome run(const Model& model, const Tasks& tasks, long solves) {
   Workspace ws(model, tasks.constrained);
-  const int n = model.dof(), iq = model.baseConfigurationSize(), iv = model.baseVelocitySize();
+  const int n = model.dof(), iv = model.baseVelocitySize();
   Eigen::VectorXd q = tasks.home, qd(model.nv()), tau = Eigen::VectorXd::Zero(model.nv());
   const Eigen::VectorXd& home = tasks.home;
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
@@ -111,10 +121,18 @@ Outcome run(const Model& model, const Tasks& tasks, long solves) {
   Hash hash;
   Outcome out;
   for (long i = 0; i < solves; ++i) {
-    for (int j = 0; j < n; ++j) {
-      q[iq + j] = home[iq + j] + tasks.amplitude[j] * std::sin(0.001 * static_cast<double>(i) + j);
-      tau[iv + j] = 2.0 * std::cos(0.002 * static_cast<double>(i) * (j + 1));
+    for (const Joint& joint : model.joints()) {
+      const int j = joint.v_index - iv;
+      const double phase = 0.001 * static_cast<double>(i) + j;
+      if (joint.type == JointType::Spherical) {  // turned from the identity by up to 0.3 rad about a moving axis
+        const Vec3 turn(std::sin(phase), std::sin(1.3 * phase + 1.0), std::sin(0.7 * phase + 2.0));
+        const Eigen::Quaterniond quat(Eigen::AngleAxisd(tasks.amplitude[j] * turn.norm(), turn.normalized()));
+        q.segment<4>(joint.q_index) << quat.w(), quat.x(), quat.y(), quat.z();
+      } else {
+        q[joint.q_index] = home[joint.q_index] + tasks.amplitude[j] * std::sin(phase);
+      }
     }
+    for (int j = 0; j < n; ++j) tau[iv + j] = 2.0 * std::cos(0.002 * static_cast<double>(i) * (j + 1));
     Status status;
     switch (i % 3) {
       case 0:  // every joint stuck, gravity only (a floating base falls)
@@ -174,8 +192,42 @@ zwang::Model dualPanda(const zwang::Model& panda) {
 // so a twentieth keeps its run at about half the Panda's.
 constexpr long kHumanoidShare = 20;
 
-// The models of the test: the Panda, the dual-arm tree, the humanoid on a free base.
+// A tree of multi-DOF joints: a torso turning about z, two arms of a spherical shoulder, a revolute elbow and a
+// spherical wrist (15 DOFs, nq = 19), breakaway friction 2 N·m on each DOF.
+Model ballArms() {
+  ModelBuilder builder("ball_arms", "base");
+  Joint torso;
+  torso.name = "torso";
+  torso.breakaway_friction = torso.kinetic_friction = 2.0;
+  builder.addJoint(torso, "torso_link", RigidInertia::fromMassComInertia(15.0, Vec3(0, 0, 0.3), Mat3::Identity()));
+  for (const char* side : {"left", "right"}) {
+    const std::string s(side);
+    const double y = s == "left" ? 0.25 : -0.25;
+    Joint ball;
+    ball.type = JointType::Spherical;
+    ball.breakaway_friction = ball.kinetic_friction = 2.0;
+    Joint elbow = torso;
+    elbow.axis = Vec3::UnitY();
+    const Mat3 rod = Vec3(0.02, 0.02, 0.001).asDiagonal();  // a slender link along z
+    ball.name = s + "_shoulder";
+    ball.placement = Transform::translation(Vec3(0, y, 0.5));
+    builder.addJoint(ball, s + "_upper_arm", RigidInertia::fromMassComInertia(2.0, Vec3(0, 0, 0.15), rod),
+                     "torso_link");
+    elbow.name = s + "_elbow";
+    elbow.placement = Transform::translation(Vec3(0, 0, 0.3));
+    builder.addJoint(elbow, s + "_forearm", RigidInertia::fromMassComInertia(1.5, Vec3(0, 0, 0.12), rod),
+                     s + "_upper_arm");
+    ball.name = s + "_wrist";
+    ball.placement = Transform::translation(Vec3(0, 0, 0.25));
+    builder.addJoint(ball, s + "_hand", RigidInertia::fromMassComInertia(0.5, Vec3(0, 0, 0.05), 0.1 * rod),
+                     s + "_forearm");
+  }
+  return builder.build();
+}
+
+// The models of the test: the Panda, the dual-arm tree, the humanoid on a free base, the ball-jointed arms.
 Model threadModel(int which) {
+  if (which == 3) return ballArms();
   const Model panda = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
   if (which == 0) return panda;
   if (which == 1) return dualPanda(panda);
@@ -186,7 +238,7 @@ Model threadModel(int which) {
 }  // namespace
 
 TEST_CASE("8 threads share one model, each with its own workspace: results identical to one thread") {
-  const int which = GENERATE(0, 1, 2);
+  const int which = GENERATE(0, 1, 2, 3);
   const Model model = threadModel(which);
   const Tasks tasks(model);
   const long solves = which == 2 ? std::max(1L, solvesPerThread() / kHumanoidShare) : solvesPerThread();
@@ -206,7 +258,8 @@ TEST_CASE("8 threads share one model, each with its own workspace: results ident
     CHECK(outcomes[static_cast<std::size_t>(t)].failures == 0);
     CHECK(outcomes[static_cast<std::size_t>(t)].hash == reference.hash);
   }
-  const char* names[] = {"Panda", "dual-arm (15-joint tree)", "humanoid (free base, 29 joints, on two feet)"};
+  const char* names[] = {"Panda", "dual-arm (15-joint tree)", "humanoid (free base, 29 joints, on two feet)",
+                         "two-arm tree of spherical shoulders and wrists (15 DOFs)"};
   std::printf(
       "threads: %d x %ld solves on one shared %s model, every thread bit-identical to the single-thread run"
       " (hash %016llx)\n",

@@ -56,13 +56,16 @@ constexpr double kCouplingRounding = 64.0 * DBL_EPSILON;
 // standing humanoid (zwang energy).
 constexpr int kSharedPasses = 3;
 
-// Largest t ≥ 0 with lo ≤ x + t·d ≤ hi.
+// Largest t ≥ 0 with lo ≤ x + t·sign·d ≤ hi. The sign, not a −d argument: −d bound to a Ref would be a heap
+// temporary in the solve.
 double roomAlong(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& d,
-                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi) {
+                 const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                 double sign) {
   double t = kInf;
   for (Eigen::Index j = 0; j < x.size(); ++j) {
-    if (d[j] > 0) t = std::min(t, (hi[j] - x[j]) / d[j]);
-    if (d[j] < 0) t = std::min(t, (lo[j] - x[j]) / d[j]);
+    const double dj = sign * d[j];
+    if (dj > 0) t = std::min(t, (hi[j] - x[j]) / dj);
+    if (dj < 0) t = std::min(t, (lo[j] - x[j]) / dj);
   }
   return std::max(0.0, t);
 }
@@ -289,8 +292,8 @@ bool leastEffortMaximiser(const Eigen::Ref<const Eigen::VectorXd>& lo, const Eig
   }
   bool indeterminate = (mu_chosen - mu_first).cwiseAbs().maxCoeff() > mu_scale;
   for (Eigen::Index e = 0; e < nullity && !indeterminate; ++e)
-    indeterminate = roomAlong(mu_first, N.col(e), box_lo, box_hi) > mu_scale ||
-                    roomAlong(mu_first, -N.col(e), box_lo, box_hi) > mu_scale;
+    indeterminate = roomAlong(mu_first, N.col(e), box_lo, box_hi, 1.0) > mu_scale ||
+                    roomAlong(mu_first, N.col(e), box_lo, box_hi, -1.0) > mu_scale;
   for (Eigen::Index t = 0; t < ns; ++t) mu[sticking[t]] = mu_chosen[t];
   return indeterminate;
 }

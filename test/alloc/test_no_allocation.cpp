@@ -614,3 +614,76 @@ TEST_CASE("floating bases: the standing humanoid, contacts sharing the load with
   REQUIRE(solveHybridDynamics(c.model, c.task, c.q, c.v, c.tau, ws));
   CHECK((felt - ws.solution.tau_control.tail(n)).cwiseAbs().maxCoeff() > 1e-3);
 }
+
+// ---------------------------------------------------------------------------
+// Multi-DOF joints (issue #25): a random 10-joint tree whose second and fourth moving joints are spherical (balls
+// inside the tree), the sixth planar and the seventh free, on a fixed, free or planar base; a frame row, a relative
+// row, joint rows on a ball (one per DOF), a contact and a wrench; every third DOF stuck.
+
+namespace {
+
+FloatingCase sphericalTree(zwang::testing::BaseKind kind, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  zwang::testing::RandomTreeOptions tree;
+  tree.min_moving_joints = tree.max_moving_joints = 10;
+  zwang::testing::ChainSpec spec = zwang::testing::randomTree(rng, tree);
+  int moving = 0;
+  for (zwang::testing::JointSpec& joint : spec.joints) {
+    if (joint.isFixed()) continue;
+    const char* type = moving == 1 || moving == 3 ? "spherical" : moving == 5 ? "planar" : moving == 6 ? "free" : "";
+    ++moving;
+    if (*type == '\0') continue;
+    joint.type = type;
+    joint.lower = joint.upper = 0.0;
+  }
+  zwang::testing::FloatingBase base;
+  base.kind = kind;
+  FloatingCase c(zwang::testing::floatingModelFromSpec(spec, base));
+  const Model& m = c.model;
+  const int last = m.bodyFrame(m.bodyCount() - 1);
+  int ball = -1;
+  for (std::size_t j = 0; j < m.joints().size() && ball < 0; ++j)
+    if (m.joints()[j].type == JointType::Spherical) ball = static_cast<int>(j);
+  c.task.addConstraint(m.bodyFrame(6), ConstraintMatrix::Identity(6, 2), Expressed::World);
+  c.task.addRelativeConstraint(last, m.bodyFrame(3), ConstraintMatrix::Identity(6, 1));
+  c.task.addJointConstraint(ball);
+  c.task.addContact(m.bodyFrame(9), ConstraintMatrix::Identity(6, 3), Expressed::World);
+  c.task.wrench(c.task.addWrench(last, Expressed::World)) << 1, 2, 3, 0.1, 0.2, 0.3;
+  // The state: the base as baseState's; balls and free joints turned 0.3 rad, one-DOF joints at 0.1·sin(j)
+  // inside their limits; every third DOF stuck, the rest moving at 0.3.
+  c.q = Eigen::VectorXd::Zero(m.nq());
+  c.v = Eigen::VectorXd::Zero(m.nv());
+  c.tau = Eigen::VectorXd::Zero(m.nv());
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
+  const int iv = m.baseVelocitySize();
+  for (const Joint& joint : m.allJoints()) {
+    const int q = joint.q_index;
+    if (joint.type == JointType::Spherical) c.q.segment<4>(q) << turn.w(), turn.x(), turn.y(), turn.z();
+    if (joint.type == JointType::Free) c.q.segment<4>(q + 3) << turn.w(), turn.x(), turn.y(), turn.z();
+    if (joint.nv() == 1) c.q[q] = std::clamp(0.1 * std::sin(joint.v_index), joint.lower, joint.upper);
+  }
+  for (int k = 0; k < iv; ++k) c.v[k] = 0.1 * (k + 1);
+  for (int k = 0; k < m.dof(); ++k) {
+    c.v[iv + k] = k % 3 == 0 ? 0.0 : 0.3;
+    c.tau[iv + k] = std::cos(k);
+  }
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("trees with spherical, planar and free joints allocate nothing (plain, friction, RNEA, CRBA)",
+          "[joint_types]") {
+  using zwang::testing::BaseKind;
+  for (const BaseKind kind : {BaseKind::Fixed, BaseKind::Free, BaseKind::Planar})
+    for (const std::uint64_t seed : {5u, 6u}) {
+      FloatingCase c = sphericalTree(kind, seed);
+      INFO(zwang::testing::toString(kind) << " base, seed " << seed);
+      REQUIRE(c.model.dof() == 21);  // 6 one-DOF joints, two balls, a planar and a free joint
+      const FloatingCounts counts = countFloatingSolves(c);
+      INFO("first error: " << counts.first_error);
+      CHECK(counts.ok);
+      CHECK(counts.allocations == 0);
+      CHECK(counts.stuck > 0);
+    }
+}

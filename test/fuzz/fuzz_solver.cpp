@@ -1,5 +1,6 @@
-// libFuzzer target: bytes → a random serial chain (1–8 joints of every type,
-// masses 1e-6–1e4 kg, offsets 1e-3–10 m, rotor inertias 0–1e3, friction
+// libFuzzer target: bytes → a random tree (1–8 joints of every type: revolute,
+// continuous, prismatic, and spherical, planar and free anywhere in the tree,
+// their quaternions drawn as a free base's; masses 1e-6–1e4 kg, offsets 1e-3–10 m, rotor inertias 0–1e3, friction
 // 0–1e4, limits), a state (speeds to 1e3, joints exactly stuck or on a limit),
 // wrenches, constraints on up to three frames (random, repeated or on the base:
 // singular tasks), mimic joints (laws to any other joint: chains, cycles the
@@ -91,20 +92,28 @@ bool buildChain(FuzzedDataProvider& in, Chain& out) {
     ModelBuilder builder("fuzz", "base");
     out.frames = {"base"};
     std::vector<std::string> path{"base"};  // the link frames back to the base: where a depth-first tree may grow
+    std::vector<bool> multi_dof;            // per joint: more than one DOF (cannot mimic or be mimicked)
     for (int j = 0; j < n; ++j) {
       if (path.size() > 1 && in.ConsumeProbability<double>() < 0.3)  // a new branch off an earlier link
         path.resize(in.ConsumeIntegralInRange<std::size_t>(1, path.size() - 1));
       Joint joint;
       joint.name = "j" + std::to_string(j);
-      const int type = in.ConsumeIntegralInRange(0, 2);
-      joint.type = type == 0 ? JointType::Revolute : type == 1 ? JointType::Continuous : JointType::Prismatic;
+      // Every joint type, multi-DOF ones anywhere in the tree (a free joint mid-tree too).
+      const int type = in.ConsumeIntegralInRange(0, 5);
+      joint.type = type == 0   ? JointType::Revolute
+                   : type == 1 ? JointType::Continuous
+                   : type == 2 ? JointType::Prismatic
+                   : type == 3 ? JointType::Spherical
+                   : type == 4 ? JointType::Planar
+                               : JointType::Free;
+      multi_dof.push_back(joint.nv() > 1);
       joint.axis = direction(in);
       joint.placement = Transform::fromPose(rotation(in), logUniform(in, 1e-3, 10.0, 0.1) * direction(in));
       joint.rotor_inertia = logUniform(in, 1e-6, 1e3, 0.4);
       joint.breakaway_friction = logUniform(in, 1e-3, 1e4, 0.2);
       joint.kinetic_friction = in.ConsumeBool() ? joint.breakaway_friction : logUniform(in, 1e-3, 1e4, 0.3);
       joint.viscous_friction = logUniform(in, 1e-3, 1e3, 0.3);
-      if (joint.type != JointType::Continuous && in.ConsumeBool()) {
+      if (joint.type != JointType::Continuous && in.ConsumeBool() && joint.nv() == 1) {  // multi-DOF: no limits
         joint.lower = -logUniform(in, 1e-3, 3.0, 0.1);
         joint.upper = logUniform(in, 1e-3, 3.0, 0.1);
       }
@@ -124,6 +133,8 @@ bool buildChain(FuzzedDataProvider& in, Chain& out) {
         int leader = in.ConsumeIntegralInRange(0, n - 2);
         leader += leader >= j ? 1 : 0;  // any other joint (a mimic joint too: a chain, or a cycle)
         const double multiplier = in.ConsumeBool() ? (in.ConsumeBool() ? 1.0 : -1.0) : signedLog(in, 1e-3, 1e2);
+        // A mimic law is between one-DOF joints; the builder's refusal of the rest is test_mimic's.
+        if (multi_dof[static_cast<std::size_t>(j)] || multi_dof[static_cast<std::size_t>(leader)]) continue;
         builder.setMimic("j" + std::to_string(j), "j" + std::to_string(leader), multiplier, signedLog(in, 1e-3, 1.0));
       }
     out.model = builder.build();
@@ -299,30 +310,56 @@ struct JointStateDraw {
   double poison_value = 0.0;
 };
 
+// A quaternion (w x y z): unit (half the draws), off unit by a relative 1e-12–1e-2 either way (across
+// kQuaternionNormTolerance), zero, or as drawn (any norm up to 2).
+Eigen::Vector4d drawQuaternion(FuzzedDataProvider& in) {
+  Eigen::Vector4d quat;
+  for (int k = 0; k < 4; ++k) quat[k] = in.ConsumeFloatingPointInRange(-1.0, 1.0);
+  const int pick = in.ConsumeIntegralInRange(0, 3);
+  if (pick <= 1 && quat.norm() > 0.0) quat.normalize();
+  if (pick == 1) quat *= 1.0 + (in.ConsumeBool() ? 1.0 : -1.0) * logUniform(in, 1e-12, 1e-2);
+  if (pick == 2) quat.setZero();
+  return quat;
+}
+
 JointStateDraw drawJointState(FuzzedDataProvider& in, const Model& chain) {
-  const int n = chain.dof();
+  // `chain` has a fixed base: its q and v are the joints' alone.
   JointStateDraw d;
-  d.q.resize(n);
-  d.qd.resize(n);
-  d.tau.resize(n);
-  for (int j = 0; j < n; ++j) {
-    const Joint& joint = chain.joint(j);
-    const int pick = in.ConsumeIntegralInRange(0, 3);
-    if (pick == 0 && std::isfinite(joint.lower))
-      d.q[j] = joint.lower;
-    else if (pick == 1 && std::isfinite(joint.upper))
-      d.q[j] = joint.upper;
-    else
-      d.q[j] = in.ConsumeFloatingPointInRange(-10.0, 10.0);
-    d.qd[j] = in.ConsumeBool() ? 0.0 : signedLog(in, 1e-9, 1e3);
-    d.tau[j] = signedLog(in, 1e-3, 1e4);
+  d.q.resize(chain.nq());
+  d.qd.resize(chain.nv());
+  d.tau.resize(chain.nv());
+  for (const Joint& joint : chain.joints()) {
+    double* q = d.q.data() + joint.q_index;
+    switch (joint.type) {
+      case JointType::Spherical: d.q.segment<4>(joint.q_index) = drawQuaternion(in); break;
+      case JointType::Free:
+        for (int k = 0; k < 3; ++k) q[k] = in.ConsumeFloatingPointInRange(-10.0, 10.0);
+        d.q.segment<4>(joint.q_index + 3) = drawQuaternion(in);
+        break;
+      case JointType::Planar:
+        for (int k = 0; k < 3; ++k) q[k] = in.ConsumeFloatingPointInRange(-10.0, 10.0);
+        break;
+      default: {
+        const int pick = in.ConsumeIntegralInRange(0, 3);
+        if (pick == 0 && std::isfinite(joint.lower))
+          q[0] = joint.lower;
+        else if (pick == 1 && std::isfinite(joint.upper))
+          q[0] = joint.upper;
+        else
+          q[0] = in.ConsumeFloatingPointInRange(-10.0, 10.0);
+      }
+    }
+    for (int k = joint.v_index; k < joint.v_index + joint.nv(); ++k) {
+      d.qd[k] = in.ConsumeBool() ? 0.0 : signedLog(in, 1e-9, 1e3);
+      d.tau[k] = signedLog(in, 1e-3, 1e4);
+    }
   }
   d.follow_leaders = in.ConsumeProbability<double>() < 0.9;  // else most likely MimicMismatch
   // Occasionally a non-finite input: must come back as NonFinite, not as a crash.
   const int poison = in.ConsumeIntegralInRange(0, 40);
-  if (poison < n) {
+  d.poisoned_vector = in.ConsumeIntegralInRange(0, 2);
+  if (poison < (d.poisoned_vector == 0 ? d.q.size() : d.qd.size())) {
     d.poison = poison;
-    d.poisoned_vector = in.ConsumeIntegralInRange(0, 2);
     d.poison_value =
         in.ConsumeBool() ? std::numeric_limits<double>::quiet_NaN() : std::numeric_limits<double>::infinity();
   }
@@ -380,7 +417,9 @@ void drawContactOrJointRows(FuzzedDataProvider& in, const Model& model, int fram
     group.expressed = in.ConsumeBool() ? Expressed::Local : Expressed::World;
   } else {
     group.kind = RowGroup::Kind::Joints;
-    for (int r = 0; r < rows; ++r) group.joints.push_back(in.ConsumeIntegralInRange(0, model.dof() - 1));
+    // Joint indices (a multi-DOF joint adds one row per DOF).
+    for (int r = 0; r < rows; ++r)
+      group.joints.push_back(in.ConsumeIntegralInRange(0, static_cast<int>(model.joints().size()) - 1));
   }
   draw.groups.push_back(group);
   const Eigen::Index first = draw.targets.size();
@@ -389,21 +428,11 @@ void drawContactOrJointRows(FuzzedDataProvider& in, const Model& model, int fram
 }
 
 // The base's coordinates, velocities and generalized forces (the first
-// entries of q, qd, tau). A free base's quaternion: unit (half the draws),
-// off unit by a relative 1e-12–1e-2 either way (across
-// kQuaternionNormTolerance), or as drawn (any norm up to 2, zero included).
+// entries of q, qd, tau). A free base's quaternion as drawQuaternion draws it.
 void drawBaseState(FuzzedDataProvider& in, const Model& model, Eigen::VectorXd& q, Eigen::VectorXd& qd,
                    Eigen::VectorXd& tau) {
   for (int k = 0; k < model.baseConfigurationSize(); ++k) q[k] = signedLog(in, 1e-3, 1e2);
-  if (model.baseType() == BaseType::Free) {
-    Eigen::Vector4d quat;
-    for (int k = 0; k < 4; ++k) quat[k] = in.ConsumeFloatingPointInRange(-1.0, 1.0);
-    const int pick = in.ConsumeIntegralInRange(0, 3);
-    if (pick <= 1 && quat.norm() > 0.0) quat.normalize();
-    if (pick == 1) quat *= 1.0 + (in.ConsumeBool() ? 1.0 : -1.0) * logUniform(in, 1e-12, 1e-2);
-    if (pick == 2) quat.setZero();
-    q.segment<4>(3) = quat;
-  }
+  if (model.baseType() == BaseType::Free) q.segment<4>(3) = drawQuaternion(in);
   const bool pushed = in.ConsumeProbability<double>() < 0.3;  // usually 0: no motor at the base
   for (int k = 0; k < model.baseVelocitySize(); ++k) {
     qd[k] = signedLog(in, 1e-9, 1e3);
@@ -421,9 +450,9 @@ void assembleState(FuzzedDataProvider& in, const Model& model, const JointStateD
   qd.setZero(model.nv());
   tau.setZero(model.nv());
   const int iq = model.baseConfigurationSize(), iv = model.baseVelocitySize();
-  q.tail(model.dof()) = joints.q;
-  qd.tail(model.dof()) = joints.qd;
-  tau.tail(model.dof()) = joints.tau;
+  q.tail(joints.q.size()) = joints.q;
+  qd.tail(joints.qd.size()) = joints.qd;
+  tau.tail(joints.tau.size()) = joints.tau;
   drawBaseState(in, model, q, qd, tau);
   if (joints.follow_leaders) model.followLeaders(q, qd);
   if (joints.poison >= 0) {
@@ -488,11 +517,11 @@ void checkNormalisation(const Model& model, const Task& task, Eigen::VectorXd q,
 }  // namespace
 
 // The draws of the fixed-base chain, its task, state and options come first,
-// in the order they always had, so that the seed corpus written before the
-// floating base (and the crash input found then) means what it meant: an
-// input whose bytes run out there, or right after, is a fixed base with
-// nothing more (every later draw is 0). Then the base, a contact or joint
-// rows, and the base's state.
+// in the order they always had: an input whose bytes run out there, or right
+// after, is a fixed base with nothing more (every later draw is 0). (A joint's
+// type byte reads among six types since issue #25, so older corpus entries
+// now draw other types.) Then the base, a contact or joint rows, and the
+// base's state.
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzedDataProvider in(data, size);
   Chain chain;

@@ -51,7 +51,7 @@ void ChainSpec::check() const {
     if (!names.insert("joint:" + joint.name).second)
       throw std::invalid_argument(where + "repeated joint " + joint.name);
     if (joint.type != "revolute" && joint.type != "continuous" && joint.type != "prismatic" &&
-        joint.type != "spherical" && joint.type != "free" && joint.type != "fixed")
+        joint.type != "spherical" && joint.type != "planar" && joint.type != "free" && joint.type != "fixed")
       throw std::invalid_argument(where + "joint " + joint.name + " has unknown type '" + joint.type + "'");
     if (joint.nv() == 1 && std::abs(joint.axis.norm() - 1.0) > 1e-12)
       throw std::invalid_argument(where + "joint " + joint.name + " axis is not a unit vector");

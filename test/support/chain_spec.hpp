@@ -33,11 +33,13 @@ struct LinkSpec {
 //    child's orientation in the joint frame, v = ω in the child frame (nq = 4, nv = 3);
 //    "free": q = [p; w, x, y, z], the child origin in the joint frame and its
 //    orientation, v = [v; ω], the origin's velocity and the angular velocity,
-//    both in the child frame (nq = 7, nv = 6); neither has limits or a mimic;
+//    both in the child frame (nq = 7, nv = 6); "planar": q = [x, y, ψ], the child origin in the joint frame's
+//    xy plane and the yaw about its z, v = q̇, rates along the JOINT frame's axes (nq = nv = 3); none has
+//    limits or a mimic;
 //  - the reflected rotor inertia on the joint is rotor_inertia·gear_ratio².
 struct JointSpec {
   std::string name;
-  std::string type = "revolute";  // "revolute", "continuous", "prismatic", "spherical", "free", "fixed"
+  std::string type = "revolute";  // "revolute", "continuous", "prismatic", "spherical", "planar", "free", "fixed"
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
   Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
@@ -58,9 +60,11 @@ struct JointSpec {
   bool isPrismatic() const { return type == "prismatic"; }
   bool isSpherical() const { return type == "spherical"; }
   bool isFree() const { return type == "free"; }
-  // Entries of q and of v (q̇, τ, q̈) the joint contributes: 0 fixed, 4 and 3 spherical, 7 and 6 free, else 1.
-  int nq() const { return isFixed() ? 0 : isSpherical() ? 4 : isFree() ? 7 : 1; }
-  int nv() const { return isFixed() ? 0 : isSpherical() ? 3 : isFree() ? 6 : 1; }
+  bool isPlanar() const { return type == "planar"; }
+  // Entries of q and of v (q̇, τ, q̈) the joint contributes: 0 fixed, 4 and 3 spherical, 3 and 3 planar, 7 and 6
+  // free, else 1.
+  int nq() const { return isFixed() ? 0 : isSpherical() ? 4 : isPlanar() ? 3 : isFree() ? 7 : 1; }
+  int nv() const { return isFixed() ? 0 : isSpherical() ? 3 : isPlanar() ? 3 : isFree() ? 6 : 1; }
   bool isMimic() const { return !mimic.empty(); }
   // rotor_inertia · gear_ratio² (docs/conventions.md, "Joints, links, frames"); 0 for fixed joints.
   double reflectedInertia() const { return isFixed() ? 0.0 : rotor_inertia * gear_ratio * gear_ratio; }

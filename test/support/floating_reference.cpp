@@ -173,6 +173,7 @@ FloatingKinematics floatingKinematics(const ChainSpec& spec, const FloatingBase&
   }
 
   int dof = nb;
+  Eigen::Index qi = nqb;
   for (std::size_t k = 0; k < spec.joints.size(); ++k) {
     const JointSpec& joint = spec.joints[k];
     const auto parent = static_cast<std::size_t>(spec.parentLink(k));
@@ -183,25 +184,64 @@ FloatingKinematics floatingKinematics(const ChainSpec& spec, const FloatingBase&
     kin.J[k + 1] = kin.J[parent];
     kin.v[k + 1] = kin.v[parent];
     kin.bias[k + 1] = kin.bias[parent];
-    if (!joint.isFixed()) {
-      kin.dof_of_joint[k] = dof;
-      kin.reflected(dof) = joint.reflectedInertia();
+    if (joint.isFixed()) {
+      kin.poses[k + 1] = child;
+      continue;
+    }
+    kin.dof_of_joint[k] = dof;
+    const int nj = joint.nv();
+    kin.reflected.segment(dof, nj).setConstant(joint.reflectedInertia());  // rotor inertia on each DOF
+    // The child's pose, then the joint's columns (world Plücker at the origin) and which of them are fixed in the
+    // child (d/dt s = v_child × s) rather than in the parent (d/dt s = v_parent × s).
+    Eigen::Matrix<double, 6, Eigen::Dynamic> S(6, nj);
+    std::vector<bool> moves_with_child(static_cast<std::size_t>(nj), true);
+    const Eigen::Vector3d o = joint_frame.translation();
+    if (joint.isSpherical() || joint.isFree()) {
+      const Eigen::Index qr = joint.isFree() ? qi + 3 : qi;
+      const Eigen::Quaterniond quat(q(qr), q(qr + 1), q(qr + 2), q(qr + 3));
+      if (!(std::abs(quat.norm() - 1.0) <= 1e-6))
+        throw std::invalid_argument("floating reference: joint " + joint.name + "'s quaternion is not of unit length");
+      if (joint.isFree()) child.translate(Eigen::Vector3d(q(qi), q(qi + 1), q(qi + 2)));
+      child.rotate(quat.normalized().toRotationMatrix());
+      // v = ω (spherical) or [v; ω] (free) in the CHILD frame: the child's own unit twists, at its origin c.
+      const Eigen::Matrix3d Rc = child.linear();
+      const Eigen::Vector3d c = child.translation();
+      const int lin0 = joint.isFree() ? 3 : 0;  // first angular column
+      for (int a = 0; a < 3; ++a) {
+        if (joint.isFree()) S.col(a) = stack(Rc.col(a), Eigen::Vector3d::Zero());
+        S.col(lin0 + a) = stack(c.cross(Rc.col(a)), Rc.col(a));
+      }
+    } else if (joint.isPlanar()) {
+      // q = [x, y, ψ]: translation in the joint frame's xy plane, then yaw about its z; rates along the JOINT
+      // frame's axes, so the translations are fixed in the parent and the yaw axis (through the child origin) in
+      // the child.
+      child.translate(Eigen::Vector3d(q(qi), q(qi + 1), 0.0));
+      child.rotate(Eigen::AngleAxisd(q(qi + 2), Eigen::Vector3d::UnitZ()));
+      const Eigen::Matrix3d Rj = joint_frame.linear();
+      const Eigen::Vector3d c = child.translation();
+      S.col(0) = stack(Rj.col(0), Eigen::Vector3d::Zero());
+      S.col(1) = stack(Rj.col(1), Eigen::Vector3d::Zero());
+      S.col(2) = stack(c.cross(Rj.col(2)), Rj.col(2));
+      moves_with_child[0] = moves_with_child[1] = false;
+    } else {
       const Eigen::Vector3d u = joint_frame.linear() * joint.axis;
-      const Eigen::Vector3d o = joint_frame.translation();
-      const double qj = q(nqb + (dof - nb));
-      Vector6d s;
+      const double qj = q(qi);
       if (joint.isPrismatic()) {
-        s = stack(u, Eigen::Vector3d::Zero());
+        S.col(0) = stack(u, Eigen::Vector3d::Zero());
         child.translate(qj * joint.axis);
       } else {
-        s = stack(o.cross(u), u);
+        S.col(0) = stack(o.cross(u), u);
         child.rotate(Eigen::AngleAxisd(qj, joint.axis));
       }
-      kin.J[k + 1].col(dof) = s;
-      kin.v[k + 1] += s * v(dof);
-      kin.bias[k + 1] += motionCross(kin.v[k + 1]) * s * v(dof);
-      ++dof;
     }
+    kin.J[k + 1].middleCols(dof, nj) = S;
+    kin.v[k + 1] += S * v.segment(dof, nj);
+    for (int a = 0; a < nj; ++a) {
+      const Vector6d& moving = moves_with_child[static_cast<std::size_t>(a)] ? kin.v[k + 1] : kin.v[parent];
+      kin.bias[k + 1] += motionCross(moving) * S.col(a) * v(dof + a);
+    }
+    dof += nj;
+    qi += joint.nq();
     kin.poses[k + 1] = child;
   }
 

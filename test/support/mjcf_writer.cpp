@@ -72,6 +72,8 @@ struct Writer {
     out << indent << "<body name=\"" << xmlEscape(link.name) << "\" pos=\"" << vec(joint.xyz) << "\" quat=\""
         << quat(rpyToMatrix(joint.rpy)) << "\">\n";
     const std::string inner = indent + "  ";
+    if (joint.isPlanar())  // MJCF has no planar joint type (a slide-slide-hinge triple would be three joints)
+      throw std::invalid_argument("toMjcf('" + spec.name + "'): planar joint " + joint.name + " has no MJCF type");
     if (!joint.isFixed()) {
       const char* type = joint.isPrismatic()   ? "slide"
                          : joint.isSpherical() ? "ball"

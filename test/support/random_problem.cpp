@@ -97,6 +97,7 @@ Model modelFromSpecByBuilder(const ChainSpec& spec) {
                  : js.type == "continuous" ? JointType::Continuous
                  : js.isSpherical()        ? JointType::Spherical
                  : js.isFree()             ? JointType::Free
+                 : js.isPlanar()           ? JointType::Planar
                                            : JointType::Revolute;
     joint.axis = js.axis;
     joint.placement = placement;

@@ -196,7 +196,7 @@ enum class WarningCode {
   PlaceholderInertia,  ///< rotational inertia too small for the mass (a body denser than osmium)
   TriangleInequality,  ///< principal moments with a + b < c (no real body has them)
   PlaceholderLimits,   ///< <limit lower == upper, effort == velocity == 0>: read as "no limits"
-  /// a <limit> on a floating or planar URDF joint, ignored: a multi-DOF joint has no limits in zwang
+  /// a `<limit>` on a floating or planar URDF joint, ignored: a multi-DOF joint has no limits in zwang
   IgnoredLimits,
   MassBeyondTip,  ///< links behind a moving joint below the tip carry mass the chain ignores
   MassOffChain,   ///< links behind a moving joint off the chain (a side branch) carry mass it ignores

@@ -200,17 +200,25 @@ bool documented(StatusCode code) {
   return false;
 }
 
-// A free base's quaternion against docs/conventions.md ("Floating base"):
-// off unit length by more than kQuaternionNormTolerance ⇒ BadConfiguration,
-// within it ⇒ not; norms within rounding of the tolerance are not judged.
+// Every quaternion of the state (a spherical or free joint's, the root's
+// included) against docs/conventions.md ("Joint types"): any one off unit
+// length by more than kQuaternionNormTolerance ⇒ BadConfiguration; all within
+// it ⇒ not; norms within rounding of the tolerance are not judged.
 void checkQuaternionVerdict(const Model& model, const Eigen::VectorXd& q, StatusCode code, const char* where) {
-  if (model.baseType() != BaseType::Free || !q.allFinite()) return;
-  const double off = std::abs(q.segment<4>(3).norm() - 1.0);
+  if (!q.allFinite()) return;
   const double margin = 1e-12;  // the norm's own rounding is ~1e-16; well clear of it
-  if (off > kQuaternionNormTolerance + margin && code != StatusCode::BadConfiguration)
+  bool beyond = false, near = false;
+  for (const Joint& joint : model.allJoints()) {
+    if (joint.type != JointType::Spherical && joint.type != JointType::Free) continue;
+    const int w = joint.q_index + (joint.type == JointType::Free ? 3 : 0);
+    const double off = std::abs(q.segment<4>(w).norm() - 1.0);
+    beyond = beyond || off > kQuaternionNormTolerance + margin;
+    near = near || off >= kQuaternionNormTolerance - margin;
+  }
+  if (beyond && code != StatusCode::BadConfiguration)
     fuzz::failure("a quaternion off unit length beyond the tolerance was not refused", where);
-  if (off < kQuaternionNormTolerance - margin && code == StatusCode::BadConfiguration)
-    fuzz::failure("BadConfiguration for a quaternion within the tolerance", where);
+  if (!near && code == StatusCode::BadConfiguration)
+    fuzz::failure("BadConfiguration for quaternions within the tolerance", where);
 }
 
 // The task as drawn, so that it can be made for the model it is solved on:
@@ -498,13 +506,16 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
   }
 }
 
-// A free base's quaternion refused: normalizeConfiguration must fix any
-// finite non-zero one (docs/conventions.md), and the solve then take it.
+// Quaternions refused: normalizeConfiguration must fix any finite non-zero
+// ones, every joint's (docs/conventions.md), and the solve then take them.
 void checkNormalisation(const Model& model, const Task& task, Eigen::VectorXd q, const Eigen::VectorXd& qd,
                         const Eigen::VectorXd& tau, Workspace& ws) {
-  if (model.baseType() != BaseType::Free || !q.allFinite()) return;
+  if (model.nq() == model.nv() || !q.allFinite()) return;  // no quaternion
+  bool zero = false;
+  for (const Joint& joint : model.allJoints())
+    if (joint.type == JointType::Spherical || joint.type == JointType::Free)
+      zero = zero || q.segment<4>(joint.q_index + (joint.type == JointType::Free ? 3 : 0)).squaredNorm() == 0.0;
   const Status normalised = normalizeConfiguration(model, q);
-  const bool zero = q.segment<4>(3).squaredNorm() == 0.0;
   if (normalised.ok() == zero)
     fuzz::failure("normalizeConfiguration: Ok exactly when the quaternion is non-zero", normalised.message);
   if (!normalised.ok()) return;

@@ -1,8 +1,12 @@
 #!/usr/bin/env python3
-"""Two builds of zwang_bench in the same run: each benchmark's median CPU time
-over `--rounds` alternating runs of the two binaries, and the ratio new/old.
+"""Two builds of zwang_bench in the same run: each benchmark's median (or
+minimum) CPU time over `--rounds` alternating runs of the two binaries, and the
+ratio new/old.
 
-  python3 bench/compare.py OLD/zwang_bench NEW/zwang_bench --filter 'REGEX' [--rounds 5] [--min-time 0.1]
+  python3 bench/compare.py OLD/zwang_bench NEW/zwang_bench --filter 'REGEX' [--rounds 5] [--min-time 0.1] [--stat min]
+
+On a shared machine whose load comes and goes, the minimum over many rounds
+is the steadier measure of what the code costs (a neighbour only ever adds).
 
 Build the old one from the commit to compare against (e.g. a clone at that
 commit: cmake -DZWANG_BUILD_BENCHMARKS=ON, target zwang_bench). Alternating
@@ -27,17 +31,20 @@ def main():
     parser.add_argument("--filter", default=".")
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--min-time", type=float, default=0.1)
+    parser.add_argument("--stat", choices=("median", "min"), default="median")
     a = parser.parse_args()
     times = {"old": {}, "new": {}}
     for _ in range(a.rounds):
         for side, binary in (("old", a.old), ("new", a.new)):
             for name, t in run(binary, a.filter, a.min_time).items():
                 times[side].setdefault(name, []).append(t)
+    stat = statistics.median if a.stat == "median" else min
+    print(f"{a.stat} CPU time over {a.rounds} rounds of {a.min_time} s\n")
     print(f"| benchmark | old [µs] | new [µs] | new/old |\n|---|---|---|---|")
     for name in times["new"]:
         if name not in times["old"]:
             continue
-        old, new = statistics.median(times["old"][name]) / 1e3, statistics.median(times["new"][name]) / 1e3
+        old, new = stat(times["old"][name]) / 1e3, stat(times["new"][name]) / 1e3
         print(f"| {name} | {old:.3f} | {new:.3f} | {new / old:.3f} |")
 
 

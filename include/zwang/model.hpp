@@ -150,7 +150,7 @@ struct Joint {
   Transform transform(const double* q) const;
 };
 
-inline Transform Joint::transform(double q) const {
+ZWANG_ALWAYS_INLINE Transform Joint::transform(double q) const {
   // X_J(q): the child frame is the joint frame rotated by q about (or shifted by
   // q along) the axis; then ʲX_parent = X_J · X_T with X_T = placement.
   if (type == JointType::Prismatic) return {placement.E, placement.r + placement.E.transpose() * (q * axis)};

@@ -14,6 +14,7 @@ namespace zwang::internal {
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
 
 inline Status checkVector(const char* name, const VectorRef& x, int expected) {
+  if (x.size() == expected && x.allFinite()) return {};  // the usual case: one vectorised pass
   if (x.size() != expected)
     return Status::error(StatusCode::SizeMismatch, "%s has %ld entries, the model has %d joints", name,
                          static_cast<long>(x.size()), expected);

@@ -9,24 +9,19 @@
 
 namespace zwang {
 
-Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q_all,
-                       const Eigen::Ref<const Eigen::VectorXd>& qd_all,
-                       const Eigen::Ref<const Eigen::VectorXd>& qdd_all, Workspace& ws) noexcept {
-  ws.kinematics.stage = KinematicsStage::None;  // until the outward stage computes them
-  if (ws.dof() != model.dof() || task.modelDof() != model.dof())
-    return Status::error(StatusCode::ModelMismatch, "workspace or task was made for another model");
-  if (!internal::workspaceFitsModel(model, ws)) return internal::workspaceMismatch(model, ws);
-  if (Status s = internal::checkStateConfiguration(model, q_all); !s) return s;  // quaternions too
-  if (Status s = internal::checkVelocityVector(model, "qd", qd_all); !s) return s;
-  if (Status s = internal::checkVelocityVector(model, "qdd", qdd_all); !s) return s;
-  if (Status s = internal::checkFinite("gravity", task.gravity); !s) return s;
+namespace {
+
+// The two sweeps of RNEA, after the checks.
+ZWANG_FLATTEN void recursiveNewtonEuler(const Model& model, const Task& task,
+                                        const Eigen::Ref<const Eigen::VectorXd>& q_all,
+                                        const Eigen::Ref<const Eigen::VectorXd>& qd_all,
+                                        const Eigen::Ref<const Eigen::VectorXd>& qdd, Workspace& ws) {
   const int N = model.nv();
-  const auto& qdd = qdd_all;
   Eigen::VectorXd& tau = ws.tau;
   const std::vector<Dof>& dofs = model.dofs();
   auto at = [](int i) { return static_cast<std::size_t>(i); };
 
-  // Outward: poses, velocities, accelerations. In base coordinates
+  // Outward: poses, velocities, bias forces, accelerations. In base coordinates
   // (src/dynamics/sweeps.hpp): no transforms between bodies. Gravity is the
   // world's acceleration [−g; 0].
   internal::outwardKinematics(model, q_all, qd_all, ws, true);
@@ -40,7 +35,6 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
     const Vec6 a = (p == i - 1 ? a_previous : ws.a[at(p)]) + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
     ws.a[at(i)] = a;
     a_previous = a;
-    ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);
   }
   ws.kinematics = {KinematicsStage::Accelerations, &model};
   internal::applyExternalWrenches(model, task, ws);
@@ -60,6 +54,22 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
     else if (p > 0)
       ws.f[at(p)] += f;
   }
+}
+
+}  // namespace
+
+Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q_all,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd_all,
+                       const Eigen::Ref<const Eigen::VectorXd>& qdd_all, Workspace& ws) noexcept {
+  ws.kinematics.stage = KinematicsStage::None;  // until the outward stage computes them
+  if (ws.dof() != model.dof() || task.modelDof() != model.dof())
+    return Status::error(StatusCode::ModelMismatch, "workspace or task was made for another model");
+  if (!internal::workspaceFitsModel(model, ws)) return internal::workspaceMismatch(model, ws);
+  if (Status s = internal::checkStateConfiguration(model, q_all); !s) return s;  // quaternions too
+  if (Status s = internal::checkVelocityVector(model, "qd", qd_all); !s) return s;
+  if (Status s = internal::checkVelocityVector(model, "qdd", qdd_all); !s) return s;
+  if (Status s = internal::checkFinite("gravity", task.gravity); !s) return s;
+  recursiveNewtonEuler(model, task, q_all, qd_all, qdd_all, ws);
   return {};
 }
 
@@ -76,15 +86,15 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
 
   // Inward: composite inertias, and row i of H from F_i = I^c_i S_i.
   for (int i = 1; i <= N; ++i) ws.Ic[at(i)] = ws.I[at(i)].matrix();
+  // H_ij ≠ 0 only for the DOFs j supporting i (its ancestors); the rest stays
+  // zero: the tree's sparsity, zero blocks between branches.
+  ws.H.setZero();
   for (int i = N; i >= 1; --i) {
     const int p = model.parent(i);
     if (p > 0) ws.Ic[at(p)] += ws.Ic[at(i)];  // base coordinates: composite inertias add
     const Vec6 F = ws.Ic[at(i)] * ws.S[at(i)];
     const int row = i - 1;
     ws.H(row, row) = ws.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
-    // H_ij ≠ 0 only for the DOFs j supporting i (its ancestors); the rest of
-    // row i stays zero: the tree's sparsity, zero blocks between branches.
-    for (int j = i - 1; j >= 1; --j) ws.H(row, j - 1) = ws.H(j - 1, row) = 0.0;
     for (int j = p; j >= 1; j = model.parent(j)) ws.H(row, j - 1) = ws.H(j - 1, row) = ws.S[at(j)].dot(F);
   }
 }

@@ -8,11 +8,11 @@ namespace internal {
 
 namespace {
 
-// A one-DOF joint (most joints, so the hot path): its body's pose, S, inertia,
-// velocity and bias in one step.
-void oneDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
-                      const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia,
-                      bool with_velocity) {
+// A one-DOF joint (most joints, so the hot path): its body's pose, S,
+// inertia, velocity, bias acceleration and bias force in one step.
+template <bool kInertia, bool kVelocity>
+ZWANG_FLATTEN void oneDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                    const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
   const int i = joint.v_index + 1;
   const auto b = static_cast<std::size_t>(i);
   const auto p = static_cast<std::size_t>(model.parent(i));
@@ -20,31 +20,41 @@ void oneDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<c
   // S_i in base coordinates: [p × a; a] (revolute) or [a; 0] (prismatic),
   // a = ᵂR_i axis, p the body origin.
   const Vec3 a = X.E.transpose() * joint.axis;
-  if (joint.isRevolute())
-    ws.S[b] << X.r.cross(a), a;
-  else
-    ws.S[b] << a, Vec3::Zero();
-  if (with_inertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
-  if (with_velocity) {
-    const Vec6 vJ = ws.S[b] * qd[i - 1];
-    ws.v[b] = ws.v[p] + vJ;                       // line 5
-    ws.c[b] = spatial::crossMotion(ws.v[b], vJ);  // line 6: Ṡ_i q̇_i = Ẋ_i × S_i q̇_i
+  Vec6& S = ws.S[b];
+  S.head<3>() = joint.isRevolute() ? Vec3(X.r.cross(a)) : a;
+  S.tail<3>() = joint.isRevolute() ? a : Vec3::Zero();
+  if (kInertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
+  if (kVelocity) {
+    const Vec6 vJ = S * qd[i - 1];
+    const Vec6 v = ws.v[b] = ws.v[p] + vJ;                            // line 5
+    ws.c[b] = spatial::crossMotion(v, vJ);                            // line 6: Ṡ_i q̇_i = Ẋ_i × S_i q̇_i
+    if (kInertia) ws.Fbias[b] = spatial::crossForce(v, ws.I[b] * v);  // line 7, without F_ext
   } else {
     ws.v[b].setZero();
     ws.c[b].setZero();
+    ws.Fbias[b].setZero();
   }
 }
 
 // A joint of several DOFs: its nv bodies share the child's pose; body k + 1
-// takes DOF k's axis, the last the child's inertia and the joint's bias.
-void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
-                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia,
-                        bool with_velocity) {
+// takes DOF k's axis, the last the child's inertia and the joint's bias; the
+// others carry nothing (no inertia, so no bias force either).
+template <bool kInertia, bool kVelocity>
+ZWANG_FLATTEN void multiDofKinematics(const Model& model, const Joint& joint,
+                                      const Eigen::Ref<const Eigen::VectorXd>& q,
+                                      const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
   const std::vector<Dof>& dofs = model.dofs();
   const int first = joint.v_index + 1, last = joint.v_index + joint.nv();
   const auto p = static_cast<std::size_t>(model.parent(first));
   const Transform X = joint.transform(q.data() + joint.q_index) * ws.Xworld[p];  // line 4: ⁱX₀
-  const Transform X_joint_frame = joint.placement * ws.Xworld[p];
+  // The joint frame's axes in the world, for DOFs whose axis is fixed there
+  // (a planar joint's x and y); the others' axes turn with the child.
+  bool any_in_joint_frame = false;
+  for (int i = first; i <= last; ++i) any_in_joint_frame |= dofs[static_cast<std::size_t>(i - 1)].in_joint_frame;
+  const Mat3 Et_joint_frame =
+      any_in_joint_frame ? Mat3(ws.Xworld[p].E.transpose() * joint.placement.E.transpose()) : Mat3::Zero();
+  const Mat3 Et_child = X.E.transpose();
+  Vec6 v = ws.v[p];
   Vec6 vJ_child = Vec6::Zero(), vJ_joint_frame = Vec6::Zero();  // S q̇ by the frame its axes are fixed in
   for (int i = first; i <= last; ++i) {
     const auto b = static_cast<std::size_t>(i);
@@ -52,27 +62,43 @@ void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref
     ws.Xworld[b] = X;
     // S_i in base coordinates: [p × a; a] (a rotation) or [a; 0] (a
     // translation), a = ᵂR axis, p the body origin.
-    const Vec3 a = (dof.in_joint_frame ? X_joint_frame.E : X.E).transpose() * dof.axis;
-    if (dof.rotation)
-      ws.S[b] << X.r.cross(a), a;
-    else
-      ws.S[b] << a, Vec3::Zero();
-    if (with_inertia) ws.I[b] = i == last ? spatial::inverseTransformInertia(X, model.inertia(i)) : RigidInertia{};
+    const Vec3 a = (dof.in_joint_frame ? Et_joint_frame : Et_child) * dof.axis;
+    Vec6& S = ws.S[b];
+    S.head<3>() = dof.rotation ? Vec3(X.r.cross(a)) : a;
+    S.tail<3>() = dof.rotation ? a : Vec3::Zero();
     ws.c[b].setZero();
-    if (with_velocity) {
-      const Vec6 vJ = ws.S[b] * qd[i - 1];
-      ws.v[b] = ws.v[static_cast<std::size_t>(model.parent(i))] + vJ;  // line 5
+    ws.Fbias[b].setZero();
+    if (kInertia && i < last) ws.I[b] = RigidInertia{};
+    if (kVelocity) {
+      const Vec6 vJ = S * qd[i - 1];
+      ws.v[b] = v += vJ;  // line 5
       (dof.in_joint_frame ? vJ_joint_frame : vJ_child) += vJ;
     } else {
       ws.v[b].setZero();
     }
   }
+  const auto b = static_cast<std::size_t>(last);
+  if (kInertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(last));
   // Line 6 on the joint's last body: Ẍ_bias = Ṡ q̇, where an axis fixed in a
   // body moving with Ẋ turns as Ṡ = Ẋ × S (the child's for most, the
-  // parent's for a planar joint's x and y).
-  if (with_velocity) {
-    const auto b = static_cast<std::size_t>(last);
-    ws.c[b] = spatial::crossMotion(ws.v[b], vJ_child) + spatial::crossMotion(ws.v[p], vJ_joint_frame);
+  // parent's for a planar joint's x and y); line 7 there.
+  if (kVelocity) {
+    ws.c[b] = spatial::crossMotion(v, vJ_child);
+    if (any_in_joint_frame) ws.c[b] += spatial::crossMotion(ws.v[p], vJ_joint_frame);
+    if (kInertia) ws.Fbias[b] = spatial::crossForce(v, ws.I[b] * v);
+  }
+}
+
+// Joint by joint: the one place a joint's type matters (its transform and
+// its DOFs' axes); every other stage visits DOFs.
+template <bool kInertia, bool kVelocity>
+void kinematicsOfJoints(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
+  for (const Joint& joint : model.allJoints()) {
+    if (joint.nv() == 1)
+      oneDofKinematics<kInertia, kVelocity>(model, joint, q, qd, ws);
+    else
+      multiDofKinematics<kInertia, kVelocity>(model, joint, q, qd, ws);
   }
 }
 
@@ -80,15 +106,13 @@ void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref
 
 void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia) {
-  // Joint by joint: the one place a joint's type matters (its transform and
-  // its DOFs' axes); every other stage visits DOFs.
   const bool with_velocity = qd.size() == model.nv();
-  for (const Joint& joint : model.allJoints()) {
-    if (joint.nv() == 1)
-      oneDofKinematics(model, joint, q, qd, ws, with_inertia, with_velocity);
-    else
-      multiDofKinematics(model, joint, q, qd, ws, with_inertia, with_velocity);
-  }
+  if (with_inertia)
+    with_velocity ? kinematicsOfJoints<true, true>(model, q, qd, ws)
+                  : kinematicsOfJoints<true, false>(model, q, qd, ws);
+  else
+    with_velocity ? kinematicsOfJoints<false, true>(model, q, qd, ws)
+                  : kinematicsOfJoints<false, false>(model, q, qd, ws);
 }
 
 void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws) {

@@ -234,11 +234,9 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
 
 void outwardSweep(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd, Workspace& ws) {
   const bool moving = qd.size() == model.nv();
-  outwardKinematics(model, q, qd, ws, true);  // lines 3–6
+  outwardKinematics(model, q, qd, ws, true);  // lines 3–7, line 7 without F_ext
   ws.kinematics = {moving ? KinematicsStage::Velocities : KinematicsStage::Poses, &model};
-  for (int i = 1; i <= model.nv(); ++i)
-    ws.Fbias[at(i)] = spatial::crossForce(ws.v[at(i)], ws.I[at(i)] * ws.v[at(i)]);  // line 7, without F_ext
-  applyExternalWrenches(model, task, ws);                                           // line 7: − F_ext
+  applyExternalWrenches(model, task, ws);  // line 7: − F_ext
   // Lines 8–9 (I^A_i = I_i, F^A_i = F_bias,i) are folded into the inward
   // sweep, which sets each body's articulated quantities as it reaches them.
   constraintsInBodyForm(model, task, ws);
@@ -499,12 +497,13 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
     const Vec6& IAS = ws.IAS[at(i)];
     const double inverse_D = ws.inverse_D[at(i)];
     const int first = task.firstColumn(i), ki = task.activeColumns(i);
+    const bool to_world = model.parent(i) == 0;  // the world takes δF^a and does nothing with it
     for (Eigen::Index c = c_begin; c < c_end; ++c) {
       const double du_ic = (bodyOfDof(dofs[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
       du(i, c) = du_ic;
       const double du_D = du_ic * inverse_D;
       for (int r = first; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
-      dF.col(c) += IAS * du_D;                                          // lines 17–18
+      if (!to_world) dF.col(c) += IAS * du_D;                           // lines 17–18
     }
   }
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the

@@ -11,12 +11,22 @@
 
 #include "zwang/workspace.hpp"
 
+// On a per-body step: every call inside it inlined. The compiler's size
+// limits otherwise leave Eigen's small fixed-size kernels (a 6-vector sum, a
+// 3-vector cross product) as calls in the loops.
+#if defined(__GNUC__) || defined(__clang__)
+#define ZWANG_FLATTEN __attribute__((flatten))
+#else
+#define ZWANG_FLATTEN
+#endif
+
 namespace zwang::internal {
 
-// Outward sweep (Algorithm 1, lines 3–6, in base coordinates): poses ⁱX₀,
+// Outward sweep (Algorithm 1, lines 3–7, in base coordinates): poses ⁱX₀,
 // motion subspaces S_i, velocities Ẋ_i = Ẋ_{i−1} + S_i q̇_i, velocity-product
 // accelerations Ẍ_bias,i = Ẋ_i × S_i q̇_i, and, when `with_inertia`, the body
-// inertias I_i. q̇ may be zero-length to skip velocities.
+// inertias I_i and bias forces F_bias,i = Ẋ_i ×* I_i Ẋ_i (line 7 without
+// F_ext). q̇ may be zero-length to skip velocities (Ẋ, Ẍ_bias, F_bias zero).
 void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia);
 

@@ -133,6 +133,7 @@ Status checkConfigurationSize(const Model& model, const char* what, Eigen::Index
 
 Status checkVelocity(const Model& model, const char* what, const ConstVector& v) {
   if (v.size() != model.nv()) return sizeMismatch(model, what, v.size(), true);
+  if (v.allFinite()) return {};  // the usual case: one vectorised pass
   for (Eigen::Index k = 0; k < v.size(); ++k)
     if (!std::isfinite(v[k]))
       return Status::error(StatusCode::NonFinite, "%s[%ld] (%s) is %g (not finite)", what, static_cast<long>(k),
@@ -393,7 +394,8 @@ QuaternionName quaternionName(const Model& model, const Joint& joint) {
 // checkConfiguration with the input's name in the messages ("q", "q0", …).
 Status checkConfigurationNamed(const Model& model, const char* what, const ConstVector& q) {
   if (Status s = checkConfigurationSize(model, what, q.size()); !s) return s;
-  for (Eigen::Index k = 0; k < q.size(); ++k)
+  const bool finite = q.allFinite();  // the usual case: one vectorised pass; the loop names the entry
+  for (Eigen::Index k = 0; !finite && k < q.size(); ++k)
     if (!std::isfinite(q[k]))
       return Status::error(StatusCode::NonFinite, "%s[%ld] (%s) is %g (not finite)", what, static_cast<long>(k),
                            configurationEntry(model, k).text, q[k]);

@@ -31,7 +31,7 @@ struct RigidInertia {
   }
 
   /// I m for a motion vector m: its momentum (a force vector).
-  Vec6 operator*(const Vec6& m) const {
+  ZWANG_ALWAYS_INLINE Vec6 operator*(const Vec6& m) const {
     const Vec3 v = lin(m), w = ang(m);
     return stack(mass * v - h.cross(w), h.cross(v) + Ibar * w);
   }

@@ -35,7 +35,9 @@ struct Transform {
   const Vec3& originOfTarget() const { return r; }
 
   /// ᶜX_A = ᶜX_B · ᴮX_A  (this = ᶜX_B, rhs = ᴮX_A)
-  Transform operator*(const Transform& rhs) const { return {E * rhs.E, rhs.r + rhs.E.transpose() * r}; }
+  ZWANG_ALWAYS_INLINE Transform operator*(const Transform& rhs) const {
+    return {E * rhs.E, rhs.r + rhs.E.transpose() * r};
+  }
 
   /// ᴬX_B
   Transform inverse() const { return {E.transpose(), -(E * r)}; }

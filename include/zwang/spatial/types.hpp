@@ -7,6 +7,14 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross products
 
+/// Inline even where the compiler's size heuristics would not: the small
+/// spatial operations of the sweeps (a call costs more than their body).
+#if defined(__GNUC__) || defined(__clang__)
+#define ZWANG_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define ZWANG_ALWAYS_INLINE inline
+#endif
+
 namespace zwang {
 
 using Vec3 = Eigen::Vector3d;              ///< 3-vector: a position, or the linear or angular part of a spatial vector.
@@ -25,19 +33,20 @@ namespace spatial {
 
 /// The linear (first three) and angular (last three) parts of a spatial vector.
 template <class V>
-inline auto lin(V&& x) {
+ZWANG_ALWAYS_INLINE auto lin(V&& x) {
   return x.template head<3>();
 }
 /// The angular part (last three) of a spatial vector.
 template <class V>
-inline auto ang(V&& x) {
+ZWANG_ALWAYS_INLINE auto ang(V&& x) {
   return x.template tail<3>();
 }
 
 /// The spatial vector [linear; angular].
-inline Vec6 stack(const Vec3& linear, const Vec3& angular) {
+ZWANG_ALWAYS_INLINE Vec6 stack(const Vec3& linear, const Vec3& angular) {
   Vec6 out;
-  out << linear, angular;
+  out.head<3>() = linear;
+  out.tail<3>() = angular;
   return out;
 }
 

@@ -11,7 +11,7 @@ namespace {
 // A one-DOF joint (most joints, so the hot path): its body's pose, S,
 // inertia, velocity, bias acceleration and bias force in one step.
 template <bool kInertia, bool kVelocity>
-ZWANG_FLATTEN void oneDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
+ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
                                     const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
   const int i = joint.v_index + 1;
   const auto b = static_cast<std::size_t>(i);
@@ -92,7 +92,7 @@ ZWANG_FLATTEN void multiDofKinematics(const Model& model, const Joint& joint,
 // Joint by joint: the one place a joint's type matters (its transform and
 // its DOFs' axes); every other stage visits DOFs.
 template <bool kInertia, bool kVelocity>
-void kinematicsOfJoints(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+ZWANG_FLATTEN void kinematicsOfJoints(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                         const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
   for (const Joint& joint : model.allJoints()) {
     if (joint.nv() == 1)

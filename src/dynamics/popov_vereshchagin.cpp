@@ -387,12 +387,17 @@ void balance(const Task& task, Workspace& ws) {
 
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
   ws.a_world = ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  // Each body's q̈ waits on its parent's Ẍ: that chain sets the time. So the
+  // parent's Ẍ comes from a register when it is the body before (a chain, a
+  // joint's DOFs), and line 28 multiplies by the 1/D the inward sweep formed.
+  Vec6 a_previous = ws.a[0];
   for (int i = 1; i <= model.nv(); ++i) {
-    const Vec6& a_parent = ws.a[at(model.parent(i))];
+    const int p = model.parent(i);
+    const Vec6 a_parent = p == i - 1 ? a_previous : ws.a[at(p)];
     const int first = task.firstColumn(i), k = task.activeColumns(i) - first;
-    const double constraint = ws.SA.col(i).segment(first, k).dot(ws.nu.segment(first, k));  // Sᵀ A_i ν
-    qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(a_parent) + constraint) / ws.D[at(i)];    // line 28
-    ws.a[at(i)] = a_parent + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                        // line 29
+    const double constraint = ws.SA.col(i).segment(first, k).dot(ws.nu.segment(first, k));        // Sᵀ A_i ν
+    qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(a_parent) + constraint) * ws.inverse_D[at(i)];  // line 28
+    a_previous = ws.a[at(i)] = a_parent + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                 // line 29
   }
 }
 

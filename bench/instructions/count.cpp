@@ -1,0 +1,104 @@
+// Instructions per call of the solvers on the robots of models/ (callgrind:
+// the instrumentation is on only around 100 calls of each case, one dump per
+// case, named by it). Counts are the same on a busy machine as on a quiet
+// one, so two builds can be compared where timings are too noisy; they are
+// instructions, not time (a long dependency chain or a cache miss counts as
+// one). Uses only the public API, so the same file builds against any commit.
+// Built and run by bench/instructions/compare.sh, not by CMake.
+#include <valgrind/callgrind.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "zwang/zwang.hpp"
+
+namespace {
+
+using namespace zwang;
+
+constexpr int kCalls = 100;
+
+template <class Call>
+void count(const std::string& name, Call call) {
+  call();  // warm: the first call may touch memory the others find in cache
+  CALLGRIND_ZERO_STATS;
+  CALLGRIND_START_INSTRUMENTATION;
+  for (int k = 0; k < kCalls; ++k) call();
+  CALLGRIND_STOP_INSTRUMENTATION;
+  CALLGRIND_DUMP_STATS_AT(name.c_str());
+}
+
+// A moving state: every joint off zero, turning, driven; a free base upright and moving.
+struct State {
+  Eigen::VectorXd q, qd, tau;
+};
+State movingState(const Model& m) {
+  State s{Eigen::VectorXd::Zero(m.nq()), Eigen::VectorXd::Zero(m.nv()), Eigen::VectorXd::Zero(m.nv())};
+  const int base_q = m.nq() - m.dof(), base_v = m.nv() - m.dof();
+  if (base_q == 7) s.q[3] = 1.0;  // quaternion w
+  for (int j = 0; j < m.dof(); ++j) {
+    s.q[base_q + j] = 0.3 + 0.05 * j;
+    s.qd[base_v + j] = 0.5 - 0.07 * j;
+    s.tau[base_v + j] = 0.2 * j;
+  }
+  for (int k = 0; k < base_v; ++k) s.qd[k] = 0.1 * (k + 1);
+  return s;
+}
+
+struct Case {
+  std::string name;
+  const Model* model;
+  std::vector<std::pair<std::string, int>> rows;  // frame, rows (world axes): held still
+  bool contacts;
+};
+
+void countCase(const Case& c) {
+  const Model& m = *c.model;
+  const State s = movingState(m);
+  Task task(m);
+  for (const auto& [frame, rows] : c.rows) {
+    const ConstraintMatrix A = ConstraintMatrix::Identity(6, 6).leftCols(rows);
+    if (c.contacts)
+      task.addContact(frame, A, Expressed::World);
+    else
+      task.addConstraint(frame, A, Expressed::World);
+  }
+  Workspace ws(m, task);
+  count(c.name + "_hd", [&] { (void)solveHybridDynamics(m, task, s.q, s.qd, s.tau, ws); });
+  const Eigen::VectorXd at_rest = Eigen::VectorXd::Zero(m.nv());  // every joint with friction stuck
+  const FrictionOptions options;
+  count(c.name + "_fric", [&] { (void)solveWithFriction(m, task, s.q, at_rest, s.tau, ws, options); });
+  if (!c.rows.empty()) return;
+  const Eigen::VectorXd qdd = Eigen::VectorXd::Constant(m.nv(), 0.3);
+  count(c.name + "_rnea", [&] { (void)inverseDynamics(m, task, s.q, s.qd, qdd, ws); });
+  count(c.name + "_crba", [&] { (void)jointSpaceInertia(m, s.q, ws); });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s MODELS_DIR (under valgrind --tool=callgrind --instr-atstart=no)\n", argv[0]);
+    return 2;
+  }
+  const std::string dir = std::string(argv[1]) + "/";
+  UrdfOptions free_base;
+  free_base.base = BaseType::Free;
+  const Model panda = loadUrdfFile(dir + "panda.urdf");
+  const Model dual = loadUrdfFile(dir + "dual_panda.urdf");
+  const Model humanoid = loadUrdfFile(dir + "simple_humanoid.urdf", free_base);
+  const Model solo = loadUrdfFile(dir + "solo12.urdf", free_base);
+  const std::string tip = panda.frames().back().name;
+  const std::vector<Case> cases = {
+      {"panda_m0", &panda, {}, false},
+      {"panda_m6", &panda, {{tip, 6}}, false},
+      {"dual_panda_m0", &dual, {}, false},
+      {"humanoid_m0", &humanoid, {}, true},
+      {"humanoid_m12", &humanoid, {{"r_ankle", 6}, {"l_ankle", 6}}, true},
+      {"solo12_m0", &solo, {}, true},
+      {"solo12_m12", &solo, {{"FL_FOOT", 3}, {"FR_FOOT", 3}, {"HL_FOOT", 3}, {"HR_FOOT", 3}}, true},
+  };
+  for (const Case& c : cases) countCase(c);
+  return 0;
+}

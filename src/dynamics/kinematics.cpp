@@ -11,8 +11,9 @@ namespace {
 // A one-DOF joint (most joints, so the hot path): its body's pose, S,
 // inertia, velocity, bias acceleration and bias force in one step.
 template <bool kInertia, bool kVelocity>
-ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
-                                    const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
+ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint,
+                                          const Eigen::Ref<const Eigen::VectorXd>& q,
+                                          const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
   const int i = joint.v_index + 1;
   const auto b = static_cast<std::size_t>(i);
   const auto p = static_cast<std::size_t>(model.parent(i));
@@ -93,7 +94,7 @@ ZWANG_FLATTEN void multiDofKinematics(const Model& model, const Joint& joint,
 // its DOFs' axes); every other stage visits DOFs.
 template <bool kInertia, bool kVelocity>
 ZWANG_FLATTEN void kinematicsOfJoints(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
-                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
+                                      const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
   for (const Joint& joint : model.allJoints()) {
     if (joint.nv() == 1)
       oneDofKinematics<kInertia, kVelocity>(model, joint, q, qd, ws);

@@ -28,9 +28,12 @@
 //    is nv steps of the sweeps, its first nv − 1 bodies without inertia. Each
 //    step is the report's one-DOF step, and together they are the block step
 //    with the joint's nv × nv D_i and nv-vector u_i: the pivots D of the steps
-//    are the LDLᵀ factor of that D. A floating base is the root's joint (free
-//    or planar), visited like any other; body 0 is the world. Entry k of q̇,
-//    τ and q̈ belongs to body k + 1.
+//    are the LDLᵀ factor of that D. The inward sweep forms them in block form
+//    (jointPivots: each pivot waits on a 6-vector update, not on a 6 × 6 downdate of
+//    I^A) and passes I^a to the parent once per joint; the other passes go
+//    DOF by DOF (docs/solver.md, "What the DOF steps cost"). A floating base
+//    is the root's joint (free or planar), visited like any other; body 0 is
+//    the world. Entry k of q̇, τ and q̈ belongs to body k + 1.
 #include "dynamics/popov_vereshchagin.hpp"
 
 #include "zwang/configuration.hpp"
@@ -242,72 +245,126 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
   constraintsInBodyForm(model, task, ws);
 }
 
+namespace {
+
+// Lines 19–21 for DOF body i, one constraint column of its subtree at a time:
+// (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle) and A_parent = P^A A_i (line 19).
+inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace& ws) {
+  ConstraintMatrix& A = ws.Ahat;
+  const Vec6& S = ws.S[at(i)];
+  const Vec6& IAS = ws.IAS[at(i)];
+  const Vec6& c = ws.c[at(i)];
+  const double inverse_D = ws.inverse_D[at(i)];
+  const int first = task.firstColumn(i), k = task.activeColumns(i);
+  double* sA = ws.SA.col(i).data();
+  const double SS_D = S.squaredNorm() * inverse_D;
+  for (int col = first; col < k; ++col) {
+    sA[col] = S.dot(A.col(col));                         // (Sᵀ A_i)ᵀ
+    ws.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
+  }
+  for (int col = first; col < k; ++col) {
+    const double sA_D = sA[col] * inverse_D;
+    ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
+    double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
+    for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
+    A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
+  }
+}
+
+// Line 13's D and 1/D of DOF body i from its I^A S, or Degenerate.
+inline Status pivot(const Dof& dof, int i, Workspace& ws) {
+  const double D = dof.rotor_inertia + ws.S[at(i)].dot(ws.IAS[at(i)]);  // line 13
+  ws.D[at(i)] = D;
+  if (!(D > 1e-300))
+    return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)", dof.name.c_str(),
+                         D);
+  ws.inverse_D[at(i)] = 1.0 / D;  // one division per DOF; the rest multiply
+  return {};
+}
+
+// Lines 16–18: the parent p gets I^a = I^A − Σ I^A S D⁻¹ Sᵀ I^A over the
+// joint's DOF bodies [first, last] and F^a = p^A + Σ I^A S D⁻¹ u. The first
+// child to arrive (the last in depth-first order: its subtree ends where p's
+// does) starts p's sums from I_p and F_bias,p.
+inline void passToParent(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA, Workspace& ws) {
+  const int p = model.parent(first);
+  if (p == 0) return;  // the world takes nothing
+  Mat6& IA_parent = ws.IA[at(p)];
+  Vec6& FA_parent = ws.FA[at(p)];
+  const Vec6& IAS = ws.IAS[at(last)];
+  const Vec6 IAS_D = IAS * ws.inverse_D[at(last)];
+  if (model.subtreeEnd(last) == model.subtreeEnd(p)) {
+    IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
+    ws.I[at(p)].addTo(IA_parent);
+    FA_parent = ws.Fbias[at(p)] + pA + IAS_D * ws.u[at(last)];
+  } else {
+    IA_parent.noalias() += IA - IAS.lazyProduct(IAS_D.transpose());
+    FA_parent += pA + IAS_D * ws.u[at(last)];
+  }
+  for (int k = first; k < last; ++k) {  // a multi-DOF joint's other DOFs
+    const Vec6 IAS_k_D = ws.IAS[at(k)] * ws.inverse_D[at(k)];
+    IA_parent.noalias() -= ws.IAS[at(k)].lazyProduct(IAS_k_D.transpose());
+    FA_parent += IAS_k_D * ws.u[at(k)];
+  }
+}
+
+// Lines 13–15 for a joint of nv DOFs, its bodies [first, last] (the last
+// carries the inertia; the others have none and Ẍ_bias = 0): the one-DOF steps
+// last, …, first in block form. Their I^A_k S_k = I^A S_k − Σ_{m>k} I^A_m S_m
+// (S_kᵀ I^A_m S_m)/D_m and u_k = τ_k − S_kᵀ p^A − Σ_{m>k} (S_kᵀ I^A_m S_m) u_m/D_m
+// (the LDLᵀ of the joint's D, last DOF first) are the one-DOF steps' numbers,
+// but each pivot waits on a 6-vector update, not on a 6 × 6 downdate of I^A.
+inline Status jointPivots(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA, const VectorRef& tau,
+                          Workspace& ws) {
+  const std::vector<Dof>& dofs = model.dofs();
+  for (int k = first; k <= last; ++k) {
+    ws.IAS[at(k)].noalias() = IA * ws.S[at(k)];  // the columns of I^A S: independent
+    ws.u[at(k)] = tau[k - 1] - ws.S[at(k)].dot(pA);
+  }
+  for (int m = last; m >= first; --m) {
+    if (Status s = pivot(dofs[at(m - 1)], m, ws); !s) return s;
+    const Vec6& IAS_m = ws.IAS[at(m)];
+    const double inverse_D = ws.inverse_D[at(m)], u_m = ws.u[at(m)];
+    for (int k = first; k < m; ++k) {
+      const double g = ws.S[at(k)].dot(IAS_m) * inverse_D;
+      ws.IAS[at(k)] -= IAS_m * g;
+      ws.u[at(k)] -= g * u_m;
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
   const int N = model.nv();
   const std::vector<Dof>& dofs = model.dofs();
   const int m = task.solverColumns();
   ws.U.head(m).setZero();  // U_N = 0
   ws.L_scale.head(m).setZero();
-  ws.L.topLeftCorner(m, m).setZero();  // 𝓛_N = 0 (only the lower triangle is kept)
-  ConstraintMatrix& A = ws.Ahat;       // A_i, each column updated in place on its way to the base
-  A.leftCols(m) = ws.A_body.leftCols(m);
-  for (int i = N; i >= 1; --i) {
+  ws.L.topLeftCorner(m, m).setZero();           // 𝓛_N = 0 (only the lower triangle is kept)
+  ws.Ahat.leftCols(m) = ws.A_body.leftCols(m);  // A_i, each column updated in place on its way to the base
+  // Joint by joint from the leaves; body i is a joint's last DOF body.
+  for (int i = N; i >= 1;) {
+    const int first = i - dofs[at(i - 1)].index_in_joint;
     if (model.subtreeEnd(i) == i + 1) {  // a leaf: lines 8–9, I^A = I, F^A = F_bias
       ws.IA[at(i)] = ws.I[at(i)].matrix();
       ws.FA[at(i)] = ws.Fbias[at(i)];
     }
-    const Dof& dof = dofs[at(i - 1)];
-    const Vec6& S = ws.S[at(i)];
     const Mat6& IA = ws.IA[at(i)];
-    const Vec6& c = ws.c[at(i)];
-    Vec6& IAS = ws.IAS[at(i)];
-    IAS.noalias() = IA * S;
-    const double D = dof.rotor_inertia + S.dot(IAS);  // line 13
-    ws.D[at(i)] = D;
-    if (!(D > 1e-300))
-      return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)", dof.name.c_str(),
-                           D);
     Vec6 pA = ws.FA[at(i)];
-    pA.noalias() += IA * c;                   // F^A + I^A Ẍ_bias
-    const double u = tau[i - 1] - S.dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
-    ws.u[at(i)] = u;
-    const double inverse_D = 1.0 / D;  // one division per body; the rest multiply
-    ws.inverse_D[at(i)] = inverse_D;
-    const double u_D = u * inverse_D;
+    pA.noalias() += IA * ws.c[at(i)];  // F^A + I^A Ẍ_bias
+    if (first == i) {                  // one DOF: lines 13–15 as the report has them
+      ws.IAS[at(i)].noalias() = IA * ws.S[at(i)];
+      if (Status s = pivot(dofs[at(i - 1)], i, ws); !s) return s;
+      ws.u[at(i)] = tau[i - 1] - ws.S[at(i)].dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
+    } else if (Status s = jointPivots(model, first, i, IA, pA, tau, ws); !s) {
+      return s;
+    }
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
-
-    // Lines 19–21, one constraint column of the subtree at a time.
-    const int first = task.firstColumn(i), k = task.activeColumns(i);
-    double* sA = ws.SA.col(i).data();
-    const double SS_D = S.squaredNorm() * inverse_D;
-    for (int col = first; col < k; ++col) {
-      sA[col] = S.dot(A.col(col));                         // (Sᵀ A_i)ᵀ
-      ws.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
-    }
-    for (int col = first; col < k; ++col) {
-      const double sA_D = sA[col] * inverse_D;
-      ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
-      double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
-      for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
-      A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
-    }
-
-    // Lines 16–18: the parent p gets I^a_i = I^A − I^A S D⁻¹ Sᵀ I^A and
-    // F^a_i. The first child to arrive (the last in depth-first order: its
-    // subtree ends where p's does) starts p's sums from I_p and F_bias,p.
-    const int p = model.parent(i);
-    if (p > 0) {  // the world takes nothing
-      Mat6& IA_parent = ws.IA[at(p)];
-      const Vec6 IAS_D = IAS * inverse_D;
-      if (model.subtreeEnd(i) == model.subtreeEnd(p)) {
-        IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
-        ws.I[at(p)].addTo(IA_parent);
-        ws.FA[at(p)] = ws.Fbias[at(p)] + pA + IAS * u_D;
-      } else {
-        IA_parent.noalias() += IA - IAS.lazyProduct(IAS_D.transpose());
-        ws.FA[at(p)] += pA + IAS * u_D;
-      }
-    }
+    for (int k = i; k >= first; --k) constraintColumnsStep(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
+    passToParent(model, first, i, IA, pA, ws);
+    i = first - 1;
   }
   return {};
 }

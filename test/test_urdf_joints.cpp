@@ -266,3 +266,91 @@ TEST_CASE("solve: a body on a planar joint follows Newton and Euler in its plane
                 ws.solution.qdd[2] - tau[2] / I_n);
   }
 }
+
+namespace {
+// world ─slide (planar, normal `axis`)→ base ─j1 (revolute)→ l1, a tool welded to the base. The planar
+// joint is the world link's only joint, so it makes a planar base; `anchored` welds a post to the world as
+// well, which keeps the world a fixed base and makes the planar joint one below it (the mid-tree case).
+std::string planarRoot(const std::string& axis, bool anchored) {
+  return "<robot name=\"sled\"><link name=\"world\"/>" +
+         (anchored ? joint("anchor", "fixed", "world", "post") + "<link name=\"post\"/>" : std::string()) +
+         joint("slide", "planar", "world", "base",
+               R"(<origin xyz="0.1 -0.2 0.3" rpy="0.3 -0.2 0.5"/><axis xyz=")" + axis + "\"/>") +
+         link("base") + joint("weld", "fixed", "base", "tool", R"(<origin xyz="0.2 0.1 0" rpy="0.1 0 0.4"/>)") +
+         link("tool", "0.01 0 0.02") +
+         joint("j1", "revolute", "base", "l1", R"(<origin xyz="0 0.3 0.1"/><axis xyz="1 0 0"/>)" + kLimit) +
+         link("l1") + "</robot>";
+}
+}  // namespace
+
+TEST_CASE("a planar ROOT joint whose axis is not z is the planar joint below a fixed world", "[urdf][joints][solve]") {
+  // The same plane either way (the joint frame turned so its z is the axis, the base link keeping the URDF's
+  // orientation): every frame's pose and acceleration, q̈, RNEA and H agree; at q = 0 the base link sits where
+  // the URDF's <origin> puts it, and x, y move it normal to the axis.
+  double worst = 0.0;
+  for (const char* axis_text : {"0 0 1", "1 0 0", "0 0 -1", "0 1 1", "-0.3 0.5 0.8"}) {
+    INFO(axis_text);
+    const Model a = loadUrdfString(planarRoot(axis_text, false));
+    const Model b = loadUrdfString(planarRoot(axis_text, true));
+    REQUIRE(a.baseType() == BaseType::Planar);
+    REQUIRE(b.baseType() == BaseType::Fixed);
+    REQUIRE(a.nq() == 4);
+    REQUIRE(b.nq() == 4);
+    REQUIRE(b.joint(0).type == JointType::Planar);
+    std::istringstream in(axis_text);
+    Vec3 normal;
+    in >> normal.x() >> normal.y() >> normal.z();
+    const Mat3 R_origin = (Eigen::AngleAxisd(0.5, Vec3::UnitZ()) * Eigen::AngleAxisd(-0.2, Vec3::UnitY()) *
+                           Eigen::AngleAxisd(0.3, Vec3::UnitX()))
+                              .toRotationMatrix();
+    const Vec3 normal_world = R_origin * normal.normalized();  // the axis is in the joint frame
+    const Task task_a(a), task_b(b);
+    Workspace ws_a(a, task_a), ws_b(b, task_b);
+    Eigen::Isometry3d pose;
+    // At q = 0 the base link is at the URDF's <origin>; x and y move it normal to the axis.
+    const Eigen::Vector4d q0 = Eigen::Vector4d::Zero();
+    REQUIRE(forwardKinematics(a, ws_a, q0));
+    REQUIRE(framePose(a, ws_a, a.frameIndex("base"), pose));
+    CHECK((pose.translation() - Vec3(0.1, -0.2, 0.3)).norm() < 1e-15);
+    CHECK((pose.linear() - R_origin).norm() < 1e-14);
+    for (int k = 0; k < 2; ++k) {
+      Eigen::Vector4d q = q0;
+      q[k] = 1.0;
+      REQUIRE(forwardKinematics(a, ws_a, q));
+      Eigen::Isometry3d moved;
+      REQUIRE(framePose(a, ws_a, a.frameIndex("base"), moved));
+      const Vec3 step = moved.translation() - pose.translation();
+      CHECK(std::abs(step.norm() - 1.0) < 1e-14);
+      CHECK(std::abs(step.dot(normal_world)) < 1e-14);
+      CHECK((moved.linear() - pose.linear()).norm() < 1e-14);
+    }
+    std::uint64_t seed = 7;
+    for (int draw = 0; draw < 20; ++draw) {
+      Eigen::VectorXd q(4), qd = Eigen::VectorXd::Random(4), tau = 5.0 * Eigen::VectorXd::Random(4),
+                            qdd = Eigen::VectorXd::Random(4);
+      REQUIRE(randomConfiguration(a, seed, q));
+      REQUIRE(solveHybridDynamics(a, task_a, q, qd, tau, ws_a));
+      REQUIRE(solveHybridDynamics(b, task_b, q, qd, tau, ws_b));
+      worst = std::max(worst, (ws_a.solution.qdd - ws_b.solution.qdd).cwiseAbs().maxCoeff());
+      for (const char* frame : {"base", "tool", "l1"}) {
+        INFO(frame);
+        Eigen::Isometry3d pa, pb;
+        Vec6 acc_a, acc_b;
+        REQUIRE(framePose(a, ws_a, a.frameIndex(frame), pa));
+        REQUIRE(framePose(b, ws_b, b.frameIndex(frame), pb));
+        REQUIRE(frameAcceleration(a, ws_a, a.frameIndex(frame), Expressed::World, acc_a));
+        REQUIRE(frameAcceleration(b, ws_b, b.frameIndex(frame), Expressed::World, acc_b));
+        CHECK((pa.matrix() - pb.matrix()).cwiseAbs().maxCoeff() < 1e-14);
+        worst = std::max(worst, (acc_a - acc_b).cwiseAbs().maxCoeff());
+      }
+      REQUIRE(inverseDynamics(a, task_a, q, qd, qdd, ws_a));
+      REQUIRE(inverseDynamics(b, task_b, q, qd, qdd, ws_b));
+      worst = std::max(worst, (ws_a.tau - ws_b.tau).cwiseAbs().maxCoeff());
+      REQUIRE(jointSpaceInertia(a, q, ws_a));
+      REQUIRE(jointSpaceInertia(b, q, ws_b));
+      worst = std::max(worst, (ws_a.H - ws_b.H).cwiseAbs().maxCoeff());
+    }
+  }
+  std::printf("planar root joint vs the same joint below a fixed world: worst difference %.2g\n", worst);
+  CHECK(worst < 1e-11);  // two sweeps over the same bodies in other orders: rounding of terms up to ~10
+}

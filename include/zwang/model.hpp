@@ -380,9 +380,16 @@ class ModelBuilder {
   ModelBuilder& addBaseLinkInertia(const RigidInertia& inertia);
   /// Let the base float: a free-flyer or a planar joint between the world and
   /// the root link (unactuated: the root joint, Model::allJoints()). `placement` is the plane's frame for a Planar base
-  /// (ᴾX_world; must be identity for Free). ModelError when the base already
-  /// floats (the URDF had a floating root joint, say) or the placement is not finite.
-  ModelBuilder& setBase(BaseType type, const Transform& placement = Transform{});
+  /// (ᴾX_world; must be identity for Free). `root_link_placement` is the root
+  /// link's frame on the joint's child body, ᶜX_link, as addJoint's
+  /// `child_placement` (the URDF loader turns a planar root joint's frame so its
+  /// z is the URDF axis and gives the link back its own orientation this way);
+  /// not the identity only for a Planar base, and only before anything is
+  /// attached to the root link. ModelError when the base already floats (the
+  /// URDF had a floating root joint, say), a placement is not finite, or
+  /// `root_link_placement` comes too late or with a Free base.
+  ModelBuilder& setBase(BaseType type, const Transform& placement = Transform{},
+                        const Transform& root_link_placement = Transform{});
 
   /// Checks the whole tree (every moving joint must carry some inertia, every
   /// moving body's merged inertia is positive semi-definite to rounding) and

@@ -54,9 +54,10 @@ enum class MimicJoints {
 ///   world's) frame; the joint's `<origin>` would only offset the zero of
 ///   those coordinates, so it is folded in (q = [origin xyz, origin
 ///   quaternion] puts the base where the URDF draws it). Planar: the joint
-///   frame (`<origin>`) is the plane (Model::basePlacement()), its `<axis>`
-///   must be its z axis, `0 0 1` (ModelError otherwise, saying how to turn
-///   the origin instead).
+///   frame (`<origin>`), turned as for a planar joint below the root (next
+///   item) so that its z is the `<axis>`, is the plane
+///   (Model::basePlacement()); the base link keeps the URDF's orientation
+///   (its frame is placed on body 0 by the inverse rotation).
 /// * A `floating` or `planar` joint anywhere else is a joint of the model
 ///   (issue #25): JointType::Free (q = [x, y, z, q_w, q_x, q_y, q_z] of the
 ///   child link in the joint frame, the URDF `<origin>`) or JointType::Planar

@@ -8,6 +8,13 @@ namespace internal {
 
 namespace {
 
+// The motion subspace of a DOF in base coordinates: [p × a; a] for a rotation
+// about the world axis a through the body origin p, [a; 0] for a translation.
+ZWANG_ALWAYS_INLINE void motionSubspace(bool rotation, const Vec3& a, const Vec3& p, Vec6& S) {
+  S.head<3>() = rotation ? Vec3(p.cross(a)) : a;
+  S.tail<3>() = rotation ? a : Vec3::Zero();
+}
+
 // A one-DOF joint (most joints, so the hot path): its body's pose, S,
 // inertia, velocity, bias acceleration and bias force in one step.
 template <bool kInertia, bool kVelocity>
@@ -18,12 +25,8 @@ ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint
   const auto b = static_cast<std::size_t>(i);
   const auto p = static_cast<std::size_t>(model.parent(i));
   const Transform& X = ws.Xworld[b] = joint.transform(q[joint.q_index]) * ws.Xworld[p];  // line 4: ⁱX₀
-  // S_i in base coordinates: [p × a; a] (revolute) or [a; 0] (prismatic),
-  // a = ᵂR_i axis, p the body origin.
-  const Vec3 a = X.E.transpose() * joint.axis;
   Vec6& S = ws.S[b];
-  S.head<3>() = joint.isRevolute() ? Vec3(X.r.cross(a)) : a;
-  S.tail<3>() = joint.isRevolute() ? a : Vec3::Zero();
+  motionSubspace(joint.isRevolute(), X.E.transpose() * joint.axis, X.r, S);  // the axis in the world
   if (kInertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
   if (kVelocity) {
     const Vec6 vJ = S * qd[i - 1];
@@ -41,9 +44,8 @@ ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint
 // takes DOF k's axis, the last the child's inertia and the joint's bias; the
 // others carry nothing (no inertia, so no bias force either).
 template <bool kInertia, bool kVelocity>
-ZWANG_FLATTEN void multiDofKinematics(const Model& model, const Joint& joint,
-                                      const Eigen::Ref<const Eigen::VectorXd>& q,
-                                      const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
+void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
+                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
   const std::vector<Dof>& dofs = model.dofs();
   const int first = joint.v_index + 1, last = joint.v_index + joint.nv();
   const auto p = static_cast<std::size_t>(model.parent(first));
@@ -61,12 +63,8 @@ ZWANG_FLATTEN void multiDofKinematics(const Model& model, const Joint& joint,
     const auto b = static_cast<std::size_t>(i);
     const Dof& dof = dofs[b - 1];
     ws.Xworld[b] = X;
-    // S_i in base coordinates: [p × a; a] (a rotation) or [a; 0] (a
-    // translation), a = ᵂR axis, p the body origin.
-    const Vec3 a = (dof.in_joint_frame ? Et_joint_frame : Et_child) * dof.axis;
     Vec6& S = ws.S[b];
-    S.head<3>() = dof.rotation ? Vec3(X.r.cross(a)) : a;
-    S.tail<3>() = dof.rotation ? a : Vec3::Zero();
+    motionSubspace(dof.rotation, (dof.in_joint_frame ? Et_joint_frame : Et_child) * dof.axis, X.r, S);
     ws.c[b].setZero();
     ws.Fbias[b].setZero();
     if (kInertia && i < last) ws.I[b] = RigidInertia{};

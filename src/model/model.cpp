@@ -353,11 +353,13 @@ const char* toString(BaseType type) {
 ModelBuilder& ModelBuilder::addBaseLinkInertia(const RigidInertia& inertia) {
   // Throws on an impossible inertia; its warnings come with build(), when the base floats.
   (void)validate::rigidInertia("link '" + model_.frames_[0].name + "'", inertia);
-  model_.link_inertias_[0] += inertia;
+  const Transform& link = model_.frames_[0].placement;  // the root link on body 0 (setBase)
+  const bool same_frame = link.E.isIdentity(0.0) && link.r.isZero(0.0);
+  model_.link_inertias_[0] += same_frame ? inertia : spatial::inverseTransformInertia(link, inertia);
   return *this;
 }
 
-ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement) {
+ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement, const Transform& root_link_placement) {
   if (model_.base_type_ != BaseType::Fixed)
     throw ModelError(std::string("the base already floats (a ") + toString(model_.base_type_) +
                      " joint under the root link '" + model_.frames_[0].name + "'): it cannot get a " + toString(type) +
@@ -365,8 +367,19 @@ ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement) {
   if (!finite(placement)) throw ModelError("base placement is not finite");
   if (type == BaseType::Free && !(placement.E.isIdentity(0.0) && placement.r.isZero(0.0)))
     throw ModelError("a free base takes no placement (its pose is its configuration)");
+  if (!finite(root_link_placement)) throw ModelError("root link placement is not finite");
+  if (!(root_link_placement.E.isIdentity(0.0) && root_link_placement.r.isZero(0.0))) {
+    if (type != BaseType::Planar)
+      throw ModelError(std::string("a ") + toString(type) + " base takes no root link placement (only a planar one)");
+    // What is attached already was placed on the root link's frame as body 0's.
+    const RigidInertia& own = model_.link_inertias_[0];
+    if (model_.frames_.size() > 1 || own.mass != 0.0 || !own.h.isZero(0.0) || !own.Ibar.isZero(0.0))
+      throw ModelError("setBase with a root link placement must come before anything is attached to the root link '" +
+                       model_.frames_[0].name + "'");
+  }
   model_.base_type_ = type;
   model_.base_placement_ = placement;
+  model_.frames_[0].placement = root_link_placement;
   return *this;
 }
 

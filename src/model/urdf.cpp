@@ -1118,35 +1118,23 @@ struct BaseChoice {
   urdf::JointConstSharedPtr joint;  // the file's floating or planar root joint in use, if any
   BaseType type = BaseType::Fixed;  // the model's base
   Transform plane;                  // a planar base's plane, ᴾX_world
+  Transform root_link;              // the root link's frame on body 0, ᶜX_link (a turned plane's: linkPlacementOf)
 };
 
-// The plane of a planar root joint: the joint frame (its <origin> in the root
-// link), whose z axis must be the joint's <axis>, the plane's normal.
-Transform planeOf(const Reporter& report, const urdf::Joint& uj, const TiXmlElement* robot) {
-  Vec3 axis = vectorOf(uj.axis);
-  const bool unit_z = axis.allFinite() && axis.norm() > 1e-9 && [&] {
-    axis.normalize();
-    return std::abs(axis.x()) <= 1e-9 && std::abs(axis.y()) <= 1e-9 && axis.z() > 0.0;
-  }();
-  if (!unit_z) {
-    bool written = false;  // urdfdom gives a missing <axis> its default, 1 0 0
-    for (const TiXmlElement* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint"))
-      if (nameOf(j) == uj.name) written = j->FirstChildElement("axis") != nullptr;
-    const std::string given = written ? "<axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " + fmt(uj.axis.z) +
-                                            "\" is not the z axis of its joint frame"
-                                      : "has no <axis> (the URDF default is \"1 0 0\")";
-    report.fail("planar root joint '" + uj.name + "': " + given +
-                ": zwang moves a planar base in the x-y plane of the joint frame, so the axis (the plane's normal) "
-                "must be \"0 0 1\"; turn the joint's <origin> rpy to put its z axis along the normal you mean "
-                "(a normal along x: rpy=\"0 1.5707963267948966 0\", along y: rpy=\"-1.5707963267948966 0 0\")");
-  }
-  const Transform plane = placementOf(uj);
-  if (!plane.E.allFinite() || !plane.r.allFinite()) report.fail("joint '" + uj.name + "': <origin> is not finite");
-  return plane;
+// The plane of a planar root joint, ᴾX_world: the joint frame (its <origin>
+// in the root link) turned as a planar joint's below the root (makeJoint), so
+// that its z is the joint's <axis>, the plane's normal.
+Transform planeOf(const Reporter& report, const urdf::Joint& uj) {
+  const Vec3 axis = vectorOf(uj.axis);
+  if (axis.norm() < 1e-9)  // finite: checkAllNumbers
+    report.fail("planar root joint '" + uj.name + "': <axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " +
+                fmt(uj.axis.z) + "\" is zero (it must give the normal of the plane)");
+  const Transform origin = placementOf(uj);
+  if (!origin.E.allFinite() || !origin.r.allFinite()) report.fail("joint '" + uj.name + "': <origin> is not finite");
+  return Transform::rotation(planeRotation(axis.normalized())) * origin;
 }
 
-BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model, const TiXmlElement* robot,
-                      const UrdfOptions& options) {
+BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model, const UrdfOptions& options) {
   BaseChoice choice;
   const LinkPtr file_root = model.getRoot();
   choice.root = options.root.empty() ? file_root : model.getLink(options.root);
@@ -1168,7 +1156,10 @@ BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model,
     choice.root = model.getLink(joint->child_link_name);
     choice.joint = joint;
     choice.type = baseTypeOf(*joint);
-    if (choice.type == BaseType::Planar) choice.plane = planeOf(report, *joint, robot);
+    if (choice.type == BaseType::Planar) {
+      choice.plane = planeOf(report, *joint);
+      choice.root_link = linkPlacementOf(*joint);
+    }
     return choice;
   }
   choice.type = options.base;
@@ -1283,14 +1274,14 @@ Model load(const Reporter& report, const std::string& text, const UrdfOptions& o
   if (options.base == BaseType::Fixed) requireMovingJoint(report, *urdf_model);  // a floating body needs none
   const std::map<std::string, double> rotor = rotorInertias(report, robot, *urdf_model, options);
 
-  const BaseChoice base = chooseBase(report, *urdf_model, robot, options);
+  const BaseChoice base = chooseBase(report, *urdf_model, options);
   const LinkPtr root = base.root;
   if (!options.tip.empty() && !urdf_model->getLink(options.tip))
     report.fail("tip link '" + options.tip + "' not found (links: " + nameList(allLinkNames(*urdf_model)) + ")");
 
   ModelBuilder builder(urdf_model->getName(), root->name);
   placement.base_floats = base.type != BaseType::Fixed;
-  if (placement.base_floats) report.builder([&] { builder.setBase(base.type, base.plane); });
+  if (placement.base_floats) report.builder([&] { builder.setBase(base.type, base.plane, base.root_link); });
   addRootLinkInertia(report, builder, *root, placement.base_floats);
   if (options.tip.empty() && branchesIntoMovingJoints(root))
     loadTree(report, *urdf_model, robot, root, rotor, options, builder, placement);

@@ -35,8 +35,7 @@ inline Status checkFinite(const char* name, const Eigen::MatrixBase<Derived>& x)
 
 // The state checks of every algorithm, for q (nq() entries) and the vectors of
 // nv() entries (q̇, q̈, τ). A model without quaternions checks q inline: the
-// hot path pays for no call and no extra Status (each one zeroes its 240-byte
-// message); a quaternion's norm goes to checkConfiguration. The size messages
+// hot path pays for no call; a quaternion's norm goes to checkConfiguration. The size messages
 // name the base's share when there is one ("… the model has nv = 9 (3 base
 // velocity coordinates + 6 joint DOFs)").
 // "joints" when every joint below the root has one DOF, else "joint DOFs": what dof() counts.

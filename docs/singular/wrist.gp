@@ -1,5 +1,5 @@
 # The figure of docs/solver.md, "Singular tasks". Regenerate from the repository root:
-#   ZWANG_SINGULAR_CSV=docs/singular/wrist.csv build/test/test_singular "[sweep]"
+#   ZWANG_SINGULAR_CSV=docs/singular/wrist.csv build/test/zwang_tests "[sweep]"
 #   (cd docs/singular && gnuplot wrist.gp)
 set encoding utf8
 set terminal pngcairo size 900,700 font "DejaVu Sans,11" noenhanced

@@ -529,44 +529,136 @@ void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eig
 }
 }  // namespace
 
+namespace {
+// Each body's run of unit-torque columns [run_begin, run_end): those whose
+// DOF's body lies in its subtree, a contiguous run since the DOFs ascend.
+void columnRuns(const Model& model, const std::vector<int>& dofs, UnitTorqueScratch& s) {
+  const auto k = static_cast<Eigen::Index>(dofs.size());
+  Eigen::Index c_begin = k;  // the first column with its DOF's body ≥ i: falls with i
+  for (int i = model.nv(); i >= 1; --i) {
+    while (c_begin > 0 && bodyOfDof(dofs[at(static_cast<int>(c_begin) - 1)]) >= i) --c_begin;
+    const int end = model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: k)
+    s.run_begin[i] = c_begin;
+    s.run_end[i] =
+        k == 0 || end > bodyOfDof(dofs.back()) ? k : std::lower_bound(dofs.begin(), dofs.end(), end, [](int d, int b) {
+                                                       return bodyOfDof(d) < b;
+                                                     }) - dofs.begin();
+  }
+}
+
+// Line 20 at body i for one column: δU₀ += SᵀA_i δu_i / D_i on the rows
+// [first, end) of i's subtree (dU_c: the column's δU₀).
+ZWANG_ALWAYS_INLINE void constraintColumnsDelta(const Workspace& ws, int i, int first, int end, double du_D,
+                                                double* dU_c) {
+  for (int r = first; r < end; ++r) dU_c[r] += ws.SA(r, i) * du_D;
+}
+
+// Lines 13–20 of a one-DOF joint (body i) on its run of columns: δu_i = [i is
+// the column's DOF] − Sᵀ δF^a, then δU₀ and δF^a for the parent.
+void oneDofColumns(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& dofs, int i,
+                   UnitTorqueScratch& s) {
+  const Vec6& S = ws.S[at(i)];
+  const Vec6& IAS = ws.IAS[at(i)];
+  const double inverse_D = ws.inverse_D[at(i)];
+  const bool to_world = model.parent(i) == 0;  // the world takes δF^a and does nothing with it
+  const int first = task.firstColumn(i), end = task.activeColumns(i);
+  const Eigen::Index begin = s.run_begin[i], run_end = s.run_end[i];
+  const Eigen::Index own = begin < run_end && bodyOfDof(dofs[at(static_cast<int>(begin))]) == i ? begin : -1;
+  double* const du = s.du.data() + i;  // row i
+  const Eigen::Index du_stride = s.du.outerStride(), dU_stride = s.dU.outerStride();
+  for (Eigen::Index c = begin; c < run_end; ++c) {
+    Eigen::Map<Vec6> dF(s.dF.data() + 6 * c);
+    const double du_ic = (c == own ? 1.0 : 0.0) - S.dot(dF);
+    du[c * du_stride] = du_ic;
+    const double du_D = du_ic * inverse_D;
+    constraintColumnsDelta(ws, i, first, end, du_D, s.dU.data() + c * dU_stride);
+    if (!to_world) dF += IAS * du_D;  // lines 17–18
+  }
+}
+
+// The same for a joint of several DOFs (bodies first..last), its steps in
+// block form as jointPivots formed them (offsets k, l from first): a column
+// entering at the joint's DOF o has δu_o = 1 and δu_k = −Σ_{k<l≤o} g_kl δu_l
+// below it, g_kl = S_kᵀ I^A_l S_l / D_l; a column from below with δF^a has
+// δu = −W δF^a, W's rows W_k = S_kᵀ − Σ_{l>k} g_kl W_l, formed once per
+// joint. So each column costs one 6 × 6 product, not a 6-vector update per
+// DOF (a free root's six bodies carry every column); the parent gets
+// Σ_k I^A_k S_k δu_k / D_k more (lines 17–18).
+void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& dofs, int first,
+                     int last, UnitTorqueScratch& s) {
+  const int n = last - first + 1;
+  double g[6][6];  // g[k][l] for 0 ≤ k < l < n
+  Mat6 W = Mat6::Zero(), IAS_D = Mat6::Zero();
+  for (int k = n - 1; k >= 0; --k) {
+    const Vec6& S_k = ws.S[at(first + k)];
+    IAS_D.col(k) = ws.IAS[at(first + k)] * ws.inverse_D[at(first + k)];
+    W.row(k) = S_k.transpose();
+    for (int l = k + 1; l < n; ++l) {
+      g[k][l] = S_k.dot(IAS_D.col(l));
+      W.row(k) -= g[k][l] * W.row(l);
+    }
+  }
+  // The joint's constraint rows: its subtree's [rows_first, rows_first +
+  // rows), DOF body k taking those before rows_end[k] (a joint row on one of
+  // the joint's DOFs sits on that DOF's body, and only the bodies before see it).
+  const int rows_first = task.firstColumn(first), rows = task.activeColumns(first) - rows_first;
+  int rows_end[6];
+  for (int k = 0; k < n; ++k) rows_end[k] = task.activeColumns(first + k) - rows_first;
+  // Line 20 for a column from below, all DOFs at once: δU₀ −= Y δF^a with
+  // Y = Σ_k SᵀA_k W_k / D_k (kept transposed: a row's 6 entries side by side).
+  auto Yt = s.joint_rows.leftCols(rows);
+  Yt.setZero();
+  for (int k = 0; k < n; ++k) {
+    const auto SA_k = ws.SA.col(first + k).segment(rows_first, rows);
+    const Vec6 W_k_D = W.row(k).transpose() * ws.inverse_D[at(first + k)];
+    for (int r = 0; r < rows_end[k]; ++r) Yt.col(r) += W_k_D * SA_k[r];
+  }
+  const bool to_world = model.parent(first) == 0;
+  const Eigen::Index du_stride = s.du.outerStride();
+  for (Eigen::Index c = s.run_begin[first]; c < s.run_end[first]; ++c) {
+    const int own = bodyOfDof(dofs[at(static_cast<int>(c))]) - first;  // a DOF of this joint (< n), or below it
+    Eigen::Map<Vec6> dF(s.dF.data() + 6 * c);
+    auto dU = s.dU.col(c).segment(rows_first, rows);
+    Vec6 du = Vec6::Zero();
+    if (own >= n) {
+      du.noalias() = -W * dF;
+      for (int r = 0; r < rows; ++r) dU[r] -= Yt.col(r).dot(dF);
+    } else {  // δF^a is zero where the column enters
+      du[own] = 1.0;
+      for (int k = own - 1; k >= 0; --k)
+        for (int l = k + 1; l <= own; ++l) du[k] -= g[k][l] * du[l];
+      for (int k = 0; k <= own; ++k)
+        dU.head(rows_end[k]) +=
+            ws.SA.col(first + k).segment(rows_first, rows_end[k]) * (du[k] * ws.inverse_D[at(first + k)]);
+    }
+    Eigen::Map<Eigen::VectorXd>(s.du.data() + c * du_stride + first, std::min(own, n - 1) + 1) =
+        du.head(std::min(own, n - 1) + 1);
+    if (!to_world) dF.noalias() += IAS_D * du;
+  }
+}
+}  // namespace
+
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& dofs,
                        UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
   // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
   // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
-  // Column c is zero except on the path from its DOF's body s_c to the
-  // world, so the inward sweep at body i works on the columns whose body lies
-  // in i's subtree [i, subtreeEnd(i)): a contiguous run of c, since the DOFs
-  // ascend. dF.col(c) carries δF^a from the path's last body to the next.
-  const int N = model.nv();
+  // Column c is zero except on the path from its DOF's body to the world, so
+  // the inward sweep at body i works on i's run of columns (columnRuns).
+  // dF.col(c) carries δF^a from the path's last body to the next.
   const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(dofs.size());
-  auto du = s.du.leftCols(k);
   auto dU = s.dU.topLeftCorner(m, k);
-  auto dF = s.dF.leftCols(k);
   dU.setZero();
-  dF.setZero();              // du is written where it is read: on each body's run of columns
-  Eigen::Index c_begin = k;  // the first column with its joint's body ≥ i: falls with i
-  for (int i = N; i >= 1; --i) {
-    while (c_begin > 0 && bodyOfDof(dofs[static_cast<std::size_t>(c_begin - 1)]) >= i) --c_begin;
-    const int end = model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: k)
-    const Eigen::Index c_end =
-        k == 0 || end > bodyOfDof(dofs.back()) ? k : std::lower_bound(dofs.begin(), dofs.end(), end, [](int d, int b) {
-                                                       return bodyOfDof(d) < b;
-                                                     }) - dofs.begin();
-    s.run_begin[i] = c_begin;
-    s.run_end[i] = c_end;
-    const Vec6& S = ws.S[at(i)];
-    const Vec6& IAS = ws.IAS[at(i)];
-    const double inverse_D = ws.inverse_D[at(i)];
-    const int first = task.firstColumn(i), ki = task.activeColumns(i);
-    const bool to_world = model.parent(i) == 0;  // the world takes δF^a and does nothing with it
-    for (Eigen::Index c = c_begin; c < c_end; ++c) {
-      const double du_ic = (bodyOfDof(dofs[static_cast<std::size_t>(c)]) == i ? 1.0 : 0.0) - S.dot(dF.col(c));
-      du(i, c) = du_ic;
-      const double du_D = du_ic * inverse_D;
-      for (int r = first; r < ki; ++r) dU(r, c) += ws.SA(r, i) * du_D;  // line 20
-      if (!to_world) dF.col(c) += IAS * du_D;                           // lines 17–18
-    }
+  s.dF.leftCols(k).setZero();  // du is written where it is read: on each body's run of columns
+  columnRuns(model, dofs, s);
+  const std::vector<Dof>& model_dofs = model.dofs();
+  for (int i = model.nv(); i >= 1;) {  // joint by joint from the leaves; body i is a joint's last DOF body
+    const int first = i - model_dofs[at(i - 1)].index_in_joint;
+    if (first == i)
+      oneDofColumns(model, task, ws, dofs, i, s);
+    else
+      multiDofColumns(model, task, ws, dofs, first, i, s);
+    i = first - 1;
   }
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
   // outward pass's lanes, a block of columns at a time; else here, all at once.

@@ -56,6 +56,7 @@ struct UnitTorqueScratch {
       : du(bodies, dof),
         dU(capacity, dof),
         dF(6, dof),
+        joint_rows(6, capacity),
         da(6 * kLanes, bodies),
         dnu_lanes(kLanes, capacity),
         run_begin(bodies),
@@ -63,6 +64,7 @@ struct UnitTorqueScratch {
   Eigen::MatrixXd du;         // bodies × k: δu_i per unit torque
   Eigen::MatrixXd dU;         // capacity × k: δU₀ per unit torque
   Matrix6X dF;                // 6 × k: δF^A carried inward per unit torque
+  Matrix6X joint_rows;        // 6 × capacity: a multi-DOF joint's δU₀ per unit δF^A, transposed
   Eigen::MatrixXd da;         // column i: body i's δẌ for up to kLanes columns (kLanes × 6, column-major)
   Eigen::MatrixXd dnu_lanes;  // kLanes × capacity: δν of those columns, one row per column
   // Body i's run of columns [run_begin[i], run_end[i]): those whose joint's

@@ -241,17 +241,19 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
   const int iv = dofOfEntry(model, 0);  // the friction entries' rows of q̈
   auto K = fs.K.topLeftCorner(k, k);
   for (Eigen::Index a = 0; a < k; ++a) fs.qdd0_stuck[a] = fs.qdd0[iv + stuck[static_cast<std::size_t>(a)]];
-  {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers: k² of them)
+  {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers: k² of them, a pair per store)
     const int* rows = stuck.data();
     const double* dqdd = fs.dqdd.data() + iv;
     const Eigen::Index dqdd_stride = fs.dqdd.outerStride();
     double* p = K.data();
     const Eigen::Index p_stride = K.outerStride();
-    for (Eigen::Index b = 0; b < k; ++b)
-      for (Eigen::Index a = 0; a < k; ++a) p[a + b * p_stride] = dqdd[rows[a] + b * dqdd_stride];
-    for (Eigen::Index b = 0; b < k; ++b)  // symmetric in exact arithmetic (K is)
+    for (Eigen::Index b = 0; b < k; ++b) {  // symmetric in exact arithmetic (K is): the mean of both halves
+      const double* dqdd_b = dqdd + b * dqdd_stride;
+      const int row_b = rows[b];
+      p[b + b * p_stride] = dqdd_b[row_b];
       for (Eigen::Index a = b + 1; a < k; ++a)
-        p[a + b * p_stride] = p[b + a * p_stride] = 0.5 * (p[a + b * p_stride] + p[b + a * p_stride]);
+        p[a + b * p_stride] = p[b + a * p_stride] = 0.5 * (dqdd_b[rows[a]] + dqdd[row_b + a * dqdd_stride]);
+    }
   }
   // The size of the terms K_ΘΘ is computed from (1/D_j, and the columns'
   // entries): where the task pins the stuck joints, K_ΘΘ is that times

@@ -143,8 +143,9 @@ BaseSpec parseBase(const JsonReader& in, const Json& value, const std::string& p
     if (!value.contains(key)) return Eigen::VectorXd::Zero(size);
     return in.numbers(value[key], childPath(path, key), size, what);
   };
-  if (type == "free") {
-    b.type = BaseType::Free;
+  b.type =
+      atPath(in, tpath, [&] { return problem::parseBaseType(kJson, type, "a fixed base needs no \"base\" section"); });
+  if (b.type == BaseType::Free) {
     in.object(value, path, {"type", "position", "orientation", "linear_velocity", "angular_velocity", "force"});
     b.q.resize(7);
     b.q.head<3>() = vector("position", 3, "x, y, z of the base origin in the world");
@@ -167,17 +168,13 @@ BaseSpec parseBase(const JsonReader& in, const Json& value, const std::string& p
     b.v.head<3>() = vector("linear_velocity", 3, "the base origin's velocity in base axes");
     b.v.tail<3>() = vector("angular_velocity", 3, "in base axes");
     b.force = vector("force", 6, "fx, fy, fz, nx, ny, nz: a wrench at the base origin in base axes");
-  } else if (type == "planar") {
-    b.type = BaseType::Planar;
+  } else {
     in.object(value, path, {"type", "position", "yaw", "velocity", "force"});
     b.q.resize(3);
     b.q.head<2>() = vector("position", 2, "x, y in the plane");
     b.q[2] = value.contains("yaw") ? in.number(value["yaw"], childPath(path, "yaw")) : 0.0;
     b.v = vector("velocity", 3, "x, y and yaw rates in the plane's axes");
     b.force = vector("force", 3, "fx, fy in the plane's axes and the torque about its normal");
-  } else {
-    in.fail(tpath, "unknown value \"" + printable(type, 40) + "\" (expected \"free\" or \"planar\"" +
-                       (type == "fixed" ? "; a fixed base needs no \"base\" section" : "") + ")");
   }
   return b;
 }
@@ -306,16 +303,11 @@ void placeJointValues(const JsonReader& in, const Model& model, const JointValue
 
 // The URDF options of the problem's keys, named as the problem names them in the loader's messages.
 UrdfOptions urdfOptions(const Problem& p) {
-  UrdfOptions urdf;
-  urdf.root = p.root;
-  urdf.tip = p.tip;
-  urdf.strict = p.strict;
-  urdf.attach_beyond_tip = p.attach_beyond_tip;
-  urdf.mimic = p.lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
-  urdf.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
-  urdf.names.base = "base.type";
-  urdf.base = p.base.type;          // Fixed when there is no "base"
-  urdf.base_may_match_file = true;  // "base" also names a floating root joint of the file
+  problem::ModelRequest request{p.root, p.tip, p.strict, p.attach_beyond_tip, p.lock_mimic, p.base.type, {}};
+  request.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
+  request.names.base = "base.type";
+  UrdfOptions urdf = problem::urdfOptions(request);  // a fixed base when there is no "base"
+  urdf.base_may_match_file = true;                   // "base" also names a floating root joint of the file
   return urdf;
 }
 

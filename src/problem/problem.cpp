@@ -101,6 +101,30 @@ Expressed parseExpressed(const Spelling& spelling, const std::string& text, Axes
                      "unknown value " + quoted(spelling, text, 40) + " (expected " + expected + hint + ")");
 }
 
+UrdfOptions urdfOptions(const ModelRequest& request) {
+  UrdfOptions urdf;
+  urdf.root = request.root;
+  urdf.tip = request.tip;
+  urdf.strict = request.strict;
+  urdf.attach_beyond_tip = request.attach_beyond_tip;
+  urdf.mimic = request.lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
+  urdf.base = request.base;
+  urdf.names = request.names;
+  return urdf;
+}
+
+BaseType parseBaseType(const Spelling& spelling, const std::string& text, const char* no_fixed) {
+  if (text == "free") return BaseType::Free;
+  if (text == "planar") return BaseType::Planar;
+  if (!no_fixed && text == "fixed") return BaseType::Fixed;
+  const auto q = [&](const char* word) { return quoted(spelling, word); };
+  const std::string expected =
+      no_fixed ? q("free") + " or " + q("planar") : q("fixed") + ", " + q("free") + " or " + q("planar");
+  const std::string hint = no_fixed && text == "fixed" ? std::string("; ") + no_fixed : "";
+  throw ProblemError(Fault::Value, "",
+                     "unknown value " + quoted(spelling, text, 40) + " (expected " + expected + hint + ")");
+}
+
 void checkRelative(const Spelling& spelling, const ConstraintDesc& c, bool relative_given) {
   if (relative_given && c.relative_to.empty())
     throw ProblemError(Fault::Value, "relative_to", "is empty (name the frame the constraint is relative to)");

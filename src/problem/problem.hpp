@@ -53,6 +53,21 @@ enum class AxesOf { Wrench, Constraint, RelativeConstraint };
 // "local", "world", "aligned", "reference"; ProblemError(Value) naming the allowed ones.
 Expressed parseExpressed(const Spelling& spelling, const std::string& text, AxesOf item);
 
+// The model a front end asks for; `names` spells its keys in the loader's messages.
+struct ModelRequest {
+  std::string root, tip;
+  bool strict = false;
+  bool attach_beyond_tip = false;
+  bool lock_mimic = false;  // weld the mimic joints (MimicJoints::Lock)
+  BaseType base = BaseType::Fixed;
+  UrdfOptions::Names names;
+};
+UrdfOptions urdfOptions(const ModelRequest& request);
+
+// "fixed", "free", "planar"; ProblemError(Value) naming the allowed ones. Where
+// "fixed" is no value (`no_fixed` given), "fixed" is refused with `no_fixed` as the hint.
+BaseType parseBaseType(const Spelling& spelling, const std::string& text, const char* no_fixed = nullptr);
+
 // One constraint as a front end describes it: a frame's rows (A, 6 × m), a
 // relative one's (relative_to), a contact's, or a joint row (joint).
 struct ConstraintDesc {

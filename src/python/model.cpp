@@ -15,24 +15,13 @@ std::string pathArg(py::handle path) {
   return fs.cast<std::string>();
 }
 
-BaseType baseArg(const std::string& base) {
-  if (base == "fixed") return BaseType::Fixed;
-  if (base == "free") return BaseType::Free;
-  if (base == "planar") return BaseType::Planar;
-  raise(PyExc_ValueError, "base: unknown value '" + base + "' (expected 'fixed', 'free' or 'planar')");
-}
-
 UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia, bool strict,
                         bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
-  UrdfOptions options;
-  options.root = root;
-  options.tip = tip;
-  options.strict = strict;
-  options.attach_beyond_tip = attach_beyond_tip;
-  options.mimic = lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
-  options.base = baseArg(base);
-  options.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
-  options.names.base = "base='" + base + "'";
+  problem::ModelRequest request{root, tip, strict, attach_beyond_tip, lock_mimic, BaseType::Fixed, {}};
+  request.base = checked("base", [&] { return problem::parseBaseType(kPython, base); });
+  request.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
+  request.names.base = "base='" + base + "'";
+  UrdfOptions options = problem::urdfOptions(request);
   if (!rotor_inertia.is_none()) {
     if (!py::isinstance<py::dict>(rotor_inertia))
       raise(PyExc_TypeError, "rotor_inertia: expected a dict {joint name: inertia}");
@@ -147,9 +136,8 @@ RigidInertia inertiaArg(double mass, py::handle com, py::handle inertia) {
 }
 
 BaseType floatingBaseArg(const std::string& type) {
-  if (type == "free") return BaseType::Free;
-  if (type == "planar") return BaseType::Planar;
-  raise(PyExc_ValueError, "set_base: unknown base '" + type + "' (expected 'free' or 'planar')");
+  return checked("set_base",
+                 [&] { return problem::parseBaseType(kPython, type, "a fixed base is a builder without set_base"); });
 }
 
 using ModelClass = py::class_<Model, std::shared_ptr<Model>>;

@@ -1096,7 +1096,7 @@ TEST_CASE("info: table and JSON", "[info]") {
                    "--base"));
     const Run bad = run({"info", solo, "--base", "flying"});
     CHECK(bad.exit_code == 2);
-    CHECK(contains(bad.err, "--base: unknown value 'flying' (expected free, planar or fixed)"));
+    CHECK(contains(bad.err, "--base: unknown value 'flying' (expected 'fixed', 'free' or 'planar')"));
   }
   SECTION("--root/--tip") {
     const Run r = run({"info", std::string(ZWANG_MODELS_DIR) + "/panda.urdf", "--tip", "panda_link4", "--json"});

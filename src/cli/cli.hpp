@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "problem/problem.hpp"
 #include "zwang/model.hpp"
 
 namespace zwang::cli {
@@ -56,10 +57,8 @@ struct Arguments {
 Arguments parseArguments(const std::string& command, int argc, char** argv, int first,
                          const std::vector<std::string>& flags, const std::vector<std::string>& with_value);
 
-// One printable line: control bytes and bytes that are not valid UTF-8 as
-// \xNN (valid UTF-8 passes through), at most `max_length` bytes, cut between
-// characters (the rest elided with "...").
-std::string printable(const std::string& text, std::size_t max_length = 200);
+// One printable line (the problem layer's: its messages and the tool's cut names alike).
+using problem::printable;
 
 // Each of the model's warnings once on stderr: "zwang: warning: <message>".
 void printWarnings(const Model& model);

@@ -157,46 +157,7 @@ Arguments parseArguments(const std::string& command, int argc, char** argv, int 
   return args;
 }
 
-namespace {
-
-// Length of the valid UTF-8 sequence starting at text[at], 0 if it is not one
-// (a stray continuation byte, an overlong or truncated sequence).
-std::size_t utf8Length(const std::string& text, std::size_t at) {
-  const auto lead = static_cast<unsigned char>(text[at]);
-  const std::size_t length = lead >= 0xF0 && lead <= 0xF4 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC2 && lead < 0xE0 ? 2 : 0;
-  if (length == 0 || at + length > text.size()) return 0;
-  for (std::size_t k = 1; k < length; ++k)
-    if ((static_cast<unsigned char>(text[at + k]) & 0xC0) != 0x80) return 0;
-  return length;
-}
-
-}  // namespace
-
-std::string printable(const std::string& text, std::size_t max_length) {
-  std::string out;
-  for (std::size_t at = 0; at < text.size();) {
-    const auto c = static_cast<unsigned char>(text[at]);
-    std::string piece;
-    std::size_t used = 1;
-    if (c >= 0x20 && c < 0x7f) {
-      piece = text.substr(at, 1);
-    } else if (const std::size_t n = c >= 0x80 ? utf8Length(text, at) : 0; n > 0) {
-      piece = text.substr(at, n);  // UTF-8 (names, "…", "·") passes through whole
-      used = n;
-    } else {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\x%02X", static_cast<unsigned>(c));
-      piece = buffer;
-    }
-    if (out.size() + piece.size() > max_length) {  // cut between characters, never inside one
-      out += "...";
-      break;
-    }
-    out += piece;
-    at += used;
-  }
-  return out;
-}
+namespace {}  // namespace
 
 void printWarnings(const Model& model) {
   for (const ModelWarning& w : model.warnings())

@@ -353,8 +353,8 @@ std::function<bool(bool)> prepareDualArmEnergy(const ReportCommand& report) {
 
 namespace {
 
-bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urdf, const Model& model,
-                   const std::vector<PostureResult>& results, bool all_ok, bool plot) {
+// What the report shows: the model, the box, the task and the postures' source.
+void printSetting(const std::filesystem::path& urdf, const Model& model) {
   std::error_code ec;
   const std::filesystem::path proximate = std::filesystem::proximate(urdf, ec);
   const std::string shown = (ec ? urdf : proximate).string();
@@ -372,7 +372,10 @@ bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urd
   std::printf(
       "\npostures: the hands at the box's side faces (box centre +-0.15 m along the torso's y), tool0 z towards\n"
       "the box, x down; solved by damped least squares from make_dual_panda.py --check's grasp\n\n");
+}
 
+// The postures (torso, box, hand error, closest limit) and their q.
+void printPostures(const std::vector<PostureResult>& results) {
   std::printf(
       "postures: torso angle [rad], box centre in the torso frame [m], hand error [m or rad], closest limit [rad]\n");
   std::vector<std::vector<std::string>> postures{
@@ -393,7 +396,10 @@ bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urd
     qs.push_back(row);
   }
   printColumns(qs);
+}
 
+// tau_control per joint and variant.
+void printTorques(const std::vector<PostureResult>& results) {
   std::printf("\ntau_control per joint [N·m]\n");
   std::vector<std::vector<std::string>> joints{{"posture", "variant"}};
   for (int j = 0; j < kDof; ++j) joints[0].push_back(jointLabel(j));
@@ -404,7 +410,10 @@ bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urd
       joints.push_back(row);
     }
   printColumns(joints, 2);
+}
 
+// The closed loop's internal force per posture.
+void printLoopForces(const std::vector<PostureResult>& results) {
   std::printf(
       "\nthe loop's force: nu of the relative rows, the wrench on the left hand (its opposite on the right arm) in\n"
       "right_tool0's axes (z points from the right hand to the left: fz > 0 pulls the hands apart, fz < 0 squeezes;\n"
@@ -418,7 +427,10 @@ bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urd
     loop.push_back(row);
   }
   printColumns(loop);
+}
 
+// The effort table and what the checks found at worst.
+void printEffortsAndChecks(const std::vector<PostureResult>& results) {
   std::vector<std::string> names;
   std::vector<energy::VariantEfforts> efforts;
   std::vector<bool> ok;
@@ -440,7 +452,15 @@ bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urd
       "with the box's wrenches (worst %s), closure tau_control - mu = G', tau_c = sum J^T A nu = tau_control\n"
       "(worst %s), the loop's force puts no torque on the torso (worst %s)\n",
       small(worst[0]).c_str(), small(worst[1]).c_str(), small(worst[2]).c_str(), small(worst[3]).c_str());
+}
 
+bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urdf, const Model& model,
+                   const std::vector<PostureResult>& results, bool all_ok, bool plot) {
+  printSetting(urdf, model);
+  printPostures(results);
+  printTorques(results);
+  printLoopForces(results);
+  printEffortsAndChecks(results);
   writeOutput((report.out / "dual_energy.csv").string(), csvText(results));
   std::printf(
       "wrote %s/dual_energy.csv (pose, variant, q1-15, tau1-15 = tau_control, mu1-15, tau_norm, tau_sq, tau_abs_sum,\n"

@@ -16,6 +16,9 @@ namespace zwang::cli {
 
 namespace {
 
+// Command-line values are quoted with ' in messages.
+const problem::Spelling kCommandLine{'\'', ""};
+
 // Limits may be infinite ("none"): null in JSON, "-" in the table.
 Json finiteOrNull(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
@@ -227,23 +230,23 @@ int commandInfo(int argc, char** argv) {
   if (args.positional.size() != 1)
     throw UsageError("info", args.positional.empty() ? "no URDF file given" : "more than one URDF file given");
   const std::string path = args.positional[0];
-  UrdfOptions options;
-  options.root = args.value("--root");
-  options.tip = args.value("--tip");
-  options.strict = args.has("--strict");
-  options.attach_beyond_tip = args.has("--attach-beyond-tip");
-  options.mimic = args.has("--lock-mimic") ? MimicJoints::Lock : MimicJoints::Model;
-  options.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
-  options.names.base = "--base";
+  problem::ModelRequest request{args.value("--root"),
+                                args.value("--tip"),
+                                args.has("--strict"),
+                                args.has("--attach-beyond-tip"),
+                                args.has("--lock-mimic"),
+                                BaseType::Fixed,
+                                {}};
+  request.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
+  request.names.base = "--base";
   if (args.has("--base")) {
-    const std::string base = args.value("--base");
-    if (base == "free")
-      options.base = BaseType::Free;
-    else if (base == "planar")
-      options.base = BaseType::Planar;
-    else if (base != "fixed")
-      throw UsageError("info", "--base: unknown value '" + printable(base, 40) + "' (expected free, planar or fixed)");
+    try {
+      request.base = problem::parseBaseType(kCommandLine, args.value("--base"));
+    } catch (const problem::ProblemError& e) {
+      throw UsageError("info", std::string("--base: ") + e.what());
+    }
   }
+  const UrdfOptions options = problem::urdfOptions(request);
   Model model;
   try {
     model = loadUrdfFile(path, options);

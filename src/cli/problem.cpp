@@ -11,20 +11,27 @@ namespace zwang::cli {
 
 namespace {
 
-// "local", "world", "aligned" (constraints only), "reference" (relative constraints only).
-Expressed parseExpressed(const JsonReader& in, const Json& value, const std::string& path, bool allow_aligned,
-                         bool allow_reference = false) {
+// Messages quote JSON's way.
+const problem::Spelling kJson{};
+
+// The problem layer's fault at `path` (its key, when it names one, below it).
+[[noreturn]] void fail(const JsonReader& in, const std::string& path, const problem::ProblemError& e) {
+  in.fail(e.key().empty() ? path : childPath(path, e.key()), e.what());
+}
+
+// Run a step of the problem layer, its fault said at `path`.
+template <class F>
+auto atPath(const JsonReader& in, const std::string& path, F step) -> decltype(step()) {
+  try {
+    return step();
+  } catch (const problem::ProblemError& e) {
+    fail(in, path, e);
+  }
+}
+
+Expressed parseExpressed(const JsonReader& in, const Json& value, const std::string& path, problem::AxesOf item) {
   const std::string text = in.string(value, path);
-  if (text == "local") return Expressed::Local;
-  if (text == "world") return Expressed::World;
-  if (allow_aligned && text == "aligned") return Expressed::Aligned;
-  if (allow_reference && text == "reference") return Expressed::Reference;
-  const std::string expected = !allow_aligned     ? "\"local\" or \"world\""
-                               : !allow_reference ? "\"local\", \"world\" or \"aligned\""
-                                                  : "\"local\", \"world\", \"aligned\" or \"reference\"";
-  std::string hint;
-  if (text == "reference" && allow_aligned) hint = "; \"reference\" is for a constraint with \"relative_to\"";
-  in.fail(path, "unknown value \"" + printable(text, 40) + "\" (expected " + expected + hint + ")");
+  return atPath(in, path, [&] { return problem::parseExpressed(kJson, text, item); });
 }
 
 WrenchSpec parseWrench(const JsonReader& in, const Json& value, const std::string& path) {
@@ -34,7 +41,7 @@ WrenchSpec parseWrench(const JsonReader& in, const Json& value, const std::strin
   if (!value.contains("frame")) in.fail(path, "missing key \"frame\" (the link the wrench acts on)");
   w.frame = in.string(value["frame"], childPath(path, "frame"));
   if (value.contains("expressed_in"))
-    w.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), false);
+    w.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), problem::AxesOf::Wrench);
   if (value.contains("force"))
     w.value.head<3>() = in.numbers(value["force"], childPath(path, "force"), 3, "fx, fy, fz");
   if (value.contains("torque"))
@@ -47,12 +54,31 @@ ConstraintSpec parseJointRow(const JsonReader& in, const Json& value, const std:
   in.object(value, path, {"joint", "acceleration"});
   ConstraintSpec c;
   c.path = path;
-  c.joint = in.string(value["joint"], childPath(path, "joint"));
-  if (c.joint.empty()) in.fail(childPath(path, "joint"), "is empty (name the joint whose acceleration is held)");
+  c.desc.joint = in.string(value["joint"], childPath(path, "joint"));
+  if (c.desc.joint.empty()) in.fail(childPath(path, "joint"), "is empty (name the joint whose acceleration is held)");
   // One per DOF of the joint (checked against the model in jointRowIndex); absent: zeros.
   if (value.contains("acceleration"))
     c.acceleration = in.numbers(value["acceleration"], childPath(path, "acceleration"));
   return c;
+}
+
+// "directions": the columns of A, and "acceleration", one per direction (default 0).
+void parseDirections(const JsonReader& in, const Json& value, ConstraintSpec& c) {
+  if (!value.contains("directions"))
+    in.fail(c.path, "missing key \"directions\" (a list of 6-vectors, linear part first)");
+  const std::string dpath = childPath(c.path, "directions");
+  const Json& directions = in.array(value["directions"], dpath);
+  if (directions.empty()) in.fail(dpath, "needs at least one direction");
+  ConstraintMatrix& A = c.desc.A;
+  A.resize(6, static_cast<Eigen::Index>(directions.size()));
+  for (std::size_t k = 0; k < directions.size(); ++k)
+    A.col(static_cast<Eigen::Index>(k)) =
+        in.numbers(directions[k], childPath(dpath, k), 6, "linear part first: lx, ly, lz, rx, ry, rz");
+  if (value.contains("acceleration"))
+    c.acceleration =
+        in.numbers(value["acceleration"], childPath(c.path, "acceleration"), A.cols(), "one per direction");
+  else
+    c.acceleration = Eigen::VectorXd::Zero(A.cols());
 }
 
 ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const std::string& path) {
@@ -60,43 +86,19 @@ ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const st
   in.object(value, path, {"frame", "relative_to", "expressed_in", "directions", "acceleration", "contact"});
   ConstraintSpec c;
   c.path = path;
+  problem::ConstraintDesc& d = c.desc;
   if (!value.contains("frame"))
     in.fail(path, "missing key \"frame\" (the link whose acceleration is constrained) or \"joint\" (a joint row)");
-  c.frame = in.string(value["frame"], childPath(path, "frame"));
-  if (value.contains("relative_to")) {
-    const std::string rpath = childPath(path, "relative_to");
-    c.relative_to = in.string(value["relative_to"], rpath);
-    if (c.relative_to.empty()) in.fail(rpath, "is empty (name the frame the constraint is relative to)");
-    if (c.relative_to == c.frame)
-      in.fail(rpath, "is the constrained frame itself (\"" + printable(c.frame, 60) +
-                         "\"): a relative constraint needs another frame to refer to");
-    c.expressed = Expressed::Reference;  // the default axes of a relative constraint
-  }
-  if (value.contains("contact")) {
-    const std::string cpath = childPath(path, "contact");
-    c.contact = in.boolean(value["contact"], cpath);
-    if (c.contact && !c.relative_to.empty())
-      in.fail(cpath,
-              "is true with \"relative_to\": a relative constraint holds two links of the robot together "
-              "and the motors give its force; a contact is a link against the environment");
-  }
+  d.frame = in.string(value["frame"], childPath(path, "frame"));
+  const bool relative = value.contains("relative_to");
+  if (relative) d.relative_to = in.string(value["relative_to"], childPath(path, "relative_to"));
+  if (value.contains("contact")) d.contact = in.boolean(value["contact"], childPath(path, "contact"));
+  atPath(in, path, [&] { problem::checkRelative(kJson, d, relative); });
+  d.expressed = relative ? Expressed::Reference : Expressed::Local;  // the default axes
   if (value.contains("expressed_in"))
-    c.expressed =
-        parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"), true, !c.relative_to.empty());
-  if (!value.contains("directions"))
-    in.fail(path, "missing key \"directions\" (a list of 6-vectors, linear part first)");
-  const std::string dpath = childPath(path, "directions");
-  const Json& directions = in.array(value["directions"], dpath);
-  if (directions.empty()) in.fail(dpath, "needs at least one direction");
-  c.A.resize(6, static_cast<Eigen::Index>(directions.size()));
-  for (std::size_t k = 0; k < directions.size(); ++k)
-    c.A.col(static_cast<Eigen::Index>(k)) =
-        in.numbers(directions[k], childPath(dpath, k), 6, "linear part first: lx, ly, lz, rx, ry, rz");
-  if (value.contains("acceleration"))
-    c.acceleration =
-        in.numbers(value["acceleration"], childPath(path, "acceleration"), c.A.cols(), "one per direction");
-  else
-    c.acceleration = Eigen::VectorXd::Zero(c.A.cols());
+    d.expressed = parseExpressed(in, value["expressed_in"], childPath(path, "expressed_in"),
+                                 relative ? problem::AxesOf::RelativeConstraint : problem::AxesOf::Constraint);
+  parseDirections(in, value, c);
   return c;
 }
 
@@ -105,41 +107,23 @@ FrictionSpec parseFriction(const JsonReader& in, const Json& value, const std::s
   FrictionSpec f;
   f.present = true;
   if (value.contains("enabled")) f.enabled = in.boolean(value["enabled"], childPath(path, "enabled"));
-  if (value.contains("velocity_tolerance")) {
-    const std::string p = childPath(path, "velocity_tolerance");
-    f.options.velocity_tolerance = in.number(value["velocity_tolerance"], p);
-    if (f.options.velocity_tolerance < 0) in.fail(p, "must be >= 0");
-  }
-  if (value.contains("margin")) {
-    const std::string p = childPath(path, "margin");
-    f.options.margin = in.number(value["margin"], p);
-    if (!(f.options.margin >= 0.0 && f.options.margin <= 1.0)) in.fail(p, "must be between 0 and 1");
-  }
+  if (value.contains("velocity_tolerance"))
+    f.options.velocity_tolerance = in.number(value["velocity_tolerance"], childPath(path, "velocity_tolerance"));
+  if (value.contains("margin")) f.options.margin = in.number(value["margin"], childPath(path, "margin"));
   if (value.contains("limits")) f.options.joint_limits = in.boolean(value["limits"], childPath(path, "limits"));
+  atPath(in, path, [&] { problem::checkFriction(f.options); });
   return f;
 }
 
-// The balance of line 25 (docs/solver.md, "Singular tasks"); the ranges are
-// the library's (checkBalanceOptions), said here with the key's path.
+// The balance of line 25 (docs/solver.md, "Singular tasks"); its ranges are the problem layer's.
 BalanceOptions parseBalance(const JsonReader& in, const Json& value, const std::string& path) {
   in.object(value, path, {"singular_threshold", "rank_tolerance", "residual_tolerance"});
   BalanceOptions o;
-  if (value.contains("singular_threshold")) {
-    const std::string p = childPath(path, "singular_threshold");
-    o.singular_threshold = in.number(value["singular_threshold"], p);
-    if (!(o.singular_threshold > 0.0 && o.singular_threshold < 1.0)) in.fail(p, "must be between 0 and 1 (exclusive)");
-  }
-  if (value.contains("rank_tolerance")) {
-    const std::string p = childPath(path, "rank_tolerance");
-    o.rank_tolerance = in.number(value["rank_tolerance"], p);
-    if (!(o.rank_tolerance >= 0.0 && o.rank_tolerance < o.singular_threshold))
-      in.fail(p, "must be >= 0 and below singular_threshold (" + formatNumber(o.singular_threshold) + ")");
-  }
-  if (value.contains("residual_tolerance")) {
-    const std::string p = childPath(path, "residual_tolerance");
-    o.residual_tolerance = in.number(value["residual_tolerance"], p);
-    if (!(o.residual_tolerance > 0.0)) in.fail(p, "must be positive");
-  }
+  for (const auto& [key, field] : {std::pair<const char*, double*>{"singular_threshold", &o.singular_threshold},
+                                   {"rank_tolerance", &o.rank_tolerance},
+                                   {"residual_tolerance", &o.residual_tolerance}})
+    if (value.contains(key)) *field = in.number(value[key], childPath(path, key));
+  atPath(in, path, [&] { problem::checkBalance(o); });
   return o;
 }
 
@@ -159,8 +143,9 @@ BaseSpec parseBase(const JsonReader& in, const Json& value, const std::string& p
     if (!value.contains(key)) return Eigen::VectorXd::Zero(size);
     return in.numbers(value[key], childPath(path, key), size, what);
   };
-  if (type == "free") {
-    b.type = BaseType::Free;
+  b.type =
+      atPath(in, tpath, [&] { return problem::parseBaseType(kJson, type, "a fixed base needs no \"base\" section"); });
+  if (b.type == BaseType::Free) {
     in.object(value, path, {"type", "position", "orientation", "linear_velocity", "angular_velocity", "force"});
     b.q.resize(7);
     b.q.head<3>() = vector("position", 3, "x, y, z of the base origin in the world");
@@ -183,17 +168,13 @@ BaseSpec parseBase(const JsonReader& in, const Json& value, const std::string& p
     b.v.head<3>() = vector("linear_velocity", 3, "the base origin's velocity in base axes");
     b.v.tail<3>() = vector("angular_velocity", 3, "in base axes");
     b.force = vector("force", 6, "fx, fy, fz, nx, ny, nz: a wrench at the base origin in base axes");
-  } else if (type == "planar") {
-    b.type = BaseType::Planar;
+  } else {
     in.object(value, path, {"type", "position", "yaw", "velocity", "force"});
     b.q.resize(3);
     b.q.head<2>() = vector("position", 2, "x, y in the plane");
     b.q[2] = value.contains("yaw") ? in.number(value["yaw"], childPath(path, "yaw")) : 0.0;
     b.v = vector("velocity", 3, "x, y and yaw rates in the plane's axes");
     b.force = vector("force", 3, "fx, fy in the plane's axes and the torque about its normal");
-  } else {
-    in.fail(tpath, "unknown value \"" + printable(type, 40) + "\" (expected \"free\" or \"planar\"" +
-                       (type == "fixed" ? "; a fixed base needs no \"base\" section" : "") + ")");
   }
   return b;
 }
@@ -226,12 +207,6 @@ Eigen::VectorXd nonNegative(const JsonReader& in, const Json& value, const std::
   return v;
 }
 
-std::string jointList(const Model& model) {
-  std::string list;
-  for (const Joint& joint : model.joints()) list += (list.empty() ? "" : ", ") + joint.name;
-  return list;
-}
-
 // True when every joint below the root has one DOF (the per-joint arrays are then one per joint).
 bool oneDofJoints(const Model& model) { return model.dof() == static_cast<int>(model.joints().size()); }
 
@@ -255,7 +230,7 @@ const char* coordinateNames(JointType type) {
 
 // What an array of the joints' q (configuration) or v (velocity) entries holds, for messages.
 std::string layout(const Model& model, bool configuration) {
-  if (oneDofJoints(model)) return "one per moving joint: " + jointList(model);
+  if (oneDofJoints(model)) return "one per moving joint: " + problem::jointNames(model);
   if (!configuration) return "one per DOF: " + dofList(model);
   std::string list;
   for (const Joint& joint : model.joints()) {
@@ -265,22 +240,14 @@ std::string layout(const Model& model, bool configuration) {
   return "the joints' coordinates in order: " + list;
 }
 
-// The index in joints() of the joint called `name` at `path`; unknown: the error names the model's joints
-// (and where a floating base's state goes, for its root joint).
-int jointIndexAt(const JsonReader& in, const Model& model, const std::string& name, const std::string& path,
-                 const std::string& what) {
-  for (int k = 0; k < static_cast<int>(model.joints().size()); ++k)
-    if (model.joint(k).name == name) return k;
-  if (model.hasFloatingBase() && name == model.allJoints().front().name)
-    in.fail(path, "names the root joint of the " + std::string(toString(model.baseType())) +
-                      " base: its state goes in \"base\"");
-  in.fail(path,
-          "unknown joint \"" + printable(name, 60) + "\"" + what + " (the model's joints: " + jointList(model) + ")");
+// The index in joints() of the joint called `name` at `path` (the problem layer's message when unknown).
+int jointIndexAt(const JsonReader& in, const Model& model, const std::string& name, const std::string& path) {
+  return atPath(in, path, [&] { return problem::jointIndex(kJson, model, name); });
 }
 
 // The joint of a joint row, named in the error with the model's joints when unknown.
 int jointRowIndex(const JsonReader& in, const Model& model, const ConstraintSpec& c) {
-  const int j = jointIndexAt(in, model, c.joint, childPath(c.path, "joint"), "");
+  const int j = jointIndexAt(in, model, c.desc.joint, childPath(c.path, "joint"));
   const Joint& joint = model.joint(j);
   if (c.acceleration.size() != 0 && c.acceleration.size() != joint.nv()) {
     std::string dofs;
@@ -314,7 +281,7 @@ void placeJointValues(const JsonReader& in, const Model& model, const JointValue
   }
   for (const auto& [name, v] : values.named) {
     const std::string path = childPath(key, name);
-    const Joint& joint = model.joint(jointIndexAt(in, model, name, path, ""));
+    const Joint& joint = model.joint(jointIndexAt(in, model, name, path));
     const int size = configuration ? joint.nq() : joint.nv();
     if (v.size() != size) {
       std::string what = "one number";
@@ -331,6 +298,117 @@ void placeJointValues(const JsonReader& in, const Model& model, const JointValue
                         " (joint '" + joint.name + "' is " + toString(joint.type) + ")");
     }
     full.segment(configuration ? joint.q_index : joint.v_index, size) = v;
+  }
+}
+
+// The URDF options of the problem's keys, named as the problem names them in the loader's messages.
+UrdfOptions urdfOptions(const Problem& p) {
+  problem::ModelRequest request{p.root, p.tip, p.strict, p.attach_beyond_tip, p.lock_mimic, p.base.type, {}};
+  request.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
+  request.names.base = "base.type";
+  UrdfOptions urdf = problem::urdfOptions(request);  // a fixed base when there is no "base"
+  urdf.base_may_match_file = true;                   // "base" also names a floating root joint of the file
+  return urdf;
+}
+
+Model loadModel(const JsonReader& in, const Problem& p) {
+  Model model;
+  try {
+    model = loadUrdfFile(p.model_path, urdfOptions(p));
+  } catch (const ModelError& e) {
+    // A relative "model" the loader could not open: say what it was resolved to and why.
+    std::error_code ec;
+    if (!std::filesystem::path(p.model).is_absolute() && !std::filesystem::is_regular_file(p.model_path, ec))
+      in.fail("model", "\"" + printable(p.model, 200) + "\", relative to the problem file, is " + e.what());
+    in.fail("model", e.what());
+  }
+  if (model.hasFloatingBase() && !p.base.present)
+    in.fail("base", std::string("missing: the URDF's root joint gives the robot a ") + toString(model.baseType()) +
+                        " base, whose state the problem must give: \"base\": {\"type\": \"" +
+                        toString(model.baseType()) + "\", …} (docs/cli.md, \"Floating base\")");
+  // An option that would change nothing is refused, as "breakaway" without "friction" is.
+  if (p.follow_leaders && model.mimicJoints().empty())
+    in.fail("follow_leaders", std::string("has no effect: the model has no mimic joints") +
+                                  (p.lock_mimic ? " (\"lock_mimic\": true welded them)" : ""));
+  return model;
+}
+
+// "rotor_inertia" (one per joint) and "breakaway" (one per DOF): their lengths, then the inertias into the model.
+void applyPerJointValues(const JsonReader& in, const Problem& p, Model& model) {
+  const int joints = static_cast<int>(model.joints().size());
+  auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key, long n, bool per_joint) {
+    if (!v || v->size() == n) return;
+    in.fail(key, "has " + std::to_string(v->size()) + (v->size() == 1 ? " entry" : " entries") + ", expected " +
+                     std::to_string(n) + " (" +
+                     (per_joint ? "one per moving joint: " + problem::jointNames(model) : layout(model, false)) + ")");
+  };
+  checkLength(p.rotor_inertia, "rotor_inertia", joints, true);  // a joint's rotor inertia applies to each of its DOFs
+  checkLength(p.breakaway, "breakaway", model.dof(), false);
+  if (!p.rotor_inertia) return;
+  ModelBuilder builder(model);
+  for (int j = 0; j < joints; ++j) {
+    try {
+      builder.setRotorInertia(model.joint(j).name, (*p.rotor_inertia)[j]);
+    } catch (const ModelError& e) {
+      in.fail(childPath("rotor_inertia", static_cast<std::size_t>(j)), e.what());
+    }
+  }
+  try {
+    model = builder.build();
+  } catch (const ModelError& e) {
+    in.fail("rotor_inertia", e.what());
+  }
+}
+
+// q, qd, tau in full: the base's coordinates first, then the joints' (docs/conventions.md, "Floating base").
+// Unset entries: zero, each quaternion the identity (a free base's from "base").
+void placeState(const JsonReader& in, const Problem& p, BoundProblem& b) {
+  const Model& m = b.model;
+  b.q = Eigen::VectorXd::Zero(m.nq());
+  b.qd = Eigen::VectorXd::Zero(m.nv());
+  b.tau = Eigen::VectorXd::Zero(m.nv());
+  for (const Joint& joint : m.joints())
+    if (joint.type == JointType::Spherical || joint.type == JointType::Free)
+      b.q[joint.q_index + (joint.type == JointType::Free ? 3 : 0)] = 1.0;  // w first
+  b.q.head(p.base.q.size()) = p.base.q;
+  b.qd.head(p.base.v.size()) = p.base.v;
+  b.tau.head(p.base.force.size()) = p.base.force;
+  placeJointValues(in, m, p.q, "q", true, b.q);
+  placeJointValues(in, m, p.qd, "qd", false, b.qd);
+  placeJointValues(in, m, p.tau, "tau", false, b.tau);
+  for (const ConstraintSpec& c : p.constraints)  // joint rows: every joint known, one target per DOF
+    if (!c.desc.joint.empty()) (void)jointRowIndex(in, m, c);
+  if (p.follow_leaders) m.followLeaders(b.q, b.qd);  // the followers' entries of "q" and "qd" are replaced
+}
+
+// A frame the solution reports: constrained, reference or loaded, in first appearance order.
+void reportFrame(BoundProblem& b, const std::string& name) {
+  const int f = problem::frameIndex(b.model, name);
+  for (const int g : b.reported_frames)
+    if (g == f) return;
+  b.reported_frames.push_back(f);
+}
+
+// The Task: constraints (the problem layer's choice of Task::add*) with their targets, then the wrenches.
+void buildTask(const JsonReader& in, const Problem& p, BoundProblem& b) {
+  const Model& m = b.model;
+  b.task = std::make_unique<Task>(m);
+  Task& task = *b.task;
+  if (p.gravity) task.gravity = *p.gravity;
+  task.balance = p.balance;
+  for (const ConstraintSpec& c : p.constraints) {
+    const int first = atPath(in, c.path, [&] { return problem::addConstraint(kJson, m, task, c.desc); });
+    Eigen::VectorXd targets = c.acceleration;
+    if (!c.desc.joint.empty() && targets.size() == 0)
+      targets = Eigen::VectorXd::Zero(m.joint(problem::jointIndex(kJson, m, c.desc.joint)).nv());
+    task.targets().segment(first, targets.size()) = targets;
+    if (c.desc.joint.empty()) reportFrame(b, c.desc.frame);
+    if (!c.desc.relative_to.empty()) reportFrame(b, c.desc.relative_to);
+  }
+  for (const WrenchSpec& w : p.wrenches) {
+    const int k = atPath(in, w.path, [&] { return problem::addWrench(m, task, w.frame, w.expressed); });
+    task.wrench(k) = w.value;
+    reportFrame(b, w.frame);
   }
 }
 
@@ -386,120 +464,11 @@ Problem readProblem(const std::string& file) {
 
 BoundProblem bindProblem(const Problem& p) {
   const JsonReader in(p.file);
-  UrdfOptions urdf;
-  urdf.root = p.root;
-  urdf.tip = p.tip;
-  urdf.strict = p.strict;
-  urdf.attach_beyond_tip = p.attach_beyond_tip;
-  urdf.mimic = p.lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
-  urdf.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
-  urdf.names.base = "base.type";
-  urdf.base = p.base.type;          // Fixed when there is no "base"
-  urdf.base_may_match_file = true;  // "base" also names a floating root joint of the file
-  Model model;
-  try {
-    model = loadUrdfFile(p.model_path, urdf);
-  } catch (const ModelError& e) {
-    // A relative "model" the loader could not open: say what it was resolved to and why.
-    std::error_code ec;
-    if (!std::filesystem::path(p.model).is_absolute() && !std::filesystem::is_regular_file(p.model_path, ec))
-      in.fail("model", "\"" + printable(p.model, 200) + "\", relative to the problem file, is " + e.what());
-    in.fail("model", e.what());
-  }
-  if (model.hasFloatingBase() && !p.base.present)
-    in.fail("base", std::string("missing: the URDF's root joint gives the robot a ") + toString(model.baseType()) +
-                        " base, whose state the problem must give: \"base\": {\"type\": \"" +
-                        toString(model.baseType()) + "\", …} (docs/cli.md, \"Floating base\")");
-  // An option that would change nothing is refused, as "breakaway" without "friction" is.
-  if (p.follow_leaders && model.mimicJoints().empty())
-    in.fail("follow_leaders", std::string("has no effect: the model has no mimic joints") +
-                                  (p.lock_mimic ? " (\"lock_mimic\": true welded them)" : ""));
-  const int joints = static_cast<int>(model.joints().size());
-  auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key, long n, bool per_joint) {
-    if (!v || v->size() == n) return;
-    in.fail(key, "has " + std::to_string(v->size()) + (v->size() == 1 ? " entry" : " entries") + ", expected " +
-                     std::to_string(n) + " (" +
-                     (per_joint ? "one per moving joint: " + jointList(model) : layout(model, false)) + ")");
-  };
-  checkLength(p.rotor_inertia, "rotor_inertia", joints, true);  // a joint's rotor inertia applies to each of its DOFs
-  checkLength(p.breakaway, "breakaway", model.dof(), false);
-  if (p.rotor_inertia) {
-    ModelBuilder builder(model);
-    for (int j = 0; j < joints; ++j) {
-      try {
-        builder.setRotorInertia(model.joint(j).name, (*p.rotor_inertia)[j]);
-      } catch (const ModelError& e) {
-        in.fail(childPath("rotor_inertia", static_cast<std::size_t>(j)), e.what());
-      }
-    }
-    try {
-      model = builder.build();
-    } catch (const ModelError& e) {
-      in.fail("rotor_inertia", e.what());
-    }
-  }
-
+  Model model = loadModel(in, p);
+  applyPerJointValues(in, p, model);
   BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, {}, {}};
-  const Model& m = b.model;
-  // The base's coordinates first, then the joints' (docs/conventions.md, "Floating base"). Unset entries:
-  // zero, each quaternion the identity (a free base's from "base").
-  b.q = Eigen::VectorXd::Zero(m.nq());
-  b.qd = Eigen::VectorXd::Zero(m.nv());
-  b.tau = Eigen::VectorXd::Zero(m.nv());
-  for (const Joint& joint : m.joints())
-    if (joint.type == JointType::Spherical || joint.type == JointType::Free)
-      b.q[joint.q_index + (joint.type == JointType::Free ? 3 : 0)] = 1.0;  // w first
-  b.q.head(p.base.q.size()) = p.base.q;
-  b.qd.head(p.base.v.size()) = p.base.v;
-  b.tau.head(p.base.force.size()) = p.base.force;
-  placeJointValues(in, m, p.q, "q", true, b.q);
-  placeJointValues(in, m, p.qd, "qd", false, b.qd);
-  placeJointValues(in, m, p.tau, "tau", false, b.tau);
-  for (const ConstraintSpec& c : p.constraints)  // joint rows: every joint known, one target per DOF
-    if (!c.joint.empty()) (void)jointRowIndex(in, m, c);
-  if (p.follow_leaders) m.followLeaders(b.q, b.qd);  // the followers' entries of "q" and "qd" are replaced
-  b.task = std::make_unique<Task>(m);
-  Task& task = *b.task;
-  if (p.gravity) task.gravity = *p.gravity;
-  task.balance = p.balance;
-
-  auto frameIndex = [&](const std::string& name, const std::string& path, const char* key = "frame") {
-    int f = -1;
-    try {
-      f = m.frameIndex(name);
-    } catch (const ModelError& e) {  // the library's message, with the model's frames
-      in.fail(childPath(path, key), e.what());
-    }
-    bool seen = false;
-    for (const int g : b.reported_frames) seen = seen || g == f;
-    if (!seen) b.reported_frames.push_back(f);
-    return f;
-  };
-  try {
-    for (const ConstraintSpec& c : p.constraints) {
-      int first;
-      Eigen::VectorXd targets = c.acceleration;
-      if (!c.joint.empty()) {
-        const int j = jointRowIndex(in, m, c);
-        first = task.addJointConstraint(j);  // one row per DOF of the joint
-        if (targets.size() == 0) targets = Eigen::VectorXd::Zero(m.joint(j).nv());
-      } else {
-        const int f = frameIndex(c.frame, c.path);
-        first = c.contact ? task.addContact(f, c.A, c.expressed)
-                : c.relative_to.empty()
-                    ? task.addConstraint(f, c.A, c.expressed)
-                    : task.addRelativeConstraint(f, frameIndex(c.relative_to, c.path, "relative_to"), c.A, c.expressed);
-      }
-      task.targets().segment(first, targets.size()) = targets;
-    }
-    for (const WrenchSpec& w : p.wrenches) {
-      const int f = frameIndex(w.frame, w.path);
-      task.wrench(task.addWrench(f, w.expressed)) = w.value;
-    }
-  } catch (const ModelError& e) {
-    in.fail("constraints", e.what());
-  }
-
+  placeState(in, p, b);
+  buildTask(in, p, b);
   b.with_friction = p.friction.present && p.friction.enabled;
   b.friction_options = p.friction.options;
   if (p.breakaway) b.friction_options.breakaway = *p.breakaway;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "problem/problem.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli {
@@ -18,15 +19,12 @@ struct WrenchSpec {
   Vec6 value = Vec6::Zero();  // [force; torque]
 };
 
+// "frame", "relative_to", "expressed_in" (default "reference" for a relative
+// constraint), "directions" (A), "contact", or "joint" (a joint row).
 struct ConstraintSpec {
-  std::string path;  // "constraints[k]"
-  std::string frame;
-  std::string relative_to;  // "relative_to": the reference frame of a relative constraint (empty: the world)
-  Expressed expressed = Expressed::Local;  // default Reference for a relative constraint
-  ConstraintMatrix A;                      // 6 × directions
-  Eigen::VectorXd acceleration;            // one per direction (default 0)
-  bool contact = false;                    // "contact": the environment gives the force (Task::addContact)
-  std::string joint;                       // "joint": a joint row q̈ = acceleration[0] (frame, A unused)
+  std::string path;              // "constraints[k]"
+  problem::ConstraintDesc desc;  // what the problem layer adds to the Task
+  Eigen::VectorXd acceleration;  // one per direction (default 0), one per DOF of a joint row
 };
 
 struct FrictionSpec {

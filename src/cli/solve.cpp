@@ -1,5 +1,4 @@
 // `zwang solve PROBLEM.json [-o FILE] [--pretty]`.
-#include <cmath>
 #include <cstdio>
 
 #include "cli.hpp"
@@ -11,18 +10,12 @@ namespace zwang::cli {
 namespace {
 
 // A configuration outside the joint limits is solved as given (the limits
-// matter to the friction solver only at a stop); it is said once per joint.
-// `q` has the base's coordinates first; "q[k]" is the problem's (the joints'
-// coordinates). Only one-DOF joints have limits.
+// matter to the friction solver only at a stop); it is said once per joint,
+// its "q[k]" the problem's (the joints' coordinates, the base's left out).
 void warnOutsideLimits(const std::string& file, const Model& model, const Eigen::VectorXd& q) {
-  const int base = model.baseConfigurationSize();
-  for (const Joint& joint : model.joints()) {
-    if (joint.nq() != 1) continue;
-    const double qj = q[joint.q_index];
-    if (std::isnan(qj) || (qj >= joint.lower && qj <= joint.upper)) continue;  // NaN: the solve refuses it
-    std::fprintf(stderr, "zwang: warning: %s: q[%d] = %g puts joint '%s' outside its limits [%g, %g]\n", file.c_str(),
-                 joint.q_index - base, qj, printable(joint.name, 4000).c_str(), joint.lower, joint.upper);
-  }
+  problem::forEachOutsideLimits(model, q, model.baseConfigurationSize(), [&](int, const std::string& message) {
+    std::fprintf(stderr, "zwang: warning: %s: %s\n", file.c_str(), message.c_str());
+  });
 }
 
 }  // namespace
@@ -44,10 +37,8 @@ int commandSolve(int argc, char** argv) {
     std::fprintf(stderr, "zwang: warning: %s: %s\n", problem.file.c_str(), printable(w.message, 4000).c_str());
   warnOutsideLimits(problem.file, bound.model, bound.q);
   Workspace ws(bound.model, *bound.task);
-  const Status status =
-      bound.with_friction
-          ? solveWithFriction(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws, bound.friction_options)
-          : solveHybridDynamics(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws);
+  const Status status = problem::solve(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws,
+                                       bound.with_friction ? &bound.friction_options : nullptr);
   const bool infeasible = status.code == StatusCode::Infeasible;
   if (!status && !infeasible) throw CliError(kExitError, problem.file + ": solve: " + status.message);
 

@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "problem/problem.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::python {
@@ -34,6 +35,21 @@ const char* codeName(StatusCode code);
 // Raise the Python exception for a failed Status (never returns).
 [[noreturn]] void raiseStatus(const Status& status, const char* where, py::object result = py::none());
 [[noreturn]] void raise(py::handle type, const std::string& message);
+
+// The problem layer's messages quote Python's way.
+extern const problem::Spelling kPython;
+// A problem layer fault as a Python exception: "WHERE.KEY: what", a ValueError
+// for a bad value, a ModelError for what the model refuses.
+[[noreturn]] void raiseProblem(const std::string& where, const problem::ProblemError& e);
+// Run a step of the problem layer, its fault raised at `where`.
+template <class F>
+auto checked(const std::string& where, F step) -> decltype(step()) {
+  try {
+    return step();
+  } catch (const problem::ProblemError& e) {
+    raiseProblem(where, e);
+  }
+}
 
 // ---- conversions (convert.cpp) ----------------------------------------------
 // A 1-D real array argument. A contiguous float64 array is read in place; any
@@ -62,14 +78,9 @@ py::array matrixCopy(const Eigen::Ref<const Eigen::MatrixXd>& m);
 
 // ---- task description objects (solve.cpp) ------------------------------------
 struct Constraint {
-  std::uint64_t serial;  // identity for the workspace's task cache (frame, A, expressed are immutable)
-  std::string frame;
-  std::string relative_to;  // the reference frame of a relative constraint (empty: the world)
-  Expressed expressed;
-  ConstraintMatrix A;
-  Eigen::VectorXd b;     // set points, mutable
-  bool contact = false;  // the environment supplies its force (Task::addContact)
-  std::string joint;     // a joint row (Constraint.on_joint, Task::addJointConstraint): frame and A unused
+  std::uint64_t serial;          // identity for the workspace's task cache (desc is immutable)
+  problem::ConstraintDesc desc;  // frame, relative_to, joint, expressed, A, contact
+  Eigen::VectorXd b;             // set points, mutable
 };
 
 struct Wrench {

@@ -134,16 +134,10 @@ ConstraintMatrix constraintMatrixArg(const char* name, py::handle value) {
 }
 
 Expressed expressedArg(const char* name, const std::string& text, bool allow_aligned, bool allow_reference) {
-  if (text == "local") return Expressed::Local;
-  if (text == "world") return Expressed::World;
-  if (allow_aligned && text == "aligned") return Expressed::Aligned;
-  if (allow_reference && text == "reference") return Expressed::Reference;
-  const std::string expected = !allow_aligned     ? "'local' or 'world'"
-                               : !allow_reference ? "'local', 'world' or 'aligned'"
-                                                  : "'local', 'world', 'aligned' or 'reference'";
-  const std::string hint =
-      text == "reference" && allow_aligned ? "; 'reference' is for a constraint with relative_to=" : "";
-  raise(PyExc_ValueError, std::string(name) + ": unknown value '" + text + "' (expected " + expected + hint + ")");
+  const problem::AxesOf axes = !allow_aligned     ? problem::AxesOf::Wrench
+                               : !allow_reference ? problem::AxesOf::Constraint
+                                                  : problem::AxesOf::RelativeConstraint;
+  return checked(name, [&] { return problem::parseExpressed(kPython, text, axes); });
 }
 
 const char* expressedName(Expressed e) {

@@ -15,24 +15,13 @@ std::string pathArg(py::handle path) {
   return fs.cast<std::string>();
 }
 
-BaseType baseArg(const std::string& base) {
-  if (base == "fixed") return BaseType::Fixed;
-  if (base == "free") return BaseType::Free;
-  if (base == "planar") return BaseType::Planar;
-  raise(PyExc_ValueError, "base: unknown value '" + base + "' (expected 'fixed', 'free' or 'planar')");
-}
-
 UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia, bool strict,
                         bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
-  UrdfOptions options;
-  options.root = root;
-  options.tip = tip;
-  options.strict = strict;
-  options.attach_beyond_tip = attach_beyond_tip;
-  options.mimic = lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
-  options.base = baseArg(base);
-  options.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
-  options.names.base = "base='" + base + "'";
+  problem::ModelRequest request{root, tip, strict, attach_beyond_tip, lock_mimic, BaseType::Fixed, {}};
+  request.base = checked("base", [&] { return problem::parseBaseType(kPython, base); });
+  request.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
+  request.names.base = "base='" + base + "'";
+  UrdfOptions options = problem::urdfOptions(request);
   if (!rotor_inertia.is_none()) {
     if (!py::isinstance<py::dict>(rotor_inertia))
       raise(PyExc_TypeError, "rotor_inertia: expected a dict {joint name: inertia}");
@@ -42,12 +31,6 @@ UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const p
     }
   }
   return options;
-}
-
-std::string jointNames(const Model& model) {
-  std::string s;
-  for (const Joint& j : model.joints()) s += (s.empty() ? "" : ", ") + j.name;
-  return s;
 }
 
 int jointCount(const Model& model) { return static_cast<int>(model.joints().size()); }
@@ -78,7 +61,7 @@ Eigen::VectorXd perJointArg(const Model& model, const char* name, py::handle val
     const std::string dofs = model.dof() == joints ? "" : std::to_string(model.dof()) + " DOFs and ";
     raise(exceptions().model_error, std::string(name) + ": has " + std::to_string(v.size()) +
                                         " entries, the model has " + dofs + std::to_string(joints) + " joints (" +
-                                        jointNames(model) + ")");
+                                        problem::jointNames(model) + ")");
   }
   Eigen::VectorXd per_joint(joints);
   const int below = model.nv() - model.dof();
@@ -153,14 +136,14 @@ RigidInertia inertiaArg(double mass, py::handle com, py::handle inertia) {
 }
 
 BaseType floatingBaseArg(const std::string& type) {
-  if (type == "free") return BaseType::Free;
-  if (type == "planar") return BaseType::Planar;
-  raise(PyExc_ValueError, "set_base: unknown base '" + type + "' (expected 'free' or 'planar')");
+  return checked("set_base",
+                 [&] { return problem::parseBaseType(kPython, type, "a fixed base is a builder without set_base"); });
 }
 
-}  // namespace
+using ModelClass = py::class_<Model, std::shared_ptr<Model>>;
 
-void bindModel(py::module_& m) {
+// Joint: a moving joint, read-only.
+void bindJoint(py::module_& m) {
   py::class_<Joint>(m, "Joint", "A moving joint of the model (read-only; SI units, radians).")
       .def_property_readonly("name", [](const Joint& j) { return j.name; })
       .def_property_readonly(
@@ -202,7 +185,10 @@ void bindModel(py::module_& m) {
           },
           "None, or (leader joint index, multiplier, offset) when the joint follows q = multiplier*q_leader + offset")
       .def("__repr__", &jointRepr);
+}
 
+// Dof: one entry of qd.
+void bindDof(py::module_& m) {
   py::class_<Dof>(m, "Dof",
                   "One degree of freedom, entry k of qd (Model.dofs): a rotation about or a translation along one axis "
                   "(read-only).")
@@ -224,7 +210,10 @@ void bindModel(py::module_& m) {
       .def_property_readonly("lower", [](const Dof& d) { return d.lower; })
       .def_property_readonly("upper", [](const Dof& d) { return d.upper; })
       .def("__repr__", [](const Dof& d) { return "<zwang.Dof '" + d.name + "'>"; });
+}
 
+// Frame: a named frame on a body.
+void bindFrame(py::module_& m) {
   py::class_<Frame>(m, "Frame", "A named frame (every URDF link), rigidly attached to a body.")
       .def_property_readonly("name", [](const Frame& f) { return f.name; })
       .def_property_readonly(
@@ -237,10 +226,11 @@ void bindModel(py::module_& m) {
           "4×4 pose of the frame in its body frame")
       .def("__repr__",
            [](const Frame& f) { return "<zwang.Frame '" + f.name + "' on body " + std::to_string(f.body) + ">"; });
+}
 
-  py::class_<Model, std::shared_ptr<Model>>(
-      m, "Model", "An immutable kinematic tree or chain (zwang::Model). Make one with load_urdf().")
-      .def_property_readonly("name", &Model::name)
+// Model: its sizes, names, joints, frames and DOFs, and the look-ups.
+void addSizesAndNames(ModelClass& cls) {
+  cls.def_property_readonly("name", &Model::name)
       .def_property_readonly("dof", &Model::dof,
                              "degrees of freedom below the root: nv without a floating base's (the number of joints "
                              "when every joint has one DOF); the length of the per-DOF arrays (friction, limits)")
@@ -308,9 +298,13 @@ void bindModel(py::module_& m) {
           },
           py::arg("q"), py::arg("qd"),
           "copies of q (nq entries) and qd (nv) with each mimic joint's entries set from its leader's "
-          "(q = a*q_leader + b, qd = a*qd_leader)")
-      .def_property_readonly("body_count", &Model::bodyCount,
-                             "nv + 1: body 0 (the world, or a fixed base) and one body per DOF (DOF k moves body k+1)")
+          "(q = a*q_leader + b, qd = a*qd_leader)");
+}
+
+// Model: the bodies' tree.
+void addTree(ModelClass& cls) {
+  cls.def_property_readonly("body_count", &Model::bodyCount,
+                            "nv + 1: body 0 (the world, or a fixed base) and one body per DOF (DOF k moves body k+1)")
       .def_property_readonly("base_body", &Model::baseBody,
                              "the root link's body: 0 on a fixed base, 6 (free) or 3 (planar) on a floating one")
       .def_property_readonly("is_chain", &Model::isChain, "True when every body's parent is the body before it")
@@ -338,9 +332,13 @@ void bindModel(py::module_& m) {
           [](const Model& model, int a, int b) {
     return model.supports(bodyArg(model, "supports", a), bodyArg(model, "supports", b));
           },
-          py::arg("a"), py::arg("b"), "True when body a is body b or one of its ancestors")
-      .def_property_readonly("lower",
-                             [](const Model& model) { return perDof(model, [](const Joint& j) { return j.lower; }); })
+          py::arg("a"), py::arg("b"), "True when body a is body b or one of its ancestors");
+}
+
+// Model: the per-DOF arrays, warnings and masses.
+void addPerDofArrays(ModelClass& cls) {
+  cls.def_property_readonly("lower",
+                            [](const Model& model) { return perDof(model, [](const Joint& j) { return j.lower; }); })
       .def_property_readonly("upper",
                              [](const Model& model) { return perDof(model, [](const Joint& j) { return j.upper; }); })
       .def_property_readonly(
@@ -381,18 +379,22 @@ void bindModel(py::module_& m) {
       if (b != model.baseBody()) mass += model.inertia(b).mass;
     return mass;
           },
-          "total mass of the bodies beyond the base [kg] (base_mass is the base's)")
-      .def(
-          "with_rotor_inertia",
-          [](const Model& model, py::handle values) {
+          "total mass of the bodies beyond the base [kg] (base_mass is the base's)");
+}
+
+// Model: copies with other rotor inertias or friction.
+void addCopies(ModelClass& cls) {
+  cls.def(
+         "with_rotor_inertia",
+         [](const Model& model, py::handle values) {
     const Eigen::VectorXd v = perJointArg(model, "rotor_inertia", values);
     ModelBuilder builder(model);
     for (int j = 0; j < jointCount(model); ++j) builder.setRotorInertia(model.joint(j).name, v[j]);
     return std::make_shared<Model>(builder.build());
-          },
-          py::arg("rotor_inertia"),
-          "a copy with these reflected rotor inertias, one per joint or one per DOF (model.dof entries; a joint's\n"
-          "DOFs must agree)")
+         },
+         py::arg("rotor_inertia"),
+         "a copy with these reflected rotor inertias, one per joint or one per DOF (model.dof entries; a joint's\n"
+         "DOFs must agree)")
       .def(
           "with_friction",
           [](const Model& model, py::handle breakaway, py::handle kinetic, py::handle viscous) {
@@ -415,9 +417,33 @@ void bindModel(py::module_& m) {
                                                                ", nv=" + std::to_string(model.nv()) + ", "
                                                          : std::string();
         return "<zwang.Model '" + model.name() + "': " + base + std::to_string(jointCount(model)) + " joints (" +
-               jointNames(model) + "), " + std::to_string(model.frames().size()) + " frames>";
+               problem::jointNames(model) + "), " + std::to_string(model.frames().size()) + " frames>";
       });
+}
 
+// ModelBuilder.add_joint: a Joint from the keyword arguments.
+ModelBuilder& addJoint(ModelBuilder& b, const std::string& name, const std::string& type, const std::string& child,
+                       const std::string& parent, py::handle axis, py::handle placement, double mass, py::handle com,
+                       py::handle inertia, double lower, double upper, double effort_limit, double velocity_limit,
+                       double rotor_inertia, double breakaway, double kinetic, double viscous) {
+  Joint joint;
+  joint.name = name;
+  joint.type = jointTypeArg(type);
+  joint.axis = vec3Arg("axis", axis);
+  joint.placement = poseArg("placement", placement);
+  joint.lower = lower;
+  joint.upper = upper;
+  joint.effort_limit = effort_limit;
+  joint.velocity_limit = velocity_limit;
+  joint.rotor_inertia = rotor_inertia;
+  joint.breakaway_friction = breakaway;
+  joint.kinetic_friction = kinetic;
+  joint.viscous_friction = viscous;
+  return b.addJoint(joint, child, inertiaArg(mass, com, inertia), parent);
+}
+
+// ModelBuilder: a Model joint by joint.
+void bindModelBuilder(py::module_& m) {
   py::class_<ModelBuilder>(m, "ModelBuilder",
                            "Builds a Model joint by joint (zwang::ModelBuilder): any joint type anywhere in the tree,\n"
                            "depth first. Each method returns the builder; build() returns the Model. Bad values raise\n"
@@ -426,42 +452,21 @@ void bindModel(py::module_& m) {
            "an empty tree: the fixed base alone, a frame called base_frame")
       .def(py::init([](const Model& model) { return ModelBuilder(model); }), py::arg("model"),
            "start from an existing model (to add joints below its last link)")
-      .def(
-          "add_joint",
-          [](ModelBuilder& b, const std::string& name, const std::string& type, const std::string& child,
-             const std::string& parent, py::handle axis, py::handle placement, double mass, py::handle com,
-             py::handle inertia, double lower, double upper, double effort_limit, double velocity_limit,
-             double rotor_inertia, double breakaway, double kinetic, double viscous) -> ModelBuilder& {
-            Joint joint;
-            joint.name = name;
-            joint.type = jointTypeArg(type);
-            joint.axis = vec3Arg("axis", axis);
-            joint.placement = poseArg("placement", placement);
-            joint.lower = lower;
-            joint.upper = upper;
-            joint.effort_limit = effort_limit;
-            joint.velocity_limit = velocity_limit;
-            joint.rotor_inertia = rotor_inertia;
-            joint.breakaway_friction = breakaway;
-            joint.kinetic_friction = kinetic;
-            joint.viscous_friction = viscous;
-            return b.addJoint(joint, child, inertiaArg(mass, com, inertia), parent);
-          },
-          py::arg("name"), py::arg("type"), py::arg("child"), py::kw_only(), py::arg("parent") = "",
-          py::arg("axis") = py::make_tuple(0.0, 0.0, 1.0), py::arg("placement") = py::none(), py::arg("mass") = 0.0,
-          py::arg("com") = py::make_tuple(0.0, 0.0, 0.0), py::arg("inertia") = py::none(),
-          py::arg("lower") = -std::numeric_limits<double>::infinity(),
-          py::arg("upper") = std::numeric_limits<double>::infinity(),
-          py::arg("effort_limit") = std::numeric_limits<double>::infinity(),
-          py::arg("velocity_limit") = std::numeric_limits<double>::infinity(), py::arg("rotor_inertia") = 0.0,
-          py::arg("breakaway_friction") = 0.0, py::arg("kinetic_friction") = 0.0, py::arg("viscous_friction") = 0.0,
-          py::return_value_policy::reference_internal,
-          "Add a moving joint of any type ('revolute', 'continuous', 'prismatic', 'spherical', 'planar', 'free')\n"
-          "whose child link is the new frame `child`, hanging from the frame `parent` (default: the last link\n"
-          "added; depth first: the last link or one of its ancestors). placement: 4×4 pose of the joint frame in\n"
-          "the parent link at q = 0 (None: identity); axis: one-DOF joints only. The child link's mass, com and\n"
-          "3×3 inertia about the com (None: zero) are in its frame. Rotor inertia and friction apply to each DOF\n"
-          "(a box per DOF); multi-DOF joints take no finite limits.")
+      .def("add_joint", &addJoint, py::arg("name"), py::arg("type"), py::arg("child"), py::kw_only(),
+           py::arg("parent") = "", py::arg("axis") = py::make_tuple(0.0, 0.0, 1.0), py::arg("placement") = py::none(),
+           py::arg("mass") = 0.0, py::arg("com") = py::make_tuple(0.0, 0.0, 0.0), py::arg("inertia") = py::none(),
+           py::arg("lower") = -std::numeric_limits<double>::infinity(),
+           py::arg("upper") = std::numeric_limits<double>::infinity(),
+           py::arg("effort_limit") = std::numeric_limits<double>::infinity(),
+           py::arg("velocity_limit") = std::numeric_limits<double>::infinity(), py::arg("rotor_inertia") = 0.0,
+           py::arg("breakaway_friction") = 0.0, py::arg("kinetic_friction") = 0.0, py::arg("viscous_friction") = 0.0,
+           py::return_value_policy::reference_internal,
+           "Add a moving joint of any type ('revolute', 'continuous', 'prismatic', 'spherical', 'planar', 'free')\n"
+           "whose child link is the new frame `child`, hanging from the frame `parent` (default: the last link\n"
+           "added; depth first: the last link or one of its ancestors). placement: 4×4 pose of the joint frame in\n"
+           "the parent link at q = 0 (None: identity); axis: one-DOF joints only. The child link's mass, com and\n"
+           "3×3 inertia about the com (None: zero) are in its frame. Rotor inertia and friction apply to each DOF\n"
+           "(a box per DOF); multi-DOF joints take no finite limits.")
       .def(
           "add_fixed_frame",
           [](ModelBuilder& b, const std::string& name, const std::string& parent, py::handle placement, double mass,
@@ -498,7 +503,10 @@ void bindModel(py::module_& m) {
       .def(
           "build", [](const ModelBuilder& b) { return issueWarnings(std::make_shared<Model>(b.build())); },
           "the Model (ModelError when a moving body has no inertia to move); warnings as load_urdf issues them");
+}
 
+// load_urdf, load_urdf_string.
+void bindLoaders(py::module_& m) {
   m.def(
       "load_urdf",
       [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
@@ -531,6 +539,21 @@ void bindModel(py::module_& m) {
       py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
       py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,
       py::arg("base") = "fixed", "load_urdf from a string holding the URDF XML.");
+}
+
+}  // namespace
+
+void bindModel(py::module_& m) {
+  bindJoint(m);
+  bindDof(m);
+  bindFrame(m);
+  ModelClass cls(m, "Model", "An immutable kinematic tree or chain (zwang::Model). Make one with load_urdf().");
+  addSizesAndNames(cls);
+  addTree(cls);
+  addPerDofArrays(cls);
+  addCopies(cls);
+  bindModelBuilder(m);
+  bindLoaders(m);
 }
 
 }  // namespace zwang::python

@@ -44,6 +44,14 @@ void raise(py::handle type, const std::string& message) {
   throw py::error_already_set();
 }
 
+const problem::Spelling kPython{'\'', "comes first in q, qd and tau"};
+
+void raiseProblem(const std::string& where, const problem::ProblemError& e) {
+  const std::string path = e.key().empty() ? where : where.empty() ? e.key() : where + "." + e.key();
+  const py::handle type = e.fault() == problem::Fault::Value ? py::handle(PyExc_ValueError) : exceptions().model_error;
+  raise(type, (path.empty() ? "" : path + ": ") + e.what());
+}
+
 void raiseStatus(const Status& status, const char* where, py::object result) {
   const Exceptions& e = exceptions();
   const py::handle type = status.code == StatusCode::Infeasible ? e.infeasible_error : e.solve_error;

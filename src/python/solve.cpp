@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 
 #include "bindings.hpp"
 
@@ -21,20 +20,6 @@ const Vec3 kDefaultGravity(0.0, 0.0, -9.81);
 // The code of a solve's q outside a joint's limits in Result.warnings (the
 // task's warnings have their WarningCode's name).
 const char* const kOutsideLimits = "outside_limits";
-
-[[noreturn]] void raiseModelError(const std::string& where, const std::exception& e) {
-  raise(exceptions().model_error, where + ": " + e.what());
-}
-
-// Unknown frame names are reported with the model's frames (Model::frameIndex's message).
-void checkFrame(const Model& model, const std::string& where, const std::string& frame) {
-  if (model.hasFrame(frame)) return;
-  try {
-    (void)model.frameIndex(frame);
-  } catch (const ModelError& e) {
-    raiseModelError(where, e);
-  }
-}
 
 PyWorkspace& workspaceArg(const std::shared_ptr<Model>& model, py::handle ws_obj) {
   if (!py::isinstance<PyWorkspace>(ws_obj))
@@ -106,16 +91,13 @@ void copySerials(const std::vector<T*>& items, std::vector<std::uint64_t>& seria
 std::vector<Constraint*> g_constraints;
 std::vector<Wrench*> g_wrenches;
 
-// The frames of g_wrenches into a task being built (ModelError "wrenches[k]: …"
-// for an unknown frame).
+// The frames of g_wrenches into a task being built (the problem layer's
+// ModelError "wrenches[k].frame: …" for an unknown frame).
 void addWrenches(const Model& model, Task& task) {
   for (std::size_t k = 0; k < g_wrenches.size(); ++k) {
-    checkFrame(model, "wrenches[" + std::to_string(k) + "]", g_wrenches[k]->frame);
-    try {
-      task.addWrench(g_wrenches[k]->frame, g_wrenches[k]->expressed);
-    } catch (const ModelError& e) {
-      raiseModelError("wrenches[" + std::to_string(k) + "]", e);
-    }
+    const Wrench& w = *g_wrenches[k];
+    checked("wrenches[" + std::to_string(k) + "]",
+            [&] { return problem::addWrench(model, task, w.frame, w.expressed); });
   }
 }
 
@@ -123,14 +105,6 @@ void addWrenches(const Model& model, Task& task) {
 void writeWrenchesAndGravity(Task& task, py::handle gravity) {
   for (std::size_t k = 0; k < g_wrenches.size(); ++k) task.wrench(static_cast<int>(k)) = g_wrenches[k]->value;
   task.gravity = gravity.is_none() ? kDefaultGravity : vec3Arg("gravity", gravity);
-}
-
-// One Constraint's rows into a task being built; its first row (ModelError for an unknown joint).
-int addConstraintRows(Task& task, const Constraint& c) {
-  if (!c.joint.empty()) return task.addJointConstraint(c.joint);
-  if (c.contact) return task.addContact(c.frame, c.A, c.expressed);
-  if (!c.relative_to.empty()) return task.addRelativeConstraint(c.frame, c.relative_to, c.A, c.expressed);
-  return task.addConstraint(c.frame, c.A, c.expressed);
 }
 
 // The workspace's task for these constraints and wrenches: rebuilt (allocating)
@@ -143,17 +117,10 @@ Task& solveTask(PyWorkspace& pw, py::handle constraints, py::handle wrenches, py
       !sameSerials(g_wrenches, pw.wrench_serials)) {
     auto task = std::make_unique<Task>(*pw.model);
     std::vector<int> first_rows;
-    for (std::size_t k = 0; k < g_constraints.size(); ++k) {
-      const Constraint& c = *g_constraints[k];
-      if (c.joint.empty()) checkFrame(*pw.model, "constraints[" + std::to_string(k) + "]", c.frame);
-      if (!c.relative_to.empty())
-        checkFrame(*pw.model, "constraints[" + std::to_string(k) + "].relative_to", c.relative_to);
-      try {
-        first_rows.push_back(addConstraintRows(*task, c));
-      } catch (const ModelError& e) {
-        raiseModelError("constraints[" + std::to_string(k) + "]", e);
-      }
-    }
+    for (std::size_t k = 0; k < g_constraints.size(); ++k)  // the problem layer's choice of Task::add*
+      first_rows.push_back(checked("constraints[" + std::to_string(k) + "]", [&] {
+        return problem::addConstraint(kPython, *pw.model, *task, g_constraints[k]->desc);
+      }));
     addWrenches(*pw.model, *task);
     pw.ensureCapacity(task->constraintRows());
     pw.task = std::move(task);
@@ -252,21 +219,11 @@ void warnOnce(const std::shared_ptr<Model>& model, Result& r, const std::string&
 }
 
 // A configuration outside the joint limits is solved as given; say so. Kept
-// out of the C++ solve, which must not allocate.
-// q[k] names the entry of the full q (a floating base's coordinates first).
+// out of the C++ solve, which must not allocate. q[k] names the entry of the
+// full q (a floating base's coordinates first).
 void warnOutsideLimits(const std::shared_ptr<Model>& model, const Eigen::Ref<const Eigen::VectorXd>& q, Result& r) {
-  for (int j = 0; j < static_cast<int>(model->joints().size()); ++j) {
-    const Joint& joint = model->joint(j);
-    if (joint.nq() != 1) continue;  // multi-DOF joints have no position limits
-    const double qj = q[joint.q_index];
-    if (qj >= joint.lower && qj <= joint.upper) continue;
-    char figures[120];
-    std::snprintf(figures, sizeof figures, "%g puts joint '", qj);
-    char limits[80];
-    std::snprintf(limits, sizeof limits, "' outside its limits [%g, %g]", joint.lower, joint.upper);
-    warnOnce(model, r, kOutsideLimits, j,
-             "q[" + std::to_string(joint.q_index) + "] = " + figures + joint.name + limits);
-  }
+  problem::forEachOutsideLimits(
+      *model, q, 0, [&](int joint, const std::string& message) { warnOnce(model, r, kOutsideLimits, joint, message); });
 }
 
 Vec6 frameAccelerationOf(const Result& r, int frame, Expressed e) {
@@ -335,8 +292,10 @@ const FrictionResult& Result::friction() const {
 
 py::handle Result::base() const { return data ? data_base : owner; }
 
-void bindSolve(py::module_& m) {
-  // ---- Workspace -----------------------------------------------------------
+namespace {
+
+// Workspace, and Model.workspace().
+void bindWorkspace(py::module_& m) {
   py::class_<PyWorkspace>(m, "Workspace",
                           "Scratch memory of the solver for one model (zwang::Workspace) and the task built from the\n"
                           "last constraints/wrenches lists. One per thread. Results of solve() are views on it.")
@@ -358,8 +317,50 @@ void bindSolve(py::module_& m) {
       "workspace",
       [](std::shared_ptr<Model> model, int rows) { return std::make_unique<PyWorkspace>(std::move(model), rows); },
       py::arg("max_constraint_rows") = 6, "zwang.Workspace(model, max_constraint_rows)");
+}
 
-  // ---- Constraint ----------------------------------------------------------
+std::string typeName(py::handle value) { return py::str(py::type::handle_of(value).attr("__name__")); }
+
+// relative_to=: a frame name, or None for a constraint on the world.
+std::string relativeToArg(py::handle relative_to) {
+  if (relative_to.is_none()) return {};
+  if (!py::isinstance<py::str>(relative_to))
+    raise(PyExc_TypeError, "relative_to: expected a frame name (str) or None, got " + typeName(relative_to));
+  return relative_to.cast<std::string>();
+}
+
+// zwang.Constraint(frame, A, b, expressed, relative_to, contact=): the problem layer's checks and defaults.
+Constraint makeConstraint(const std::string& frame, py::handle A, py::handle b, py::handle expressed,
+                          py::handle relative_to, bool contact) {
+  Constraint c{g_next_serial++, {}, {}};
+  problem::ConstraintDesc& d = c.desc;
+  d.frame = frame;
+  d.relative_to = relativeToArg(relative_to);
+  d.contact = contact;
+  const bool relative = !relative_to.is_none();
+  checked("", [&] { problem::checkRelative(kPython, d, relative); });
+  std::string axes = relative ? "reference" : "local";
+  if (!expressed.is_none()) {
+    if (!py::isinstance<py::str>(expressed))
+      raise(PyExc_TypeError, "expressed: expected a str, got " + typeName(expressed));
+    axes = expressed.cast<std::string>();
+  }
+  d.expressed = expressedArg("expressed", axes, true, relative);
+  d.A = constraintMatrixArg("A", A);
+  c.b.setZero(d.A.cols());
+  if (!b.is_none()) {
+    Eigen::VectorXd buffer;
+    const auto v = vectorArg("b", b, buffer);
+    if (v.size() != d.A.cols())
+      raise(PyExc_ValueError,
+            "b: has " + std::to_string(v.size()) + " entries, A has " + std::to_string(d.A.cols()) + " columns");
+    c.b = v;
+  }
+  return c;
+}
+
+// Constraint: a frame's, a relative, a contact's or a joint's rows.
+void bindConstraint(py::module_& m) {
   py::class_<Constraint>(m, "Constraint",
                          "Acceleration constraint A^T Xdd = b on a frame (classical, true accelerations of the frame\n"
                          "origin; gravity not included). A is 6×m, its columns unit constraint forces, linear part\n"
@@ -370,79 +371,44 @@ void bindSolve(py::module_& m) {
                          "the task. contact=True: the environment gives the force (a foot on the ground,\n"
                          "Task::addContact): nu is the contact force, left out of tau_constraint and tau_control.\n"
                          "Constraint.on_joint(joint, b): one row qdd_joint = b (Task::addJointConstraint).")
-      .def(py::init([](const std::string& frame, py::handle A, py::handle b, py::handle expressed,
-                       py::handle relative_to, bool contact) {
-             std::string reference;
-             if (!relative_to.is_none()) {
-               if (!py::isinstance<py::str>(relative_to))
-                 raise(PyExc_TypeError, "relative_to: expected a frame name (str) or None, got " +
-                                            std::string(py::str(py::type::handle_of(relative_to).attr("__name__"))));
-               reference = relative_to.cast<std::string>();
-               if (reference == frame)
-                 raise(exceptions().model_error, "relative_to: is the constrained frame itself ('" + frame +
-                                                     "'): a relative constraint needs another frame to refer to");
-               if (contact)
-                 raise(PyExc_ValueError,
-                       "contact=True with relative_to: a relative constraint holds two links of "
-                       "the robot together, the motors give its force; a contact is a link "
-                       "against the environment");
-             }
-             std::string axes = reference.empty() ? "local" : "reference";
-             if (!expressed.is_none()) {
-               if (!py::isinstance<py::str>(expressed))
-                 raise(PyExc_TypeError, "expressed: expected a str, got " +
-                                            std::string(py::str(py::type::handle_of(expressed).attr("__name__"))));
-               axes = expressed.cast<std::string>();
-             }
-             Constraint c{g_next_serial++,
-                          frame,
-                          reference,
-                          expressedArg("expressed", axes, true, !reference.empty()),
-                          constraintMatrixArg("A", A),
-                          {},
-                          contact,
-                          {}};
-             c.b.setZero(c.A.cols());
-             if (!b.is_none()) {
-               Eigen::VectorXd buffer;
-               const auto v = vectorArg("b", b, buffer);
-               if (v.size() != c.A.cols())
-                 raise(PyExc_ValueError, "b: has " + std::to_string(v.size()) + " entries, A has " +
-                                             std::to_string(c.A.cols()) + " columns");
-               c.b = v;
-             }
-             return c;
-           }),
-           py::arg("frame"), py::arg("A"), py::arg("b") = py::none(), py::arg("expressed") = py::none(),
-           py::arg("relative_to") = py::none(), py::kw_only(), py::arg("contact") = false)
+      .def(py::init(&makeConstraint), py::arg("frame"), py::arg("A"), py::arg("b") = py::none(),
+           py::arg("expressed") = py::none(), py::arg("relative_to") = py::none(), py::kw_only(),
+           py::arg("contact") = false)
       .def_static(
           "on_joint",
           [](const std::string& joint, double b) {
-    Constraint c{g_next_serial++, {}, {}, Expressed::Local, ConstraintMatrix::Zero(6, 1), {}, false, joint};
-    c.b = Eigen::VectorXd::Constant(1, b);
+    Constraint c{g_next_serial++, {}, Eigen::VectorXd::Constant(1, b)};
+    c.desc.joint = joint;
+    c.desc.A = ConstraintMatrix::Zero(6, 1);
     return c;
           },
           py::arg("joint"), py::arg("b") = 0.0,
           "A joint row: qdd of this joint = b (Task::addJointConstraint); its nu is the motor torque that holds\n"
           "it, part of tau_control. ModelError at solve for an unknown joint.")
       .def_property_readonly(
-          "joint", [](const Constraint& c) { return c.joint.empty() ? py::object(py::none()) : py::str(c.joint); },
+          "joint",
+          [](const Constraint& c) { return c.desc.joint.empty() ? py::object(py::none()) : py::str(c.desc.joint); },
           "the joint of a joint row (Constraint.on_joint), else None")
       .def_property_readonly(
-          "contact", [](const Constraint& c) { return c.contact; },
+          "contact", [](const Constraint& c) { return c.desc.contact; },
           "True when the environment supplies the force (a foot on the ground): it moves the robot like any\n"
           "constraint, its nu is the contact force, and it is left out of tau_constraint and tau_control")
-      .def_property_readonly("frame", [](const Constraint& c) { return c.frame; })
+      .def_property_readonly("frame", [](const Constraint& c) { return c.desc.frame; })
       .def_property_readonly(
           "relative_to",
-          [](const Constraint& c) { return c.relative_to.empty() ? py::object(py::none()) : py::str(c.relative_to); },
+          [](const Constraint& c) {
+    return c.desc.relative_to.empty() ? py::object(py::none()) : py::str(c.desc.relative_to);
+          },
           "the frame a relative constraint refers to (None: the world)")
-      .def_property_readonly("expressed", [](const Constraint& c) { return std::string(expressedName(c.expressed)); })
+      .def_property_readonly("expressed",
+                             [](const Constraint& c) { return std::string(expressedName(c.desc.expressed)); })
       .def_property_readonly(
           "A",
-          [](const Constraint& c) { return c.joint.empty() ? py::object(matrixCopy(c.A)) : py::object(py::none()); },
+          [](const Constraint& c) {
+    return c.desc.joint.empty() ? py::object(matrixCopy(c.desc.A)) : py::object(py::none());
+          },
           "6×m (a copy); None for a joint row")
-      .def_property_readonly("rows", [](const Constraint& c) { return c.A.cols(); })
+      .def_property_readonly("rows", [](const Constraint& c) { return c.desc.A.cols(); })
       .def_property(
           "b", [](py::object self) { return vectorView(self.cast<Constraint&>().b, self, true); },
           [](Constraint& c, py::handle value) {
@@ -455,13 +421,16 @@ void bindSolve(py::module_& m) {
           },
           "set points, one per column of A (a writable view)")
       .def("__repr__", [](const Constraint& c) {
-        if (!c.joint.empty()) return "<zwang.Constraint on joint '" + c.joint + "', 1 row>";
-        return "<zwang.Constraint on '" + c.frame + "'" + (c.contact ? std::string(" (contact)") : std::string()) +
-               (c.relative_to.empty() ? std::string() : " relative to '" + c.relative_to + "'") + ", " +
-               std::to_string(c.A.cols()) + " rows, " + expressedName(c.expressed) + ">";
+        if (!c.desc.joint.empty()) return "<zwang.Constraint on joint '" + c.desc.joint + "', 1 row>";
+        return "<zwang.Constraint on '" + c.desc.frame + "'" +
+               (c.desc.contact ? std::string(" (contact)") : std::string()) +
+               (c.desc.relative_to.empty() ? std::string() : " relative to '" + c.desc.relative_to + "'") + ", " +
+               std::to_string(c.desc.A.cols()) + " rows, " + expressedName(c.desc.expressed) + ">";
       });
+}
 
-  // ---- Wrench --------------------------------------------------------------
+// Wrench: a wrench at a frame, its value writable.
+void bindWrench(py::module_& m) {
   py::class_<Wrench>(m, "Wrench",
                      "External wrench [force; torque] acting at a frame's origin, components in the frame's axes\n"
                      "('local') or the world axes ('world'). The value may be changed between solves.")
@@ -492,8 +461,10 @@ void bindSolve(py::module_& m) {
           [](Wrench& w, py::handle v) { w.value.tail<3>() = vec3Arg("torque", v); })
       .def("__repr__",
            [](const Wrench& w) { return "<zwang.Wrench on '" + w.frame + "', " + expressedName(w.expressed) + ">"; });
+}
 
-  // ---- Friction ------------------------------------------------------------
+// Friction: the options of the friction-aware solve, checked by the problem layer.
+void bindFriction(py::module_& m) {
   py::class_<Friction>(m, "Friction",
                        "Options of the friction-aware solve (zwang::FrictionOptions). margin: when mu* is not\n"
                        "unique, the effort-minimising choice uses at most margin*f_j. breakaway/kinetic/viscous:\n"
@@ -518,6 +489,7 @@ void bindSolve(py::module_& m) {
              f.options.breakaway = optionalOverride("breakaway", breakaway);
              f.options.kinetic = optionalOverride("kinetic", kinetic);
              f.options.viscous = optionalOverride("viscous", viscous);
+             checked("", [&] { problem::checkFriction(f.options); });
              return f;
            }),
            py::kw_only(), py::arg("margin") = 1.0, py::arg("velocity_tolerance") = 1e-6,
@@ -541,8 +513,10 @@ void bindSolve(py::module_& m) {
       .def("__repr__", [](const Friction& f) {
         return "<zwang.Friction margin=" + std::string(py::str(py::float_(f.options.margin))) + ">";
       });
+}
 
-  // ---- Balance -------------------------------------------------------------
+// Balance: the options of a singular task's balance, checked by the problem layer.
+void bindBalance(py::module_& m) {
   py::class_<Balance>(m, "Balance",
                       "Options of the balance of line 25 (zwang::BalanceOptions; docs/solver.md, 'Singular tasks'):\n"
                       "equilibrated eigenvalues at or below rank_tolerance are exact rank loss (least squares, no\n"
@@ -553,7 +527,7 @@ void bindSolve(py::module_& m) {
              b.options.singular_threshold = singular_threshold;
              b.options.rank_tolerance = rank_tolerance;
              b.options.residual_tolerance = residual_tolerance;
-             if (const Status s = checkBalanceOptions(b.options); !s) raise(PyExc_ValueError, s.message);
+             checked("", [&] { problem::checkBalance(b.options); });
              return b;
            }),
            py::kw_only(), py::arg("singular_threshold") = BalanceOptions{}.singular_threshold,
@@ -566,15 +540,13 @@ void bindSolve(py::module_& m) {
         return "<zwang.Balance singular_threshold=" + std::string(py::str(py::float_(b.options.singular_threshold))) +
                " rank_tolerance=" + std::string(py::str(py::float_(b.options.rank_tolerance))) + ">";
       });
+}
 
-  // ---- Result --------------------------------------------------------------
-  py::class_<Result>(m, "Result",
-                     "What solve() computed. Arrays are read-only NumPy views on the workspace (no copy), valid\n"
-                     "until the next call on that workspace; reading a Result after that raises\n"
-                     "StaleResultError, and arrays taken earlier then show the new values. Result.copy() keeps it.")
-      .def_property_readonly(
-          "qdd", [](const Result& r) { return vectorView(r.solution().qdd, r.base()); },
-          "q̈ (nv entries: a floating base's first, the derivative of its velocity coordinates as given)")
+// What a solve computed: q̈, the forces and the balance's status.
+void addSolutionProperties(py::class_<Result>& cls) {
+  cls.def_property_readonly(
+         "qdd", [](const Result& r) { return vectorView(r.solution().qdd, r.base()); },
+         "q̈ (nv entries: a floating base's first, the derivative of its velocity coordinates as given)")
       .def_property_readonly(
           "base_acceleration_world",
           [](const Result& r) { return vectorView(r.solution().base_acceleration_world.data(), 6, r.base()); },
@@ -609,10 +581,14 @@ void bindSolve(py::module_& m) {
           "‖Aᵀ Ẍ − b‖ over the constraint rows, in their own units")
       .def_property_readonly(
           "consistent", [](const Result& r) { return r.solution().balance.consistent; },
-          "every constraint row met (False: least squares only, or a damped direction gave)")
-      .def_property_readonly(
-          "body_acc_local", [](const Result& r) { return bodyAccelerations(r, Expressed::Local); },
-          "(bodies, 6) true classical accelerations of the body frames, body axes (a new array)")
+          "every constraint row met (False: least squares only, or a damped direction gave)");
+}
+
+// Frame accelerations, warnings and the outcome.
+void addFrameProperties(py::class_<Result>& cls) {
+  cls.def_property_readonly(
+         "body_acc_local", [](const Result& r) { return bodyAccelerations(r, Expressed::Local); },
+         "(bodies, 6) true classical accelerations of the body frames, body axes (a new array)")
       .def_property_readonly(
           "body_acc_world", [](const Result& r) { return bodyAccelerations(r, Expressed::World); },
           "(bodies, 6) the same in world axes (a new array)")
@@ -630,8 +606,12 @@ void bindSolve(py::module_& m) {
     return out;
           },
           "list of (code, message): every warning of this solve ('outside_limits', 'fixed_base_contact'), also\n"
-          "those a zwang.ModelWarning said already (each is issued once per model, code and joint)")
-      .def_property_readonly("infeasible", [](const Result& r) { return r.infeasible; })
+          "those a zwang.ModelWarning said already (each is issued once per model, code and joint)");
+}
+
+// The friction results (None, 0 or False without friction).
+void addFrictionProperties(py::class_<Result>& cls) {
+  cls.def_property_readonly("infeasible", [](const Result& r) { return r.infeasible; })
       .def_property_readonly("message", [](const Result& r) { return r.message; })
       .def_property_readonly("with_friction", [](const Result& r) { return r.with_friction; })
       .def_property_readonly(
@@ -681,110 +661,137 @@ void bindSolve(py::module_& m) {
       .def_property_readonly("limit_impact",
                              [](const Result& r) { return r.with_friction && r.friction().limit_impact; })
       .def_property_readonly("impact_joint",
-                             [](const Result& r) { return r.with_friction ? r.friction().impact_joint : -1; })
-      .def_property_readonly("is_copy", [](const Result& r) { return static_cast<bool>(r.data); })
-      .def(
-          "copy",
-          [](const Result& r) {
-    auto data = std::make_shared<ResultData>();
-    data->solution = r.solution();
-    data->friction = r.friction();
-    const auto frames = static_cast<Eigen::Index>(r.model->frames().size());
-    data->frame_acc_local.resize(frames, 6);
-    data->frame_acc_world.resize(frames, 6);
-    for (int f = 0; f < frames; ++f) {
-      data->frame_acc_local.row(f) = frameAccelerationOf(r, f, Expressed::Local).transpose();
-      data->frame_acc_world.row(f) = frameAccelerationOf(r, f, Expressed::World).transpose();
-    }
-    Result copy;
-    copy.model = r.model;
-    copy.with_friction = r.with_friction;
-    copy.infeasible = r.infeasible;
-    copy.message = r.message;
-    copy.warnings = r.warnings;
-    copy.data_base = py::capsule(new std::shared_ptr<ResultData>(data),
-                                 [](void* p) { delete static_cast<std::shared_ptr<ResultData>*>(p); });
-    copy.data = std::move(data);
-    return copy;
-          },
-          "a detached copy that later solves do not change")
+                             [](const Result& r) { return r.with_friction ? r.friction().impact_joint : -1; });
+}
+
+// A Result with its own data, which later solves do not change.
+Result copyResult(const Result& r) {
+  auto data = std::make_shared<ResultData>();
+  data->solution = r.solution();
+  data->friction = r.friction();
+  const auto frames = static_cast<Eigen::Index>(r.model->frames().size());
+  data->frame_acc_local.resize(frames, 6);
+  data->frame_acc_world.resize(frames, 6);
+  for (int f = 0; f < frames; ++f) {
+    data->frame_acc_local.row(f) = frameAccelerationOf(r, f, Expressed::Local).transpose();
+    data->frame_acc_world.row(f) = frameAccelerationOf(r, f, Expressed::World).transpose();
+  }
+  Result copy;
+  copy.model = r.model;
+  copy.with_friction = r.with_friction;
+  copy.infeasible = r.infeasible;
+  copy.message = r.message;
+  copy.warnings = r.warnings;
+  copy.data_base = py::capsule(new std::shared_ptr<ResultData>(data),
+                               [](void* p) { delete static_cast<std::shared_ptr<ResultData>*>(p); });
+  copy.data = std::move(data);
+  return copy;
+}
+
+// Result: views on the workspace until its next use, or a copy.
+void bindResult(py::module_& m) {
+  py::class_<Result> cls(
+      m, "Result",
+      "What solve() computed. Arrays are read-only NumPy views on the workspace (no copy), valid\n"
+      "until the next call on that workspace; reading a Result after that raises\n"
+      "StaleResultError, and arrays taken earlier then show the new values. Result.copy() keeps it.");
+  addSolutionProperties(cls);
+  addFrameProperties(cls);
+  addFrictionProperties(cls);
+  cls.def_property_readonly("is_copy", [](const Result& r) { return static_cast<bool>(r.data); })
+      .def("copy", &copyResult, "a detached copy that later solves do not change")
       .def("__repr__", &resultRepr);
+}
 
-  // ---- solve ---------------------------------------------------------------
-  m.def(
-      "solve",
-      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
-         py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity, py::handle balance) {
-    PyWorkspace& pw = workspaceArg(model, ws_obj);
-    const FrictionOptions* options = frictionArg(friction);
-    const BalanceOptions& balance_options = balanceArg(balance);
-    Task& task = solveTask(pw, constraints, wrenches, gravity);
-    task.balance = balance_options;
-    const auto qv = vectorArg("q", q, pw.q_buf);
-    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
-    const auto tauv = optionalVector("tau", tau, pw.tau_buf, pw.zeros);
-    ++pw.generation;
-    const Status status = options ? solveWithFriction(*model, task, qv, qdv, tauv, *pw.ws, *options)
-                                  : solveHybridDynamics(*model, task, qv, qdv, tauv, *pw.ws);
-    const bool infeasible = status.code == StatusCode::Infeasible;
-    if (!status && !infeasible) raiseStatus(status, "solve");
-    Result r;
-    for (const ModelWarning& w : task.warnings()) warnOnce(model, r, toString(w.code), -1, w.message);
-    warnOutsideLimits(model, qv, r);
-    r.model = std::move(model);
-    r.owner = std::move(ws_obj);
-    r.live = &pw;
-    r.generation = pw.generation;
-    r.with_friction = options != nullptr;
-    r.infeasible = infeasible;
-    if (infeasible) {
-      r.message = status.message;
-      raiseStatus(status, "solve", py::cast(std::move(r)));
-    }
-    return r;
-      },
-      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
-      py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
-      py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("balance") = py::none(),
-      "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
-      "q: model.nq entries, qd, tau: model.nv (one per joint on a fixed base; a floating base's coordinates\n"
-      "first: docs/python.md); qd, tau default to zeros; float64 arrays are read in place.\n"
-      "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
-      "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
-      "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
-      "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
-      "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions). A q outside a\n"
-      "joint's limits, or contacts on a fixed base with mass, give a zwang.ModelWarning once per model, code and\n"
-      "joint; Result.warnings lists every one of this solve.");
+// The arguments of solve() and _time_cpp_solve() as the C++ solve takes them.
+struct SolveArgs {
+  PyWorkspace& pw;
+  const FrictionOptions* friction;  // the problem layer's choice: with friction, or plain
+  Task& task;
+  Eigen::Map<const Eigen::VectorXd> q, qd, tau;
+};
 
-  // ---- the C++ cost of a solve, for measuring the Python-call overhead -----
-  m.def(
-      "_time_cpp_solve",
-      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
-         py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity, int repeat) {
-    PyWorkspace& pw = workspaceArg(model, ws_obj);
-    const FrictionOptions* options = frictionArg(friction);
-    const Task& task = solveTask(pw, constraints, wrenches, gravity);
-    const auto qv = vectorArg("q", q, pw.q_buf);
-    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
-    const auto tauv = optionalVector("tau", tau, pw.tau_buf, pw.zeros);
-    ++pw.generation;
-    Status status;
-    const auto start = std::chrono::steady_clock::now();
-    for (int k = 0; k < repeat; ++k)
-      status = options ? solveWithFriction(*model, task, qv, qdv, tauv, *pw.ws, *options)
-                       : solveHybridDynamics(*model, task, qv, qdv, tauv, *pw.ws);
-    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
-    if (!status) raiseStatus(status, "_time_cpp_solve");
-    return elapsed.count() / std::max(repeat, 1);
-      },
-      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
-      py::kw_only(), py::arg("constraints") = py::none(), py::arg("wrenches") = py::none(),
-      py::arg("friction") = py::none(), py::arg("gravity") = py::none(), py::arg("repeat") = 1000,
-      "Seconds per call of the C++ solve alone (same arguments as solve), looped in C++: the baseline for\n"
-      "the Python-call overhead in docs/python.md. Not part of the API.");
+SolveArgs solveArgs(const std::shared_ptr<Model>& model, py::handle ws_obj, py::handle q, py::handle qd, py::handle tau,
+                    py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
+                    py::handle balance) {
+  PyWorkspace& pw = workspaceArg(model, ws_obj);
+  const FrictionOptions* options = frictionArg(friction);
+  const BalanceOptions& balance_options = balanceArg(balance);
+  Task& task = solveTask(pw, constraints, wrenches, gravity);
+  task.balance = balance_options;
+  return {pw,
+          options,
+          task,
+          vectorArg("q", q, pw.q_buf),
+          optionalVector("qd", qd, pw.qd_buf, pw.zeros),
+          optionalVector("tau", tau, pw.tau_buf, pw.zeros)};
+}
 
-  // ---- kinematics and dynamics ---------------------------------------------
+Result solvePython(std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
+                   py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
+                   py::handle balance) {
+  SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance);
+  ++a.pw.generation;
+  const Status status = problem::solve(*model, a.task, a.q, a.qd, a.tau, *a.pw.ws, a.friction);
+  const bool infeasible = status.code == StatusCode::Infeasible;
+  if (!status && !infeasible) raiseStatus(status, "solve");
+  Result r;
+  for (const ModelWarning& w : a.task.warnings()) warnOnce(model, r, toString(w.code), -1, w.message);
+  warnOutsideLimits(model, a.q, r);
+  r.model = std::move(model);
+  r.owner = std::move(ws_obj);
+  r.live = &a.pw;
+  r.generation = a.pw.generation;
+  r.with_friction = a.friction != nullptr;
+  r.infeasible = infeasible;
+  if (infeasible) {
+    r.message = status.message;
+    raiseStatus(status, "solve", py::cast(std::move(r)));
+  }
+  return r;
+}
+
+// Seconds per C++ solve of these arguments, looped in C++.
+double timeCppSolve(std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
+                    py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
+                    py::handle balance, int repeat) {
+  const SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance);
+  ++a.pw.generation;
+  Status status;
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < repeat; ++k) status = problem::solve(*model, a.task, a.q, a.qd, a.tau, *a.pw.ws, a.friction);
+  const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+  if (!status) raiseStatus(status, "_time_cpp_solve");
+  return elapsed.count() / std::max(repeat, 1);
+}
+
+// solve() and _time_cpp_solve(), over the same arguments.
+void bindSolveFunctions(py::module_& m) {
+  m.def("solve", &solvePython, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
+        py::arg("tau") = py::none(), py::kw_only(), py::arg("constraints") = py::none(),
+        py::arg("wrenches") = py::none(), py::arg("friction") = py::none(), py::arg("gravity") = py::none(),
+        py::arg("balance") = py::none(),
+        "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
+        "q: model.nq entries, qd, tau: model.nv (one per joint on a fixed base; a floating base's coordinates\n"
+        "first: docs/python.md); qd, tau default to zeros; float64 arrays are read in place.\n"
+        "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
+        "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
+        "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
+        "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
+        "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions). A q outside a\n"
+        "joint's limits, or contacts on a fixed base with mass, give a zwang.ModelWarning once per model, code and\n"
+        "joint; Result.warnings lists every one of this solve.");
+
+  m.def("_time_cpp_solve", &timeCppSolve, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
+        py::arg("tau") = py::none(), py::kw_only(), py::arg("constraints") = py::none(),
+        py::arg("wrenches") = py::none(), py::arg("friction") = py::none(), py::arg("gravity") = py::none(),
+        py::arg("balance") = py::none(), py::arg("repeat") = 1000,
+        "Seconds per call of the C++ solve alone (same arguments as solve), looped in C++: the baseline for\n"
+        "the Python-call overhead in docs/python.md. Not part of the API.");
+}
+
+// forward_kinematics, frame_pose, frame_velocity, frame_jacobian.
+void bindKinematics(py::module_& m) {
   m.def(
       "forward_kinematics",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd) {
@@ -845,6 +852,10 @@ void bindSolve(py::module_& m) {
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), py::arg("expressed") = "local",
       "6×nv J with frame_velocity = J qd (nv = dof on a fixed base)");
+}
+
+// inverse_dynamics, joint_space_inertia.
+void bindDynamics(py::module_& m) {
   m.def(
       "inverse_dynamics",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle qdd,
@@ -871,6 +882,20 @@ void bindSolve(py::module_& m) {
     return matrixCopy(pw.ws->H);
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), "CRBA: H(q), rotor inertias included, a new array");
+}
+
+}  // namespace
+
+void bindSolve(py::module_& m) {
+  bindWorkspace(m);
+  bindConstraint(m);
+  bindWrench(m);
+  bindFriction(m);
+  bindBalance(m);
+  bindResult(m);
+  bindSolveFunctions(m);
+  bindKinematics(m);
+  bindDynamics(m);
 }
 
 }  // namespace zwang::python

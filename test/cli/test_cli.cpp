@@ -696,6 +696,33 @@ TEST_CASE("Errors in the problem file", "[errors]") {
   }
 }
 
+// The table test/problem/bad_inputs.json, also read by the problem layer's test and the Python
+// module's: each row's input as a problem file, its message the layer's words.
+TEST_CASE("Errors in the problem file: the problem layer's shared table", "[errors]") {
+  const Json table = Json::parse(cli_test::readText(ZWANG_PROBLEM_TABLE));
+  REQUIRE(table["rows"].size() >= 10);
+  const auto sameQuotes = [](std::string text) {  // JSON quotes with ", Python with '
+    for (char& c : text)
+      if (c == '"') c = '\'';
+    return text;
+  };
+  for (const Json& row : table["rows"]) {
+    SECTION(row["name"].get<std::string>()) {
+      Json p = {{"model", ZWANG_MODELS_DIR "/panda.urdf"}, {"root", "panda_link0"}, {"tip", "tool0"}};
+      if (row.contains("constraint")) p["constraints"] = Json::array({row["constraint"]});
+      if (row.contains("wrench")) p["wrenches"] = Json::array({row["wrench"]});
+      for (const char* key : {"balance", "friction"})
+        if (row.contains(key)) p[key] = row[key];
+      const std::string file = cli_test::scratchDir() + "/shared_table.json";
+      cli_test::writeText(file, p.dump());
+      const Run r = run({"solve", file});
+      checkOneLineError(r, 1);
+      INFO("stderr: " << r.err);
+      CHECK(contains(sameQuotes(r.err), sameQuotes(row["expect"].get<std::string>())));
+    }
+  }
+}
+
 TEST_CASE("Errors outside the problem's content", "[errors]") {
   SECTION("a missing problem file") {
     const Run r = run({"solve", cli_test::scratchDir() + "/no_such_problem.json"});
@@ -1069,7 +1096,7 @@ TEST_CASE("info: table and JSON", "[info]") {
                    "--base"));
     const Run bad = run({"info", solo, "--base", "flying"});
     CHECK(bad.exit_code == 2);
-    CHECK(contains(bad.err, "--base: unknown value 'flying' (expected free, planar or fixed)"));
+    CHECK(contains(bad.err, "--base: unknown value 'flying' (expected 'fixed', 'free' or 'planar')"));
   }
   SECTION("--root/--tip") {
     const Run r = run({"info", std::string(ZWANG_MODELS_DIR) + "/panda.urdf", "--tip", "panda_link4", "--json"});

@@ -81,10 +81,11 @@ def test_accepted_inputs_give_the_same_answer(panda, ws):
 
 def test_unknown_frames_and_joints(panda, ws):
     with pytest.raises(
-        zwang.ModelError, match=r"constraints\[1\]: model 'panda' has no frame 'hand' \(frames: 'panda_link0', .*'tool0'"
+        zwang.ModelError,
+        match=r"constraints\[1\]\.frame: model 'panda' has no frame 'hand' \(frames: 'panda_link0', .*'tool0'",
     ):
         solve(panda, ws, constraints=[zwang.Constraint("tool0", np.eye(6)), zwang.Constraint("hand", np.eye(6))])
-    with pytest.raises(zwang.ModelError, match=r"wrenches\[0\]: model 'panda' has no frame 'nowhere' \(frames: "):
+    with pytest.raises(zwang.ModelError, match=r"wrenches\[0\]\.frame: model 'panda' has no frame 'nowhere' \(frames: "):
         solve(panda, ws, wrenches=[zwang.Wrench("nowhere")])
     with pytest.raises(zwang.ModelError, match="no frame 'hand'"):
         panda.frame_index("hand")
@@ -149,9 +150,8 @@ def test_bad_constraints_wrenches_and_options(panda, ws):
         solve(panda, ws, wrenches="tool0")
     with pytest.raises(TypeError, match="friction"):
         solve(panda, ws, friction=0.8)
-    with pytest.raises(zwang.SolveError, match="margin 1.5 must be in") as e:
-        solve(panda, ws, friction=zwang.Friction(margin=1.5))
-    assert e.value.code == "BadOption"
+    with pytest.raises(ValueError, match=r"margin: must be between 0 and 1, got 1.5"):
+        zwang.Friction(margin=1.5)
     with pytest.raises(zwang.SolveError, match="breakaway' has 3 entries"):
         solve(panda, ws, friction=zwang.Friction(breakaway=[1, 2, 3]))
     with pytest.raises(ValueError, match="method"):
@@ -242,11 +242,11 @@ print("ok", count)
 
 
 def test_balance_options_out_of_range(panda, ws):
-    with pytest.raises(ValueError, match=r"singular_threshold 0 must be in \(0, 1\)"):
+    with pytest.raises(ValueError, match=r"singular_threshold: must be between 0 and 1 \(exclusive\), got 0"):
         zwang.Balance(singular_threshold=0)
-    with pytest.raises(ValueError, match="rank_tolerance 0.001 must be in"):
+    with pytest.raises(ValueError, match=r"rank_tolerance: must be >= 0 and below singular_threshold \(0.0001\), got 0.001"):
         zwang.Balance(singular_threshold=1e-4, rank_tolerance=1e-3)
-    with pytest.raises(ValueError, match="residual_tolerance nan must be finite and positive"):
+    with pytest.raises(ValueError, match="residual_tolerance: must be finite and positive, got nan"):
         zwang.Balance(residual_tolerance=float("nan"))
     with pytest.raises(TypeError, match="balance: expected zwang.Balance"):
         solve(panda, ws, balance={"singular_threshold": 1e-6})

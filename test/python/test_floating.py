@@ -290,5 +290,5 @@ def test_contact_and_joint_row_errors():
     model = zwang.load_urdf(SOLO, base="free")
     with pytest.raises(zwang.ModelError, match=r"constraints\[0\].*'nope'"):
         zwang.solve(model, model.workspace(), solo_q(), constraints=[zwang.Constraint.on_joint("nope")])
-    with pytest.raises(ValueError, match="contact=True with relative_to"):
+    with pytest.raises(ValueError, match="contact: is true with 'relative_to'"):
         zwang.Constraint("FL_FOOT", np.eye(6), relative_to="FR_FOOT", contact=True)

@@ -133,7 +133,8 @@ def test_builder_errors():
         b.add_joint("j", "revolute", "l", mass=1.0, placement=np.eye(3))
     with pytest.raises(zwang.ModelError, match="joint 'j'"):
         b.add_joint("j", "spherical", "l", mass=1.0, lower=-1.0, upper=1.0)  # multi-DOF: no position limits
-    with pytest.raises(ValueError, match="set_base: unknown base 'fixed'"):
+    with pytest.raises(ValueError,
+                       match=r"set_base: unknown value 'fixed' \(expected 'free' or 'planar'; a fixed base is a builder"):
         b.set_base("fixed")
     assert b.add_joint("j", "spherical", "l", mass=1.0) is b  # chains
     c, s = math.cos(0.3), math.sin(0.3)

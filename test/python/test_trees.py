@@ -147,7 +147,7 @@ def test_relative_constraint_two_hands_hold_a_box(baxter):
     # Other axes are allowed for a relative constraint; 'reference' is only for one.
     assert zwang.Constraint("left_gripper", np.eye(6), expressed="local", relative_to="right_gripper").expressed == \
         "local"
-    with pytest.raises(ValueError, match="'reference' is for a constraint with relative_to="):
+    with pytest.raises(ValueError, match="'reference' is for a constraint with 'relative_to'"):
         zwang.Constraint("left_gripper", np.eye(6), expressed="reference")
     with pytest.raises(zwang.ModelError, match=r"relative_to: is the constrained frame itself \('left_gripper'\)"):
         zwang.Constraint("left_gripper", np.eye(6), relative_to="left_gripper")

@@ -1,0 +1,206 @@
+// The problem layer's checks and messages (problem.hpp).
+#include "problem.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+namespace zwang::problem {
+
+namespace {
+
+// Length of the valid UTF-8 sequence starting at text[at], 0 if it is not one
+// (a stray continuation byte, an overlong or truncated sequence).
+std::size_t utf8Length(const std::string& text, std::size_t at) {
+  const auto lead = static_cast<unsigned char>(text[at]);
+  const std::size_t length = lead >= 0xF0 && lead <= 0xF4 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC2 && lead < 0xE0 ? 2 : 0;
+  if (length == 0 || at + length > text.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k)
+    if ((static_cast<unsigned char>(text[at + k]) & 0xC0) != 0x80) return 0;
+  return length;
+}
+
+// A number as %g writes it: the short form users typed.
+std::string number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", value);
+  return buffer;
+}
+
+[[noreturn]] void badValue(const char* key, const std::string& what, double value) {
+  throw ProblemError(Fault::Value, key, what + ", got " + number(value));
+}
+
+// A fault of the model's (a ModelError) as the part `key` of the item.
+template <class F>
+auto keyed(const char* key, F lookup) -> decltype(lookup()) {
+  try {
+    return lookup();
+  } catch (const ProblemError& e) {
+    throw ProblemError(e.fault(), key, e.what());
+  } catch (const ModelError& e) {
+    throw ProblemError(Fault::Model, key, e.what());
+  }
+}
+
+}  // namespace
+
+ProblemError::ProblemError(Fault fault, std::string key, const std::string& what)
+    : std::runtime_error(what), fault_(fault), key_(std::move(key)) {}
+
+std::string jointNames(const Model& model) {
+  std::string list;
+  for (const Joint& joint : model.joints()) list += (list.empty() ? "" : ", ") + joint.name;
+  return list;
+}
+
+std::string printable(const std::string& text, std::size_t max_length) {
+  std::string out;
+  for (std::size_t at = 0; at < text.size();) {
+    const auto c = static_cast<unsigned char>(text[at]);
+    std::string piece;
+    std::size_t used = 1;
+    if (c >= 0x20 && c < 0x7f) {
+      piece = text.substr(at, 1);
+    } else if (const std::size_t n = c >= 0x80 ? utf8Length(text, at) : 0; n > 0) {
+      piece = text.substr(at, n);  // UTF-8 (names, "…", "·") passes through whole
+      used = n;
+    } else {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\x%02X", static_cast<unsigned>(c));
+      piece = buffer;
+    }
+    if (out.size() + piece.size() > max_length) {  // cut between characters, never inside one
+      out += "...";
+      break;
+    }
+    out += piece;
+    at += used;
+  }
+  return out;
+}
+
+std::string quoted(const Spelling& spelling, const std::string& text, std::size_t max_length) {
+  return spelling.quote + printable(text, max_length) + spelling.quote;
+}
+
+Expressed parseExpressed(const Spelling& spelling, const std::string& text, AxesOf item) {
+  if (text == "local") return Expressed::Local;
+  if (text == "world") return Expressed::World;
+  if (item != AxesOf::Wrench && text == "aligned") return Expressed::Aligned;
+  if (item == AxesOf::RelativeConstraint && text == "reference") return Expressed::Reference;
+  const auto q = [&](const char* word) { return quoted(spelling, word); };
+  const std::string expected = item == AxesOf::Wrench ? q("local") + " or " + q("world")
+                               : item == AxesOf::Constraint
+                                   ? q("local") + ", " + q("world") + " or " + q("aligned")
+                                   : q("local") + ", " + q("world") + ", " + q("aligned") + " or " + q("reference");
+  const std::string hint = text == "reference" && item == AxesOf::Constraint
+                               ? "; " + q("reference") + " is for a constraint with " + q("relative_to")
+                               : "";
+  throw ProblemError(Fault::Value, "",
+                     "unknown value " + quoted(spelling, text, 40) + " (expected " + expected + hint + ")");
+}
+
+UrdfOptions urdfOptions(const ModelRequest& request) {
+  UrdfOptions urdf;
+  urdf.root = request.root;
+  urdf.tip = request.tip;
+  urdf.strict = request.strict;
+  urdf.attach_beyond_tip = request.attach_beyond_tip;
+  urdf.mimic = request.lock_mimic ? MimicJoints::Lock : MimicJoints::Model;
+  urdf.base = request.base;
+  urdf.names = request.names;
+  return urdf;
+}
+
+BaseType parseBaseType(const Spelling& spelling, const std::string& text, const char* no_fixed) {
+  if (text == "free") return BaseType::Free;
+  if (text == "planar") return BaseType::Planar;
+  if (!no_fixed && text == "fixed") return BaseType::Fixed;
+  const auto q = [&](const char* word) { return quoted(spelling, word); };
+  const std::string expected =
+      no_fixed ? q("free") + " or " + q("planar") : q("fixed") + ", " + q("free") + " or " + q("planar");
+  const std::string hint = no_fixed && text == "fixed" ? std::string("; ") + no_fixed : "";
+  throw ProblemError(Fault::Value, "",
+                     "unknown value " + quoted(spelling, text, 40) + " (expected " + expected + hint + ")");
+}
+
+void checkRelative(const Spelling& spelling, const ConstraintDesc& c, bool relative_given) {
+  if (relative_given && c.relative_to.empty())
+    throw ProblemError(Fault::Value, "relative_to", "is empty (name the frame the constraint is relative to)");
+  if (relative_given &&
+      c.relative_to == c.frame)  // a frame name that cannot be: a fault of the names, as an unknown one
+    throw ProblemError(Fault::Model, "relative_to",
+                       "is the constrained frame itself (" + quoted(spelling, c.frame) +
+                           "): a relative constraint needs another frame to refer to");
+  if (c.contact && !c.relative_to.empty())
+    throw ProblemError(Fault::Value, "contact",
+                       "is true with " + quoted(spelling, "relative_to") +
+                           ": a relative constraint holds two links of the robot together and the motors give its "
+                           "force; a contact is a link against the environment");
+}
+
+int frameIndex(const Model& model, const std::string& name) {
+  try {
+    return model.frameIndex(name);
+  } catch (const ModelError& e) {  // the library's message names the model's frames
+    throw ProblemError(Fault::Model, "", e.what());
+  }
+}
+
+int jointIndex(const Spelling& spelling, const Model& model, const std::string& name) {
+  for (int k = 0; k < static_cast<int>(model.joints().size()); ++k)
+    if (model.joint(k).name == name) return k;
+  if (model.hasFloatingBase() && name == model.allJoints().front().name)
+    throw ProblemError(Fault::Model, "",
+                       "names the root joint of the " + std::string(toString(model.baseType())) + " base: its state " +
+                           spelling.base_state);
+  throw ProblemError(Fault::Model, "",
+                     "unknown joint " + quoted(spelling, name) + " (the model's joints: " + jointNames(model) + ")");
+}
+
+int addConstraint(const Spelling& spelling, const Model& model, Task& task, const ConstraintDesc& c) {
+  if (!c.joint.empty()) {
+    const int j = keyed("joint", [&] { return jointIndex(spelling, model, c.joint); });
+    return keyed("joint", [&] { return task.addJointConstraint(j); });
+  }
+  const int f = keyed("frame", [&] { return frameIndex(model, c.frame); });
+  if (c.contact) return keyed("", [&] { return task.addContact(f, c.A, c.expressed); });
+  if (c.relative_to.empty()) return keyed("", [&] { return task.addConstraint(f, c.A, c.expressed); });
+  const int reference = keyed("relative_to", [&] { return frameIndex(model, c.relative_to); });
+  return keyed("", [&] { return task.addRelativeConstraint(f, reference, c.A, c.expressed); });
+}
+
+int addWrench(const Model& model, Task& task, const std::string& frame, Expressed expressed) {
+  const int f = keyed("frame", [&] { return frameIndex(model, frame); });
+  return keyed("", [&] { return task.addWrench(f, expressed); });
+}
+
+void checkBalance(const BalanceOptions& o) {
+  // The equilibrated eigenvalues lie in [0, m] with one at least 1: a threshold of 1 calls every task singular.
+  if (!(o.singular_threshold > 0.0 && o.singular_threshold < 1.0))
+    badValue("singular_threshold", "must be between 0 and 1 (exclusive)", o.singular_threshold);
+  if (!(o.rank_tolerance >= 0.0 && o.rank_tolerance < o.singular_threshold))
+    badValue("rank_tolerance", "must be >= 0 and below singular_threshold (" + number(o.singular_threshold) + ")",
+             o.rank_tolerance);
+  if (!(o.residual_tolerance > 0.0 && std::isfinite(o.residual_tolerance)))
+    badValue("residual_tolerance", "must be finite and positive", o.residual_tolerance);
+}
+
+void checkFriction(const FrictionOptions& o) {
+  if (!(o.velocity_tolerance >= 0.0 && std::isfinite(o.velocity_tolerance)))
+    badValue("velocity_tolerance", "must be finite and >= 0", o.velocity_tolerance);
+  if (!(o.limit_tolerance >= 0.0 && std::isfinite(o.limit_tolerance)))
+    badValue("limit_tolerance", "must be finite and >= 0", o.limit_tolerance);
+  if (!(o.margin >= 0.0 && o.margin <= 1.0)) badValue("margin", "must be between 0 and 1", o.margin);
+  if (o.max_iterations < 1) badValue("max_iterations", "must be at least 1", o.max_iterations);
+  if (!(o.kkt_tolerance > 0.0 && std::isfinite(o.kkt_tolerance)))
+    badValue("kkt_tolerance", "must be finite and positive", o.kkt_tolerance);
+}
+
+std::string outsideLimitsMessage(const Joint& joint, double q, int index) {
+  return "q[" + std::to_string(index) + "] = " + number(q) + " puts joint '" + printable(joint.name, 4000) +
+         "' outside its limits [" + number(joint.lower) + ", " + number(joint.upper) + "]";
+}
+
+}  // namespace zwang::problem

@@ -1,0 +1,130 @@
+// The problem layer under the front ends (the CLI's JSON, the Python module):
+// the parts of a problem, their checks and their messages, once. A front end
+// translates its input into these parts and prints what comes back; the layer
+// builds the Task and the options before the solve and is not in it.
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+#include "zwang/zwang.hpp"
+
+namespace zwang::problem {
+
+// What is wrong: a value out of its range or form, or one the model refuses (a name it lacks).
+enum class Fault { Value, Model };
+
+// A bad input. key() is the part of the item at fault ("relative_to",
+// "margin"; empty for the item itself): each front end puts its own path in
+// front of it ("constraints[0].", "friction.").
+class ProblemError : public std::runtime_error {
+ public:
+  ProblemError(Fault fault, std::string key, const std::string& what);
+  Fault fault() const { return fault_; }
+  const std::string& key() const { return key_; }
+
+ private:
+  Fault fault_;
+  std::string key_;
+};
+
+// How a front end quotes names and values in its messages: JSON's " or Python's '.
+struct Spelling {
+  char quote = '"';
+  std::string base_state = "goes in \"base\"";  // where a floating base's state is given, for messages
+};
+
+// One printable line: control bytes and bytes that are not valid UTF-8 as
+// \xNN (valid UTF-8 passes through), at most `max_length` bytes, cut between
+// characters (the rest elided with "...").
+std::string printable(const std::string& text, std::size_t max_length = 200);
+
+// The model's joints below the root, "a, b, c", for messages.
+std::string jointNames(const Model& model);
+
+// `text`, printable and cut at `max_length`, between the spelling's quotes.
+std::string quoted(const Spelling& spelling, const std::string& text, std::size_t max_length = 60);
+
+// Which axes an item may be expressed in: a wrench local or world, a
+// constraint also aligned, a relative constraint also its reference's.
+enum class AxesOf { Wrench, Constraint, RelativeConstraint };
+
+// "local", "world", "aligned", "reference"; ProblemError(Value) naming the allowed ones.
+Expressed parseExpressed(const Spelling& spelling, const std::string& text, AxesOf item);
+
+// The model a front end asks for; `names` spells its keys in the loader's messages.
+struct ModelRequest {
+  std::string root, tip;
+  bool strict = false;
+  bool attach_beyond_tip = false;
+  bool lock_mimic = false;  // weld the mimic joints (MimicJoints::Lock)
+  BaseType base = BaseType::Fixed;
+  UrdfOptions::Names names;
+};
+UrdfOptions urdfOptions(const ModelRequest& request);
+
+// "fixed", "free", "planar"; ProblemError(Value) naming the allowed ones. Where
+// "fixed" is no value (`no_fixed` given), "fixed" is refused with `no_fixed` as the hint.
+BaseType parseBaseType(const Spelling& spelling, const std::string& text, const char* no_fixed = nullptr);
+
+// One constraint as a front end describes it: a frame's rows (A, 6 × m), a
+// relative one's (relative_to), a contact's, or a joint row (joint).
+struct ConstraintDesc {
+  std::string frame;
+  std::string relative_to;  // empty: the world
+  std::string joint;        // a joint row: frame, A and expressed unused
+  Expressed expressed = Expressed::Local;
+  ConstraintMatrix A;
+  bool contact = false;
+};
+
+// relative_to neither empty when given nor the frame itself; not with a contact.
+void checkRelative(const Spelling& spelling, const ConstraintDesc& c, bool relative_given);
+
+// The index of a frame; ProblemError(Model, "") with the model's frames when unknown.
+int frameIndex(const Model& model, const std::string& name);
+
+// The index in joints() of a joint; ProblemError(Model, "") naming the model's
+// joints when unknown (and where a floating base's state goes, for its root joint).
+int jointIndex(const Spelling& spelling, const Model& model, const std::string& name);
+
+// The constraint's rows into `task` by the Task::add* its kind asks for; its
+// first row. ProblemError keyed "frame", "relative_to" or "joint" for a name
+// the model does not have.
+int addConstraint(const Spelling& spelling, const Model& model, Task& task, const ConstraintDesc& c);
+
+// A wrench on a frame into `task`; its index. ProblemError keyed "frame".
+int addWrench(const Model& model, Task& task, const std::string& frame, Expressed expressed);
+
+// The ranges of the balance and friction options; ProblemError(Value) keyed by the option.
+void checkBalance(const BalanceOptions& options);
+void checkFriction(const FrictionOptions& options);
+
+// The solve a problem asks for: with friction when it has friction options, else plain.
+inline Status solve(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+                    const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
+                    Workspace& ws, const FrictionOptions* friction) {
+  return friction ? solveWithFriction(model, task, q, qd, tau, ws, *friction)
+                  : solveHybridDynamics(model, task, q, qd, tau, ws);
+}
+
+// Each one-DOF joint whose q lies outside its limits (NaN is the solve's to
+// refuse), with its message; `q_offset` is subtracted from the joint's index
+// in q for the message's "q[k]" (a front end whose q leaves the base out).
+template <class Say>
+void forEachOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q, int q_offset, Say say);
+std::string outsideLimitsMessage(const Joint& joint, double q, int index);
+
+template <class Say>
+void forEachOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q, int q_offset, Say say) {
+  for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {
+    const Joint& joint = model.joint(j);
+    if (joint.nq() != 1) continue;  // multi-DOF joints have no position limits
+    const double qj = q[joint.q_index];
+    if (qj != qj || (qj >= joint.lower && qj <= joint.upper)) continue;
+    say(j, outsideLimitsMessage(joint, qj, joint.q_index - q_offset));
+  }
+}
+
+}  // namespace zwang::problem

@@ -64,6 +64,10 @@ std::string knownNames(const std::vector<std::string>& names) {
 
 bool finite(const Transform& X) { return X.E.allFinite() && X.r.allFinite(); }
 
+// Bit for bit the identity: then a placement changes nothing and is skipped, so
+// what a user gives in the body frame stays exactly as given.
+bool exactlyIdentity(const Transform& X) { return X.E.isIdentity(0.0) && X.r.isZero(0.0); }
+
 }  // namespace
 
 int Model::jointIndex(const std::string& name) const {
@@ -272,7 +276,7 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
   model_.joints_.push_back(joint);
   model_.link_parents_.push_back(parent_link);
   // The link's inertia in the body frame (left bit for bit as given when the frames coincide).
-  const bool same_frame = child_placement.E.isIdentity(0.0) && child_placement.r.isZero(0.0);
+  const bool same_frame = exactlyIdentity(child_placement);
   model_.link_inertias_.push_back(same_frame ? child_inertia
                                              : spatial::inverseTransformInertia(child_placement, child_inertia));
   model_.frames_.push_back(Frame{child_frame, 0, child_placement});
@@ -354,7 +358,7 @@ ModelBuilder& ModelBuilder::addBaseLinkInertia(const RigidInertia& inertia) {
   // Throws on an impossible inertia; its warnings come with build(), when the base floats.
   (void)validate::rigidInertia("link '" + model_.frames_[0].name + "'", inertia);
   const Transform& link = model_.frames_[0].placement;  // the root link on body 0 (setBase)
-  const bool same_frame = link.E.isIdentity(0.0) && link.r.isZero(0.0);
+  const bool same_frame = exactlyIdentity(link);
   model_.link_inertias_[0] += same_frame ? inertia : spatial::inverseTransformInertia(link, inertia);
   return *this;
 }
@@ -365,10 +369,10 @@ ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement, c
                      " joint under the root link '" + model_.frames_[0].name + "'): it cannot get a " + toString(type) +
                      " base as well");
   if (!finite(placement)) throw ModelError("base placement is not finite");
-  if (type == BaseType::Free && !(placement.E.isIdentity(0.0) && placement.r.isZero(0.0)))
+  if (type == BaseType::Free && !exactlyIdentity(placement))
     throw ModelError("a free base takes no placement (its pose is its configuration)");
   if (!finite(root_link_placement)) throw ModelError("root link placement is not finite");
-  if (!(root_link_placement.E.isIdentity(0.0) && root_link_placement.r.isZero(0.0))) {
+  if (!exactlyIdentity(root_link_placement)) {
     if (type != BaseType::Planar)
       throw ModelError(std::string("a ") + toString(type) + " base takes no root link placement (only a planar one)");
     // What is attached already was placed on the root link's frame as body 0's.

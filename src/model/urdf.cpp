@@ -532,6 +532,30 @@ Mat3 planeRotation(const Vec3& axis) {
   return Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), axis).toRotationMatrix();
 }
 
+// A planar joint's frame turned so that its z is the plane's normal `axis`
+// (unit): planeRotation applied to the joint's <origin>.
+Transform planeFrameOf(const Vec3& axis, const Transform& origin) {
+  return Transform::rotation(planeRotation(axis)) * origin;
+}
+
+// A joint's <axis>, made unit; refused when not finite or zero (`meaning`:
+// what the axis must give, for the message).
+Vec3 unitAxisOf(const Reporter& report, const urdf::Joint& uj, const std::string& who, const char* meaning) {
+  const Vec3 axis = vectorOf(uj.axis);
+  if (!axis.allFinite()) report.fail(who + ": <axis> xyz is not finite");
+  if (axis.norm() < 1e-9)
+    report.fail(who + ": <axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " + fmt(uj.axis.z) +
+                "\" is zero (it must give " + meaning + ")");
+  return axis.normalized();
+}
+
+// A joint's <origin>; refused when not finite.
+Transform checkedPlacementOf(const Reporter& report, const urdf::Joint& uj, const std::string& who) {
+  const Transform origin = placementOf(uj);
+  if (!origin.E.allFinite() || !origin.r.allFinite()) report.fail(who + ": <origin> is not finite");
+  return origin;
+}
+
 // The child link's frame relative to the zwang joint's child frame, ᶜX_body:
 // identity except for a planar joint whose axis is not z (planeRotation turns
 // the joint frame, the link keeps the URDF's orientation).
@@ -562,22 +586,12 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
                   " is not supported (only revolute, continuous, prismatic, planar, floating and fixed joints are)");
   }
 
-  joint.placement = placementOf(uj);
-  if (!joint.placement.E.allFinite() || !joint.placement.r.allFinite()) report.fail(who + ": <origin> is not finite");
-
-  if (joint.type != JointType::Free) {  // urdfdom reads no axis for a floating joint
-    Vec3 axis = vectorOf(uj.axis);
-    if (!axis.allFinite()) report.fail(who + ": <axis> xyz is not finite");
-    if (axis.norm() < 1e-9)
-      report.fail(who + ": <axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " + fmt(uj.axis.z) +
-                  "\" is zero (it must give the joint's direction" +
-                  (joint.type == JointType::Planar ? ", here the normal of the plane)" : ")"));
-    axis.normalize();
-    if (joint.type == JointType::Planar)
-      joint.placement = Transform::rotation(planeRotation(axis)) * joint.placement;  // the plane's frame
-    else
-      joint.axis = axis;
-  }
+  joint.placement = checkedPlacementOf(report, uj, who);
+  if (joint.type == JointType::Planar)
+    joint.placement = planeFrameOf(unitAxisOf(report, uj, who, "the joint's direction, here the normal of the plane"),
+                                   joint.placement);
+  else if (joint.type != JointType::Free)  // urdfdom reads no axis for a floating joint
+    joint.axis = unitAxisOf(report, uj, who, "the joint's direction");
 
   if (joint.nv() > 1) {
     // A <limit> cannot say which of the joint's coordinates it bounds (and
@@ -1125,13 +1139,8 @@ struct BaseChoice {
 // in the root link) turned as a planar joint's below the root (makeJoint), so
 // that its z is the joint's <axis>, the plane's normal.
 Transform planeOf(const Reporter& report, const urdf::Joint& uj) {
-  const Vec3 axis = vectorOf(uj.axis);
-  if (axis.norm() < 1e-9)  // finite: checkAllNumbers
-    report.fail("planar root joint '" + uj.name + "': <axis> xyz \"" + fmt(uj.axis.x) + " " + fmt(uj.axis.y) + " " +
-                fmt(uj.axis.z) + "\" is zero (it must give the normal of the plane)");
-  const Transform origin = placementOf(uj);
-  if (!origin.E.allFinite() || !origin.r.allFinite()) report.fail("joint '" + uj.name + "': <origin> is not finite");
-  return Transform::rotation(planeRotation(axis.normalized())) * origin;
+  const Vec3 axis = unitAxisOf(report, uj, "planar root joint '" + uj.name + "'", "the normal of the plane");
+  return planeFrameOf(axis, checkedPlacementOf(report, uj, "joint '" + uj.name + "'"));
 }
 
 BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model, const UrdfOptions& options) {

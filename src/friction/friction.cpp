@@ -117,8 +117,10 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
                                 const Eigen::Ref<const Eigen::VectorXd>& tau, const FrictionOptions& options,
                                 FrictionScratch& fs, FrictionResult& fr) {
   const int n = model.dof();
+  const int iv = dofOfEntry(model, 0);  // entry j is DOF iv + j
+  const std::vector<Dof>& dofs = model.dofs();
   for (int j = 0; j < n; ++j) {
-    const Dof& dof = frictionDof(model, j);
+    const Dof& dof = dofs[static_cast<std::size_t>(iv + j)];
     fs.breakaway[j] = options.breakaway.size() ? options.breakaway[j] : dof.breakaway_friction;
     fs.kinetic[j] = options.kinetic.size() ? options.kinetic[j] : dof.kinetic_friction;
     fs.viscous[j] = options.viscous.size() ? options.viscous[j] : dof.viscous_friction;
@@ -148,8 +150,8 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
       fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
       continue;
     }
-    const int v = dofOfEntry(model, j);
-    const Dof& dof = model.dofs()[static_cast<std::size_t>(v)];
+    const int v = iv + j;
+    const Dof& dof = dofs[static_cast<std::size_t>(v)];
     // Limits belong to one-DOF joints (a multi-DOF joint's are ±∞: never at one).
     const bool limited = options.joint_limits && (std::isfinite(dof.lower) || std::isfinite(dof.upper));
     const double qj = limited ? q[model.joint(dof.joint).q_index] : 0.0, qdj = qd[v];

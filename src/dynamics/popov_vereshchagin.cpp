@@ -248,8 +248,10 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 namespace {
 
 // Lines 19–21 for DOF body i, one constraint column of its subtree at a time:
-// (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle) and A_parent = P^A A_i (line 19).
-inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace& ws) {
+// (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle; unless `balance` is
+// false: jointBalanceUpdate then adds a joint's DOFs at once) and
+// A_parent = P^A A_i (line 19).
+inline void constraintColumnsStep(const Task& task, int i, double u_D, bool balance, Workspace& ws) {
   ConstraintMatrix& A = ws.Ahat;
   const Vec6& S = ws.S[at(i)];
   const Vec6& IAS = ws.IAS[at(i)];
@@ -266,9 +268,48 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
     const double sA_D = sA[col] * inverse_D;
     ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
     double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
-    for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
+    if (balance)
+      for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
     A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
   }
+}
+
+// Line 21 for a joint of several DOFs, after its steps: 𝓛 += Σ_k (SᵀA_k)ᵀ
+// SᵀA_k / D_k over its n DOF bodies in one pass over 𝓛's lower triangle (not
+// a pass per DOF; n a constant, so the sum over k stays in registers). Body k
+// sees the columns before activeColumns(k) (a joint row on one of the joint's
+// DOFs sits on that DOF's body): its SᵀA is zero beyond. kDofs 0: n at run time.
+template <int kDofs>
+void jointBalanceUpdate(const Task& task, int first, int dofs, Workspace& ws) {
+  const int n = kDofs > 0 ? kDofs : dofs;
+  const int c0 = task.firstColumn(first), c1 = task.activeColumns(first);
+  const double* sA[6];
+  for (int k = 0; k < n; ++k) {
+    double* sA_k = ws.SA.col(first + k).data();
+    for (int r = task.activeColumns(first + k); r < c1; ++r) sA_k[r] = 0.0;
+    sA[k] = sA_k;
+  }
+  for (int col = c0; col < c1; ++col) {
+    double w[6];  // SᵀA_k / D_k of this column
+    for (int k = 0; k < n; ++k) w[k] = sA[k][col] * ws.inverse_D[at(first + k)];
+    double* L_col = &ws.L(0, col);
+    for (int r = col; r < c1; ++r) {
+      double sum = 0.0;
+      for (int k = 0; k < n; ++k) sum += sA[k][r] * w[k];
+      L_col[r] += sum;
+    }
+  }
+}
+
+// The joint types' DOF counts as constants: a free joint's 6, a spherical or planar one's 3.
+void jointBalanceUpdate(const Task& task, int first, int last, Workspace& ws) {
+  const int n = last - first + 1;
+  if (n == 6)
+    jointBalanceUpdate<6>(task, first, n, ws);
+  else if (n == 3)
+    jointBalanceUpdate<3>(task, first, n, ws);
+  else
+    jointBalanceUpdate<0>(task, first, n, ws);
 }
 
 // Line 13's D and 1/D of DOF body i from its I^A S, or Degenerate.
@@ -362,7 +403,8 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
       return s;
     }
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
-    for (int k = i; k >= first; --k) constraintColumnsStep(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
+    for (int k = i; k >= first; --k) constraintColumnsStep(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], first == i, ws);
+    if (first < i) jointBalanceUpdate(task, first, i, ws);
     passToParent(model, first, i, IA, pA, ws);
     i = first - 1;
   }
@@ -631,8 +673,8 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
         dU.head(rows_end[k]) +=
             ws.SA.col(first + k).segment(rows_first, rows_end[k]) * (du[k] * ws.inverse_D[at(first + k)]);
     }
-    Eigen::Map<Eigen::VectorXd>(s.du.data() + c * du_stride + first, std::min(own, n - 1) + 1) =
-        du.head(std::min(own, n - 1) + 1);
+    double* const du_c = s.du.data() + c * du_stride + first;  // the DOFs the column reaches
+    for (int k = 0, top = std::min(own, n - 1); k <= top; ++k) du_c[k] = du[k];
     if (!to_world) dF.noalias() += IAS_D * du;
   }
 }

@@ -248,10 +248,11 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 namespace {
 
 // Lines 19–21 for DOF body i, one constraint column of its subtree at a time:
-// (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle; unless `balance` is
-// false: jointBalanceUpdate then adds a joint's DOFs at once) and
+// (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle; without kBalance,
+// jointBalanceUpdate adds a joint's DOFs at once) and
 // A_parent = P^A A_i (line 19).
-inline void constraintColumnsStep(const Task& task, int i, double u_D, bool balance, Workspace& ws) {
+template <bool kBalance>
+inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace& ws) {
   ConstraintMatrix& A = ws.Ahat;
   const Vec6& S = ws.S[at(i)];
   const Vec6& IAS = ws.IAS[at(i)];
@@ -268,7 +269,7 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, bool bala
     const double sA_D = sA[col] * inverse_D;
     ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
     double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
-    if (balance)
+    if (kBalance)
       for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
     A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
   }
@@ -403,8 +404,12 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
       return s;
     }
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
-    for (int k = i; k >= first; --k) constraintColumnsStep(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], first == i, ws);
-    if (first < i) jointBalanceUpdate(task, first, i, ws);
+    if (first == i) {
+      constraintColumnsStep<true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
+    } else {
+      for (int k = i; k >= first; --k) constraintColumnsStep<false>(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
+      jointBalanceUpdate(task, first, i, ws);
+    }
     passToParent(model, first, i, IA, pA, ws);
     i = first - 1;
   }
@@ -673,8 +678,15 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
         dU.head(rows_end[k]) +=
             ws.SA.col(first + k).segment(rows_first, rows_end[k]) * (du[k] * ws.inverse_D[at(first + k)]);
     }
-    double* const du_c = s.du.data() + c * du_stride + first;  // the DOFs the column reaches
-    for (int k = 0, top = std::min(own, n - 1); k <= top; ++k) du_c[k] = du[k];
+    // All n entries (those above the column's own DOF are zero and never read):
+    // fixed sizes, not a call to memcpy per column.
+    double* const du_c = s.du.data() + c * du_stride + first;
+    if (n == 6)
+      Eigen::Map<Vec6>{du_c} = du;
+    else if (n == 3)
+      Eigen::Map<Vec3>{du_c} = du.head<3>();
+    else
+      for (int k = 0; k < n; ++k) du_c[k] = du[k];
     if (!to_world) dF.noalias() += IAS_D * du;
   }
 }

@@ -12,7 +12,6 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -29,12 +28,6 @@ using namespace zwang;
 using namespace zwang::testing;
 
 namespace {
-
-// ZWANG_STRESS_SEED draws other trees (the default seeds are CI's).
-unsigned long long seedOr(unsigned long long ci_seed) {
-  const char* seed_text = std::getenv("ZWANG_STRESS_SEED");
-  return seed_text ? ci_seed + std::strtoull(seed_text, nullptr, 10) : ci_seed;
-}
 
 // A random unit quaternion (w x y z), uniform on the sphere.
 Eigen::Vector4d randomQuaternion(std::mt19937_64& rng) {
@@ -193,7 +186,7 @@ Task taskWithJointRows(const Model& model, FloatingInput& in, const std::vector<
 
 TEST_CASE("joint types: solveHybridDynamics against the dense reference on trees with spherical joints",
           "[joint_types]") {
-  std::mt19937_64 rng(seedOr(2025112601ULL));
+  std::mt19937_64 rng(stressSeedOr(2025112601ULL));
   Census census;
   int compared = 0, draws = 0, constrained = 0, rows = 0, joint_row_sets = 0, multi_dof_joint_rows = 0;
   double e_qdd = 0, e_nu = 0, e_tau_c = 0, e_tau_control = 0, e_gauss = 0;
@@ -257,7 +250,7 @@ TEST_CASE("joint types: solveHybridDynamics against the dense reference on trees
 
 TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumeration on trees with spherical joints",
           "[joint_types][friction]") {
-  std::mt19937_64 rng(seedOr(2025112602ULL));
+  std::mt19937_64 rng(stressSeedOr(2025112602ULL));
   Census census;
   int compared = 0, draws = 0, unique = 0, constrained = 0, spherical_stuck = 0, own_friction = 0;
   int states[3] = {0, 0, 0};
@@ -421,7 +414,7 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
 // such joints, against the brute force (q̈ and g(μ*), which are unique).
 TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the brute-force enumeration",
           "[joint_types][friction]") {
-  std::mt19937_64 rng(seedOr(2025112701ULL));
+  std::mt19937_64 rng(stressSeedOr(2025112701ULL));
   int compared = 0, draws = 0, stuck_in_row_joint = 0;
   double e_qdd = 0, e_g = 0;
   while (compared < 150) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -28,6 +29,11 @@ LinkSpec randomLink(std::mt19937_64& rng, const std::string& name) {
   return link;
 }
 }  // namespace
+
+unsigned long long stressSeedOr(unsigned long long ci_seed) {
+  const char* seed_text = std::getenv("ZWANG_STRESS_SEED");
+  return seed_text ? ci_seed + std::strtoull(seed_text, nullptr, 10) : ci_seed;
+}
 
 double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 

@@ -31,6 +31,10 @@ struct RandomChainOptions {
   double damping_min = 0.0, damping_max = 1.0;    // viscous damping
 };
 
+// A random test's seed: ci_seed, or ci_seed + N when ZWANG_STRESS_SEED=N is set
+// (other draws than CI's, for stress runs).
+unsigned long long stressSeedOr(unsigned long long ci_seed);
+
 // Uniform in [0, 1) from the top 53 bits of one draw.
 double uniform01(std::mt19937_64& rng);
 // Uniform in [lo, hi).

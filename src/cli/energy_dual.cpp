@@ -23,7 +23,7 @@
 //   friction-aware (solveWithFriction, all joints stuck): the least-effort
 //     maximiser, |τ_control,j| = max(0, |G'_j| − margin·f_j).
 // The postures are solved at startup by damped least squares on each arm
-// (frameJacobian, from the grasp pose of make_dual_panda.py --check): every
+// (dual_arm_ik.hpp, from the grasp pose of make_dual_panda.py --check): every
 // one is checked (hand error, joint-limit distance) before anything is solved.
 #include <algorithm>
 #include <array>
@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "dual_arm_ik.hpp"
 #include "energy_report.hpp"
 #include "zwang/zwang.hpp"
 
@@ -66,10 +67,6 @@ const Posture kPostures[] = {
     {"torso_turned", "the grasp with the torso turned 0.6 rad to the left", 0.6, {0.5, 0.0, 0.35}},
 };
 
-// The seed of the IK: make_dual_panda.py --check's grasp (left arm, right arm).
-const double kSeed[2][7] = {{-0.0597, 0.9013, 0.2395, -2.0689, -0.7983, 2.8788, -0.6992},
-                            {-0.1724, 0.8639, -0.0690, -2.1175, 0.3159, 2.9720, 1.0418}};
-
 // What the dual arm's report adds to a posture's solves: the IK's result,
 // the loop's force and the worst of each check.
 struct PostureDetail {
@@ -82,54 +79,12 @@ struct PostureDetail {
 using energy::fmt;
 using energy::small;
 
-Eigen::Matrix3d rotZ(double angle) { return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
-
-// The world pose a hand must have: at the box's side, z axis towards the box
-// (−y for the left hand, +y for the right, torso axes), x axis down.
-Eigen::Isometry3d handTarget(const Posture& posture, double side) {
-  const Eigen::Matrix3d torso = rotZ(posture.torso);
-  Eigen::Matrix3d R;
-  const Eigen::Vector3d z = torso * Eigen::Vector3d(0.0, -side, 0.0), x(0.0, 0.0, -1.0);
-  R.col(0) = x;
-  R.col(1) = z.cross(x);
-  R.col(2) = z;
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = R;
-  pose.translation() = torso * Eigen::Vector3d(posture.box[0], posture.box[1] + side * kGrip, posture.box[2]);
-  return pose;
-}
-
-// Damped least squares on one arm's seven joints (columns first..first+6),
-// the rest of q fixed; deterministic (fixed seed, fixed iteration rule).
-double reachHand(const Model& model, Workspace& ws, Eigen::VectorXd& q, int frame, int first,
-                 const Eigen::Isometry3d& target, const std::string& where) {
-  Eigen::MatrixXd J(6, model.dof());
-  Eigen::Isometry3d pose;
-  Vec6 e;
-  for (int iteration = 0; iteration < 500; ++iteration) {
-    Status s = frameJacobian(model, ws, q, frame, Expressed::World, J);
-    if (s) s = framePose(model, ws, frame, pose);
-    if (!s) throw CliError(kExitError, where + s.message);
-    const Eigen::AngleAxisd rotation(target.linear() * pose.linear().transpose());
-    e << target.translation() - pose.translation(), rotation.angle() * rotation.axis();
-    if (e.norm() < 1e-13) break;
-    const Eigen::Matrix<double, 6, 7> Ja = J.middleCols(first, 7);
-    const double damping = e.norm() > 1e-3 ? 1e-2 : 1e-6;
-    const Eigen::Matrix<double, 6, 6> JJt =
-        Ja * Ja.transpose() + damping * damping * Eigen::Matrix<double, 6, 6>::Identity();
-    q.segment(first, 7) += Ja.transpose() * JJt.ldlt().solve(e);
-  }
-  return e.norm();
-}
-
+// The posture's q from the IK (dual_arm_ik.hpp), checked: the hands on the box, every joint inside its limits.
 Eigen::VectorXd solvePosture(const Model& model, const Posture& posture, PostureDetail& r) {
-  Workspace ws(model);
-  Eigen::VectorXd q(kDof);
-  q[0] = posture.torso;
-  for (int k = 0; k < 7; ++k) q[1 + k] = kSeed[0][k], q[8 + k] = kSeed[1][k];
   const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
-  r.ik_error = std::max(reachHand(model, ws, q, model.frameIndex("left_tool0"), 1, handTarget(posture, 1.0), where),
-                        reachHand(model, ws, q, model.frameIndex("right_tool0"), 8, handTarget(posture, -1.0), where));
+  const dual_arm::BoxPlacement box{posture.torso, Eigen::Vector3d(posture.box[0], posture.box[1], posture.box[2]),
+                                   kGrip};
+  const Eigen::VectorXd q = dual_arm::reachBox(model, box, r.ik_error, where);
   r.limit_distance = std::numeric_limits<double>::infinity();
   for (int j = 0; j < kDof; ++j)
     r.limit_distance = std::min({r.limit_distance, q[j] - model.joint(j).lower, model.joint(j).upper - q[j]});

@@ -25,7 +25,8 @@
 // rank nv and |q̈|; RNEA with the ground wrenches (ν of the contacts) on the
 // feet gives 0 on the base and τ_control − μ on the joints; ν is the
 // least-norm solution of the dense balance Gᵀν = RNEA(q, 0, 0) + [0; μ]
-// (G from frameJacobian, Eigen's complete orthogonal decomposition); with
+// (G from frameJacobian, Eigen's complete orthogonal decomposition: the
+// dense reference of standing_reference.hpp); with
 // friction, |μ_j| ≤ margin·f_j, μ meets the optimality (KKT) conditions of
 // min ‖τ_control(μ)‖² over that box with τ_control(μ) from the same dense
 // map, and ‖τ_control‖² is not above the plain one.
@@ -50,12 +51,9 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
-#include <Eigen/QR>
-
 #include "cli.hpp"
 #include "energy_report.hpp"
+#include "standing_reference.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli {
@@ -69,7 +67,6 @@ constexpr double kCheckTolerance = 1e-9;       // the checks: torques [N·m], fo
 constexpr double kPlacementTolerance = 1e-12;  // feet off z = 0 or off level after placing the base [m, rad]:
                                                // a few transforms of numbers below 1 round to ~1e-16
 constexpr double kLimitDistance = 0.05;        // every joint at least this far inside its limits [rad]
-constexpr double kBoundTolerance = 1e-9;       // μ within this of ±margin·f counts as on the bound [N·m]
 
 struct JointValue {
   std::string joint;
@@ -179,12 +176,6 @@ struct VariantDetail {
   double kkt = 0;          // friction variants: how far μ is from minimising ‖τ_control‖² there (kktViolation)
 };
 
-// Plain, with the split of the ground's force that needs the least motor effort (bestSplit).
-struct BestSplit {
-  double sq = 0;          // ‖τ_control‖²
-  double tangential = 0;  // the largest |horizontal force| / vertical force on a foot
-};
-
 // What the standing report adds to a posture's solves (energy::PostureResult).
 struct PostureDetail {
   double placement_error = 0, limit_distance = 0;
@@ -194,7 +185,7 @@ struct PostureDetail {
   int rank = 0;
   double worst_qdd = 0, worst_rnea = 0, worst_split = 0, worst_bound = 0, split_shift = 0;
   double worst_reference_kkt = 0;  // of the least-effort reference (leastEffort)
-  BestSplit best_split;            // plain: the least ‖τ_control‖² over every split of the ground's force
+  standing::BestSplit best_split;  // plain: the least ‖τ_control‖² over every split of the ground's force
 };
 
 struct RobotResult {
@@ -306,122 +297,14 @@ Task standingTask(const Model& model, const StandingRobot& robot) {
   return task;
 }
 
-// Gᵀ of the task's rows, built densely from the feet's world Jacobians and
-// the joint rows' unit torques, independently of the solver's sweeps.
-Eigen::MatrixXd balanceTranspose(const Model& model, Workspace& ws, const StandingRobot& robot,
-                                 const Eigen::VectorXd& q) {
-  const int contacts = robot.contact_rows * static_cast<int>(robot.feet.size()), n = model.dof(), nv = model.nv();
-  Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(nv, contacts + n);
-  Eigen::MatrixXd J(6, nv);
-  for (std::size_t k = 0; k < robot.feet.size(); ++k) {
-    require(frameJacobian(model, ws, q, model.frameIndex(robot.feet[k]), Expressed::World, J), "energy: ");
-    Gt.middleCols(robot.contact_rows * static_cast<int>(k), robot.contact_rows) =
-        J.topRows(robot.contact_rows).transpose();
-  }
-  Gt.bottomRightCorner(n, n).setIdentity();
-  return Gt;
-}
-
-// RNEA with the ground wrenches on the feet: the generalized force the
-// motors and friction must supply for q̈ = 0 (0 on the base when the ground
-// carries the robot).
-Eigen::VectorXd torquesWithGround(const Model& model, Workspace& ws, const StandingRobot& robot,
-                                  const Eigen::VectorXd& q, const Eigen::VectorXd& ground) {
-  Task loaded(model);
-  for (std::size_t k = 0; k < robot.feet.size(); ++k) {
-    Vec6 w = Vec6::Zero();
-    w.head(robot.contact_rows) = ground.segment(robot.contact_rows * static_cast<Eigen::Index>(k), robot.contact_rows);
-    loaded.wrench(loaded.addWrench(robot.feet[k], Expressed::World)) = w;
-  }
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, loaded, q, zero, zero, ws), "energy: RNEA: ");
-  return ws.tau;
-}
-
-// The standing balance written densely, independently of the solver's
-// sweeps: the least-norm ν for a friction torque μ is Gᵀ⁺ (RNEA(q, 0, 0) +
-// [0; μ]), so τ_control(μ) = τ₀ + M μ, its joint rows' part, is affine in μ.
-struct DenseBalance {
-  Eigen::MatrixXd Gt_matrix;  // Gᵀ: nv × rows, the contacts' columns first, then the joint rows'
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Gt;
-  Eigen::VectorXd gravity;  // RNEA(q, 0, 0), nv
-  Eigen::VectorXd tau0;     // τ_control(0)
-  Eigen::MatrixXd M;        // ∂τ_control/∂μ (n × n; the identity if the split did not move)
-};
-
-DenseBalance denseBalance(const Model& model, Workspace& ws, const StandingRobot& robot, const Eigen::VectorXd& q,
-                          const std::string& context) {
-  const int n = model.dof();
-  DenseBalance d;
-  d.Gt_matrix = balanceTranspose(model, ws, robot, q);
-  d.Gt.compute(d.Gt_matrix);
-  const Task gravity_only(model);
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, gravity_only, q, zero, zero, ws), context + "RNEA: ");
-  d.gravity = ws.tau;
-  d.tau0 = d.Gt.solve(d.gravity).tail(n);
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(model.nv(), n);
-  unit.bottomRows(n).setIdentity();
-  d.M = d.Gt.solve(unit).bottomRows(n);
-  return d;
-}
-
-// The least ‖τ_control‖² over every split of the ground's force, without
-// friction: ν = ν₀ + N z solves the balance for any z (N spans null(Gᵀ), the
-// internal forces), and z is chosen for the least motor torques.
-BestSplit bestSplit(const DenseBalance& d, int contact_rows) {
-  const Eigen::Index n = d.tau0.size();
-  const Eigen::MatrixXd internal = Eigen::FullPivLU<Eigen::MatrixXd>(d.Gt_matrix).kernel();
-  const Eigen::MatrixXd on_joints = internal.bottomRows(n);
-  const Eigen::VectorXd z = -on_joints.completeOrthogonalDecomposition().solve(d.tau0);
-  const Eigen::VectorXd nu = d.Gt.solve(d.gravity) + internal * z;
-  BestSplit best;
-  best.sq = nu.tail(n).squaredNorm();
-  for (Eigen::Index foot = 0; foot + contact_rows <= nu.size() - n; foot += contact_rows)
-    best.tangential = std::max(best.tangential, nu.segment<2>(foot).norm() / nu[foot + 2]);
-  return best;
-}
-
-// The worst violation of the optimality conditions of min ½‖τ₀ + M μ‖² over
-// |μ_j| ≤ bound_j: the gradient Mᵀτ is 0 inside the box and points out of
-// it on a bound [N·m].
-double kktViolation(const DenseBalance& d, const Eigen::VectorXd& mu, const Eigen::VectorXd& bound) {
-  const Eigen::VectorXd gradient = d.M.transpose() * (d.tau0 + d.M * mu);
-  double worst = 0;
-  for (Eigen::Index j = 0; j < mu.size(); ++j) {
-    if (mu[j] >= bound[j] - kBoundTolerance)
-      worst = std::max(worst, gradient[j]);
-    else if (mu[j] <= -bound[j] + kBoundTolerance)
-      worst = std::max(worst, -gradient[j]);
-    else
-      worst = std::max(worst, std::abs(gradient[j]));
-  }
-  return worst;
-}
-
-// The least ‖τ_control(μ)‖² over the margin box, by projected gradient with
-// the step 1/λ_max(MᵀM) (a convex quadratic: every step lowers it), until
-// the optimality conditions hold to 1e-12 N·m (the gradient sums torques of
-// at most a few hundred N·m, rounding at ~1e-13; the result is judged at
-// kCheckTolerance) or 10⁵ steps. The reference for the friction-aware
-// solve's pick.
-Eigen::VectorXd leastEffort(const DenseBalance& d, const Eigen::VectorXd& bound) {
-  const Eigen::MatrixXd MtM = d.M.transpose() * d.M;
-  const double step = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(MtM).eigenvalues().maxCoeff();
-  Eigen::VectorXd mu = Eigen::VectorXd::Zero(bound.size());
-  for (int iteration = 0; iteration < 100000 && kktViolation(d, mu, bound) > 1e-12; ++iteration)
-    mu = (mu - step * (d.M.transpose() * (d.tau0 + d.M * mu))).cwiseMax(-bound).cwiseMin(bound);
-  return mu;
-}
-
 void checkVariant(const Model& model, Workspace& ws, const StandingRobot& robot, const Eigen::VectorXd& q,
-                  const DenseBalance& dense, const Eigen::VectorXd& breakaway, int v, const Solution& solution,
-                  const energy::VariantResult& e, PostureDetail& r) {
+                  const standing::DenseBalance& dense, const Eigen::VectorXd& breakaway, int v,
+                  const Solution& solution, const energy::VariantResult& e, PostureDetail& r) {
   const int n = model.dof(), kb = model.baseVelocitySize();
   const energy::Variant& variant = energy::kVariants[v];
   VariantDetail& g = r.variant[static_cast<std::size_t>(v)];
   // The ground's wrenches hold the robot; the joints feel τ_control − μ.
-  const Eigen::VectorXd needed = torquesWithGround(model, ws, robot, q, g.ground);
+  const Eigen::VectorXd needed = standing::torquesWithGround(model, ws, robot.feet, robot.contact_rows, q, g.ground);
   r.worst_rnea = std::max({r.worst_rnea, needed.head(kb).cwiseAbs().maxCoeff(),
                            (needed.tail(n) - (e.tau - e.mu)).cwiseAbs().maxCoeff(),
                            solution.tau_control.head(kb).cwiseAbs().maxCoeff()});
@@ -433,9 +316,9 @@ void checkVariant(const Model& model, Workspace& ws, const StandingRobot& robot,
   // Friction: inside the margin box; how far from the least ‖τ_control‖² there.
   const Eigen::VectorXd bound = variant.margin * breakaway;
   r.worst_bound = std::max(r.worst_bound, (e.mu.cwiseAbs() - bound).maxCoeff());
-  g.kkt = kktViolation(dense, e.mu, bound);
-  const Eigen::VectorXd least = leastEffort(dense, bound);
-  r.worst_reference_kkt = std::max(r.worst_reference_kkt, kktViolation(dense, least, bound));
+  g.kkt = standing::kktViolation(dense, e.mu, bound);
+  const Eigen::VectorXd least = standing::leastEffort(dense, bound);
+  r.worst_reference_kkt = std::max(r.worst_reference_kkt, standing::kktViolation(dense, least, bound));
   g.least_sq = (dense.tau0 + dense.M * least).squaredNorm();
 }
 
@@ -457,8 +340,9 @@ energy::PostureResult runPosture(const Model& model, const StandingRobot& robot,
   Workspace check_ws(model, 0);
   s.q = postureConfiguration(model, check_ws, robot, posture, r);
   const std::string context = where(robot, posture);
-  const DenseBalance dense = denseBalance(model, check_ws, robot, s.q, context);
-  r.best_split = bestSplit(dense, robot.contact_rows);
+  const standing::DenseBalance dense =
+      standing::denseBalance(model, check_ws, robot.feet, robot.contact_rows, s.q, context);
+  r.best_split = standing::bestSplit(dense, robot.contact_rows);
   const Task task = standingTask(model, robot);
   Workspace ws(model, task);
   const int n = model.dof(), contacts = robot.contact_rows * static_cast<int>(robot.feet.size());

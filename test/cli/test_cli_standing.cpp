@@ -240,6 +240,15 @@ TEST_CASE("energy: the humanoid and Solo 12 standing regenerate the committed CS
       }
       CHECK(sq[2] < sq[1]);
       CHECK(sq[1] < sq[0]);
+      // The best split without friction, independently of the tool's: the
+      // internal forces move the joints' share along basis' joint rows, so the
+      // least ‖τ_control‖² is what of plain's τ_control they cannot cancel.
+      const Eigen::VectorXd tau_plain = fresh.at(at + "plain,tau").vector();
+      const Eigen::MatrixXd on_joints = basis.bottomRows(n);
+      const Eigen::VectorXd rest = tau_plain - on_joints * (on_joints.transpose() * on_joints)
+                                                               .completeOrthogonalDecomposition()
+                                                               .solve(on_joints.transpose() * tau_plain);
+      CHECK(fresh.at(at + "plain,effort").values[3] == Approx(rest.squaredNorm()).epsilon(1e-9));
     }
   }
 }

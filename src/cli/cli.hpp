@@ -6,7 +6,6 @@
 #pragma once
 
 #include <filesystem>
-#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -123,18 +122,6 @@ int commandSolve(int argc, char** argv);
 int commandInfo(int argc, char** argv);
 int commandScenarios(int argc, char** argv);
 int commandEnergy(int argc, char** argv);
-// The second part of `zwang energy` (energy_dual.cpp): the dual arm holding a
-// box. Loads models/dual_panda.urdf, solves and checks every posture (CliError
-// when something cannot be solved), writing nothing; the function it returns
-// prints the tables and writes dual_energy.csv and dual_energy.gp into
-// report.out (running gnuplot on it when its argument is true), and returns
-// false when a check failed.
-std::function<bool(bool)> prepareDualArmEnergy(const ReportCommand& report);
-// The third part (energy_standing.cpp): simple_humanoid.urdf and solo12.urdf
-// on a free base standing still on the ground. The same contract: solves and
-// checks first (CliError when something cannot be solved), writing nothing;
-// the function it returns prints and writes standing_energy.csv and
-// standing_energy.gp (with gnuplot: its PNGs) and returns false when a check failed.
-std::function<bool(bool)> prepareStandingEnergy(const ReportCommand& report);
+// Its scenarios are in energy_report.hpp.
 
 }  // namespace zwang::cli

@@ -23,19 +23,20 @@
 //   friction-aware (solveWithFriction, all joints stuck): the least-effort
 //     maximiser, |τ_control,j| = max(0, |G'_j| − margin·f_j).
 // The postures are solved at startup by damped least squares on each arm
-// (frameJacobian, from the grasp pose of make_dual_panda.py --check): every
+// (dual_arm_ik.hpp, from the grasp pose of make_dual_panda.py --check): every
 // one is checked (hand error, joint-limit distance) before anything is solved.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <limits>
-#include <sstream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
+#include "dual_arm_ik.hpp"
 #include "energy_report.hpp"
 #include "zwang/zwang.hpp"
 
@@ -66,77 +67,24 @@ const Posture kPostures[] = {
     {"torso_turned", "the grasp with the torso turned 0.6 rad to the left", 0.6, {0.5, 0.0, 0.35}},
 };
 
-// The seed of the IK: make_dual_panda.py --check's grasp (left arm, right arm).
-const double kSeed[2][7] = {{-0.0597, 0.9013, 0.2395, -2.0689, -0.7983, 2.8788, -0.6992},
-                            {-0.1724, 0.8639, -0.0690, -2.1175, 0.3159, 2.9720, 1.0418}};
-
-struct VariantResult {
-  Eigen::VectorXd tau, mu;
-  Vec6 loop = Vec6::Zero();  // ν of the relative rows: the wrench on the left hand, right_tool0's axes
-  energy::Effort effort;
-};
-
-struct PostureResult {
-  Eigen::VectorXd q, gravity;  // G'(q): RNEA with the box's wrenches
-  Eigen::Vector3d left, right;
+// What the dual arm's report adds to a posture's solves: the IK's result,
+// the loop's force and the worst of each check.
+struct PostureDetail {
   double ik_error = 0, limit_distance = 0;
-  VariantResult variant[energy::kVariantCount];
-  int rank = 0;
+  // ν of the relative rows per variant: the wrench on the left hand, right_tool0's axes
+  std::array<Vec6, energy::kVariantCount> loop;
   double worst_qdd = 0, worst_closed_form = 0, worst_closure = 0, worst_torso_internal = 0;
-  bool ok = false;
 };
 
 using energy::fmt;
 using energy::small;
 
-Eigen::Matrix3d rotZ(double angle) { return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
-
-// The world pose a hand must have: at the box's side, z axis towards the box
-// (−y for the left hand, +y for the right, torso axes), x axis down.
-Eigen::Isometry3d handTarget(const Posture& posture, double side) {
-  const Eigen::Matrix3d torso = rotZ(posture.torso);
-  Eigen::Matrix3d R;
-  const Eigen::Vector3d z = torso * Eigen::Vector3d(0.0, -side, 0.0), x(0.0, 0.0, -1.0);
-  R.col(0) = x;
-  R.col(1) = z.cross(x);
-  R.col(2) = z;
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = R;
-  pose.translation() = torso * Eigen::Vector3d(posture.box[0], posture.box[1] + side * kGrip, posture.box[2]);
-  return pose;
-}
-
-// Damped least squares on one arm's seven joints (columns first..first+6),
-// the rest of q fixed; deterministic (fixed seed, fixed iteration rule).
-double reachHand(const Model& model, Workspace& ws, Eigen::VectorXd& q, int frame, int first,
-                 const Eigen::Isometry3d& target, const std::string& where) {
-  Eigen::MatrixXd J(6, model.dof());
-  Eigen::Isometry3d pose;
-  Vec6 e;
-  for (int iteration = 0; iteration < 500; ++iteration) {
-    Status s = frameJacobian(model, ws, q, frame, Expressed::World, J);
-    if (s) s = framePose(model, ws, frame, pose);
-    if (!s) throw CliError(kExitError, where + s.message);
-    const Eigen::AngleAxisd rotation(target.linear() * pose.linear().transpose());
-    e << target.translation() - pose.translation(), rotation.angle() * rotation.axis();
-    if (e.norm() < 1e-13) break;
-    const Eigen::Matrix<double, 6, 7> Ja = J.middleCols(first, 7);
-    const double damping = e.norm() > 1e-3 ? 1e-2 : 1e-6;
-    const Eigen::Matrix<double, 6, 6> JJt =
-        Ja * Ja.transpose() + damping * damping * Eigen::Matrix<double, 6, 6>::Identity();
-    q.segment(first, 7) += Ja.transpose() * JJt.ldlt().solve(e);
-  }
-  return e.norm();
-}
-
-Eigen::VectorXd solvePosture(const Model& model, const Posture& posture, PostureResult& r) {
-  Workspace ws(model);
-  Eigen::VectorXd q(kDof);
-  q[0] = posture.torso;
-  for (int k = 0; k < 7; ++k) q[1 + k] = kSeed[0][k], q[8 + k] = kSeed[1][k];
+// The posture's q from the IK (dual_arm_ik.hpp), checked: the hands on the box, every joint inside its limits.
+Eigen::VectorXd solvePosture(const Model& model, const Posture& posture, PostureDetail& r) {
   const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
-  r.ik_error = std::max(reachHand(model, ws, q, model.frameIndex("left_tool0"), 1, handTarget(posture, 1.0), where),
-                        reachHand(model, ws, q, model.frameIndex("right_tool0"), 8, handTarget(posture, -1.0), where));
+  const dual_arm::BoxPlacement box{posture.torso, Eigen::Vector3d(posture.box[0], posture.box[1], posture.box[2]),
+                                   kGrip};
+  const Eigen::VectorXd q = dual_arm::reachBox(model, box, r.ik_error, where);
   r.limit_distance = std::numeric_limits<double>::infinity();
   for (int j = 0; j < kDof; ++j)
     r.limit_distance = std::min({r.limit_distance, q[j] - model.joint(j).lower, model.joint(j).upper - q[j]});
@@ -177,13 +125,10 @@ Eigen::VectorXd constraintTorques(const Model& model, Workspace& ws, const Eigen
   return tau;
 }
 
-PostureResult run(const Model& model, const Posture& posture) {
-  PostureResult r;
-  r.q = solvePosture(model, posture, r);
-  const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
-
+// The hold-still task with the box's weight on the hands; `loop_row` is set to the loop's first row.
+Task holdBoxTask(const Model& model, int& loop_row) {
   Task task(model);  // gravity (0, 0, −9.81)
-  const int loop_row =
+  loop_row =
       task.addRelativeConstraint("left_tool0", "right_tool0", ConstraintMatrix::Identity(6, 6), Expressed::Reference);
   task.addConstraint("right_tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
   ConstraintMatrix lock = ConstraintMatrix::Zero(6, 1);
@@ -193,6 +138,42 @@ PostureResult run(const Model& model, const Posture& posture) {
   const Vec6 half_weight = (Vec6() << 0.0, 0.0, -0.5 * kBoxMass * 9.81, 0.0, 0.0, 0.0).finished();
   task.wrench(task.addWrench("left_tool0", Expressed::World)) = half_weight;
   task.wrench(task.addWrench("right_tool0", Expressed::World)) = half_weight;
+  return task;
+}
+
+// The checks of one variant's solve against G'(q) (RNEA with the box's
+// wrenches) and the Jacobians, their worst kept in `d`.
+void checkVariant(const Model& model, Workspace& check_ws, const Eigen::VectorXd& q, const Eigen::VectorXd& gravity,
+                  const energy::Variant& variant, const energy::VariantResult& e, const Solution& solution,
+                  int loop_row, const Vec6& loop, PostureDetail& d) {
+  d.worst_qdd = std::max(d.worst_qdd, solution.qdd.cwiseAbs().maxCoeff());
+  // The closed form: τ_control = G' + μ with the effort-minimising μ.
+  for (int j = 0; j < kDof; ++j) {
+    const double f = variant.margin < 0 ? 0.0 : variant.margin * model.joint(j).breakaway_friction;
+    const double expected = std::copysign(std::max(0.0, std::abs(gravity[j]) - f), gravity[j]);
+    d.worst_closed_form = std::max(d.worst_closed_form, std::abs(e.tau[j] - expected));
+  }
+  // Closure: the joints feel τ_control − μ = G' (RNEA, with the wrenches);
+  // τ_c from ν and the Jacobians is the solver's, and τ_control = 0 + τ_c.
+  const Eigen::VectorXd tau_c = constraintTorques(model, check_ws, q, solution.nu);
+  d.worst_closure =
+      std::max({d.worst_closure, (e.tau - e.mu - gravity).cwiseAbs().maxCoeff(),
+                (tau_c - solution.tau_constraint).cwiseAbs().maxCoeff(), (e.tau - tau_c).cwiseAbs().maxCoeff()});
+  // The loop's force is internal: it does nothing to the torso joint, which
+  // both arms hang from.
+  Eigen::VectorXd loop_only = Eigen::VectorXd::Zero(kDof);
+  loop_only.segment<6>(loop_row) = loop;
+  d.worst_torso_internal =
+      std::max(d.worst_torso_internal, std::abs(constraintTorques(model, check_ws, q, loop_only)[0]));
+}
+
+energy::PostureResult run(const Model& model, const Posture& posture, PostureDetail& d) {
+  energy::PostureResult r;
+  r.name = posture.name;
+  r.q = solvePosture(model, posture, d);
+  const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
+  int loop_row = 0;
+  const Task task = holdBoxTask(model, loop_row);
   Workspace ws(model, task);
   Workspace check_ws(model);
 
@@ -200,14 +181,7 @@ PostureResult run(const Model& model, const Posture& posture) {
   // G'(q): RNEA with the task's gravity and wrenches (constraints ignored).
   if (const Status s = inverseDynamics(model, task, r.q, zero, zero, ws); !s)
     throw CliError(kExitError, where + "RNEA: " + s.message);
-  r.gravity = ws.tau;
-  Eigen::Isometry3d pose;
-  Status s = forwardKinematics(model, ws, r.q);
-  if (s) s = framePose(model, ws, model.frameIndex("left_tool0"), pose);
-  r.left = pose.translation();
-  if (s) s = framePose(model, ws, model.frameIndex("right_tool0"), pose);
-  r.right = pose.translation();
-  if (!s) throw CliError(kExitError, where + s.message);
+  const Eigen::VectorXd gravity = ws.tau;
 
   for (int v = 0; v < energy::kVariantCount; ++v) {
     const energy::Variant& variant = energy::kVariants[v];
@@ -217,118 +191,22 @@ PostureResult run(const Model& model, const Posture& posture) {
       throw CliError(kExitError, where + variant.name + ": the hold-still task has rank " +
                                      std::to_string(ws.solution.balance.rank) + ", not " + std::to_string(kDof) +
                                      " (q̈ is not fully determined)");
-    VariantResult& e = r.variant[v];
-    e.tau = ws.solution.tau_control;
-    e.mu = variant.margin < 0 ? zero : Eigen::VectorXd(ws.friction.mu);
-    e.loop = ws.solution.nu.segment<6>(loop_row);
-    e.effort = energy::effortOf(e.tau);
-    r.rank = ws.solution.balance.rank;
-    r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
-    // The closed form: τ_control = G' + μ with the effort-minimising μ.
-    for (int j = 0; j < kDof; ++j) {
-      const double f = variant.margin < 0 ? 0.0 : variant.margin * model.joint(j).breakaway_friction;
-      const double expected = std::copysign(std::max(0.0, std::abs(r.gravity[j]) - f), r.gravity[j]);
-      r.worst_closed_form = std::max(r.worst_closed_form, std::abs(e.tau[j] - expected));
-    }
-    // Closure: the joints feel τ_control − μ = G' (RNEA, with the wrenches);
-    // τ_c from ν and the Jacobians is the solver's, and τ_control = 0 + τ_c.
-    const Eigen::VectorXd tau_c = constraintTorques(model, check_ws, r.q, ws.solution.nu);
-    r.worst_closure =
-        std::max({r.worst_closure, (e.tau - e.mu - r.gravity).cwiseAbs().maxCoeff(),
-                  (tau_c - ws.solution.tau_constraint).cwiseAbs().maxCoeff(), (e.tau - tau_c).cwiseAbs().maxCoeff()});
-    // The loop's force is internal: it does nothing to the torso joint, which
-    // both arms hang from.
-    Eigen::VectorXd loop_only = Eigen::VectorXd::Zero(kDof);
-    loop_only.segment<6>(loop_row) = e.loop;
-    r.worst_torso_internal =
-        std::max(r.worst_torso_internal, std::abs(constraintTorques(model, check_ws, r.q, loop_only)[0]));
+    const auto k = static_cast<std::size_t>(v);
+    r.variant[k] = energy::variantResult(variant, ws.solution.tau_control, ws);
+    d.loop[k] = ws.solution.nu.segment<6>(loop_row);
+    checkVariant(model, check_ws, r.q, gravity, variant, r.variant[k], ws.solution, loop_row, d.loop[k], d);
   }
-  r.ok = r.rank == kDof && r.worst_qdd < kCheckTolerance && r.worst_closed_form < kCheckTolerance &&
-         r.worst_closure < kCheckTolerance && r.worst_torso_internal < kCheckTolerance;
+  r.ok = d.worst_qdd < kCheckTolerance && d.worst_closed_form < kCheckTolerance && d.worst_closure < kCheckTolerance &&
+         d.worst_torso_internal < kCheckTolerance;
   return r;
-}
-
-std::string csvText(const std::vector<PostureResult>& results) {
-  std::ostringstream out;
-  out << "pose,variant";
-  for (const char* column : {"q", "tau", "mu"})
-    for (int j = 1; j <= kDof; ++j) out << "," << column << j;
-  out << ",tau_norm,tau_sq,tau_abs_sum,loop_fx,loop_fy,loop_fz,loop_nx,loop_ny,loop_nz\n";
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    const PostureResult& r = results[p];
-    for (int v = 0; v < energy::kVariantCount; ++v) {
-      const VariantResult& e = r.variant[v];
-      out << kPostures[p].name << "," << energy::kVariants[v].name;
-      for (int j = 0; j < kDof; ++j) out << energy::csvCell(r.q[j]);
-      for (int j = 0; j < kDof; ++j) out << energy::csvCell(e.tau[j]);
-      for (int j = 0; j < kDof; ++j) out << energy::csvCell(e.mu[j]);
-      out << energy::csvCell(e.effort.norm) << energy::csvCell(e.effort.sq) << energy::csvCell(e.effort.abs_sum);
-      for (int k = 0; k < 6; ++k) out << energy::csvCell(e.loop[k]);
-      out << "\n";
-    }
-  }
-  return out.str();
 }
 
 // The joints' short names in the charts: t (torso), L1–L7, R1–R7.
 std::string jointLabel(int j) { return j == 0 ? "t" : (j <= 7 ? "L" : "R") + std::to_string(j <= 7 ? j : j - 7); }
 
-// The same two charts as the Panda's (energy.gp), in the same style.
-std::string plotScript(const Model& model, const std::vector<PostureResult>& results) {
-  std::vector<std::string> names, labels;
-  std::vector<energy::VariantEfforts> efforts;
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    names.push_back(kPostures[p].name);
-    efforts.push_back({results[p].variant[0].effort, results[p].variant[1].effort, results[p].variant[2].effort});
-  }
-  Eigen::VectorXd breakaway(kDof);
-  for (int j = 0; j < kDof; ++j) {
-    labels.push_back(jointLabel(j));
-    breakaway[j] = model.joint(j).breakaway_friction;
-  }
-  std::ostringstream s;
-  s << "# Generated by `zwang energy`; run it in this directory: gnuplot dual_energy.gp\n"
-       "set encoding utf8\n"
-       "set datafile separator whitespace\n"
-    << energy::normsData("$norms", "posture", names, efforts);
-  for (std::size_t p = 0; p < results.size(); ++p)
-    s << energy::jointsData(std::string("$joints_") + kPostures[p].name, labels,
-                            {results[p].variant[0].tau, results[p].variant[1].tau, results[p].variant[2].tau},
-                            breakaway);
-  s << energy::histogramStyle(results.size())
-    << "\n"
-       "set terminal pngcairo size 900,520 font \"DejaVu Sans,11\"\n"
-       "set output \"dual_energy.png\"\n"
-       "set title \"Dual arm holding a 3 kg box still: motor effort ‖τ_{control}‖\"\n"
-       "set ylabel \"‖τ_{control}‖ [N·m]\"\n"
-       "set xtics noenhanced\n"
-    << energy::normsPlot("$norms")
-    << "\n"
-       "set terminal pngcairo size 1400,800 font \"DejaVu Sans,10\"\n"
-       "set output \"dual_energy_joints.png\"\n"
-       "set multiplot layout 2,3 title \"Dual arm holding a box: |τ_{control,j}| per joint (bars; t = torso, L/R = left/right "
-       "arm) and breakaway friction f_j (red)\"\n"
-    << energy::jointsPanelStyle(kDof);
-  for (std::size_t p = 0; p < results.size(); ++p)
-    s << energy::jointsPanel(std::string("$joints_") + kPostures[p].name, kPostures[p].name, p == 0);
-  s << "unset multiplot\nunset output\n";
-  return s.str();
-}
-
-bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urdf, const Model& model,
-                   const std::vector<PostureResult>& results, bool all_ok, bool plot);
-
-}  // namespace
-
-std::function<bool(bool)> prepareDualArmEnergy(const ReportCommand& report) {
-  const std::string file = "dual_panda.urdf";
-  const std::filesystem::path urdf = std::filesystem::path(modelsDirectory(report.args, file)) / file;
-  Model model;
-  try {
-    model = loadUrdfFile(urdf.string());
-  } catch (const ModelError& e) {
-    throw CliError(kExitError, report.name + ": " + e.what() + " (use --models DIR)");
-  }
+// The dual Panda of models/ (CliError when it does not load or is another model).
+Model loadDualPanda(const ReportCommand& report, std::filesystem::path& urdf) {
+  Model model = energy::loadScenarioModel(report, "dual_panda.urdf", UrdfOptions(), urdf);
   bool as_expected = model.dof() == kDof;
   for (const char* frame : {"torso_link", "left_panda_link1", "right_panda_link1", "left_tool0", "right_tool0"})
     as_expected = as_expected && model.hasFrame(frame);
@@ -339,26 +217,63 @@ std::function<bool(bool)> prepareDualArmEnergy(const ReportCommand& report) {
     throw CliError(kExitError, report.name + ": " + urdf.string() +
                                    ": expected the 15-joint dual Panda (torso_joint, left_panda_joint1-7, "
                                    "right_panda_joint1-7) with frames left_tool0 and right_tool0");
-
-  std::vector<PostureResult> results;
-  bool all_ok = true;
-  for (const Posture& posture : kPostures) {
-    results.push_back(run(model, posture));
-    all_ok = all_ok && results.back().ok;
-  }
-  return [&report, urdf, model = std::move(model), results = std::move(results), all_ok](bool plot) {
-    return printAndWrite(report, urdf, model, results, all_ok, plot);
-  };
+  return model;
 }
 
-namespace {
+// The dual arm holding the box still in each posture of kPostures.
+class DualArmScenario final : public energy::Scenario {
+ public:
+  explicit DualArmScenario(const ReportCommand& report) : model_(loadDualPanda(report, urdf_)) {
+    for (const Posture& posture : kPostures) {
+      details_.emplace_back();
+      postures_.push_back(run(model_, posture, details_.back()));
+    }
+  }
+  energy::ScenarioFiles files() const override {
+    return {"dual_energy.csv",
+            "pose, variant, q1-15, tau1-15 = tau_control, mu1-15, tau_norm, tau_sq, tau_abs_sum,\nloop_fx..loop_nz",
+            "dual_energy.gp", "dual_energy.png, dual_energy_joints.png"};
+  }
+  bool ok() const override {
+    return std::all_of(postures_.begin(), postures_.end(), [](const energy::PostureResult& r) { return r.ok; });
+  }
+  void print() const override;
+  std::string csvText() const override {
+    return energy::armCsv(postures_, ",loop_fx,loop_fy,loop_fz,loop_nx,loop_ny,loop_nz", [this](std::size_t p, int v) {
+      return Eigen::VectorXd(details_[p].loop[static_cast<std::size_t>(v)]);
+    });
+  }
+  std::string plotScript() const override;
+
+ private:
+  void printSetting() const;
+  void printPostures() const;
+  void printTorques() const;
+  void printLoopForces() const;
+  void printChecks() const;
+
+  std::filesystem::path urdf_;
+  Model model_;
+  std::vector<energy::PostureResult> postures_;
+  std::vector<PostureDetail> details_;
+};
+
+// The same two charts as the Panda's (energy.gp), in the same style.
+std::string DualArmScenario::plotScript() const {
+  const energy::ArmCharts charts{"posture",
+                                 "dual_energy.png",
+                                 "Dual arm holding a 3 kg box still: motor effort ‖τ_{control}‖",
+                                 "1400,800",
+                                 "dual_energy_joints.png",
+                                 "Dual arm holding a box: |τ_{control,j}| per joint (bars; t = torso, L/R = "
+                                 "left/right arm) and breakaway friction f_j (red)"};
+  return energy::armPlotScript(files().script, charts, postures_, model_, jointLabel);
+}
 
 // What the report shows: the model, the box, the task and the postures' source.
-void printSetting(const std::filesystem::path& urdf, const Model& model) {
-  std::error_code ec;
-  const std::filesystem::path proximate = std::filesystem::proximate(urdf, ec);
-  const std::string shown = (ec ? urdf : proximate).string();
-  std::printf("\nzwang energy: %s (torso + two Pandas, 15 joints) holding a box still, at rest\n", shown.c_str());
+void DualArmScenario::printSetting() const {
+  std::printf("\nzwang energy: %s (torso + two Pandas, 15 joints) holding a box still, at rest\n",
+              energy::shownPath(urdf_).c_str());
   std::printf(
       "box: %g kg, 0.3 m wide (y, between the hands) x 0.2 m deep x 0.2 m high, centre midway between the hands;\n"
       "its weight split evenly: (0, 0, -%g) N at each tool0 origin, world axes (no moment: the lever arms cancel)\n",
@@ -367,85 +282,77 @@ void printSetting(const std::filesystem::path& urdf, const Model& model) {
       "task: left_tool0 relative to right_tool0 (6 rows, right_tool0's axes: the closed loop) + right_tool0 fixed\n"
       "(6 rows, world axes) + torso_link, left_panda_link1, right_panda_link1 angular z (= qdd of torso, L1, R1)\n"
       "fixed: 15 independent rows on 15 joints, qdd = 0 exactly\n");
-  std::printf("breakaway friction f [N·m]: torso %s, each arm", fmt(model.joint(0).breakaway_friction).c_str());
-  for (int j = 1; j <= 7; ++j) std::printf(" %s", fmt(model.joint(j).breakaway_friction).c_str());
+  std::printf("breakaway friction f [N·m]: torso %s, each arm", fmt(model_.joint(0).breakaway_friction).c_str());
+  for (int j = 1; j <= 7; ++j) std::printf(" %s", fmt(model_.joint(j).breakaway_friction).c_str());
   std::printf(
       "\npostures: the hands at the box's side faces (box centre +-0.15 m along the torso's y), tool0 z towards\n"
       "the box, x down; solved by damped least squares from make_dual_panda.py --check's grasp\n\n");
 }
 
 // The postures (torso, box, hand error, closest limit) and their q.
-void printPostures(const std::vector<PostureResult>& results) {
+void DualArmScenario::printPostures() const {
   std::printf(
       "postures: torso angle [rad], box centre in the torso frame [m], hand error [m or rad], closest limit [rad]\n");
   std::vector<std::vector<std::string>> postures{
       {"posture", "what", "torso", "box x", "y", "z", "hand error", "closest limit"}};
-  for (std::size_t p = 0; p < results.size(); ++p) {
+  for (std::size_t p = 0; p < postures_.size(); ++p) {
     const Posture& posture = kPostures[p];
     postures.push_back({posture.name, posture.what, fmt(posture.torso), fmt(posture.box[0]), fmt(posture.box[1]),
-                        fmt(posture.box[2]), small(results[p].ik_error), fmt(results[p].limit_distance, "%.3f")});
+                        fmt(posture.box[2]), small(details_[p].ik_error), fmt(details_[p].limit_distance, "%.3f")});
   }
   printColumns(postures, 2);
 
   std::printf("\nq [rad]: torso, left arm 1-7, right arm 1-7\n");
   std::vector<std::vector<std::string>> qs{
       {"posture", "t", "L1", "L2", "L3", "L4", "L5", "L6", "L7", "R1", "R2", "R3", "R4", "R5", "R6", "R7"}};
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    std::vector<std::string> row{kPostures[p].name};
-    for (int j = 0; j < kDof; ++j) row.push_back(fmt(results[p].q[j], "%.4f"));
+  for (const energy::PostureResult& r : postures_) {
+    std::vector<std::string> row{r.name};
+    for (const double q : r.q) row.push_back(fmt(q, "%.4f"));
     qs.push_back(row);
   }
   printColumns(qs);
 }
 
 // tau_control per joint and variant.
-void printTorques(const std::vector<PostureResult>& results) {
+void DualArmScenario::printTorques() const {
   std::printf("\ntau_control per joint [N·m]\n");
   std::vector<std::vector<std::string>> joints{{"posture", "variant"}};
   for (int j = 0; j < kDof; ++j) joints[0].push_back(jointLabel(j));
-  for (std::size_t p = 0; p < results.size(); ++p)
+  for (const energy::PostureResult& r : postures_)
     for (int v = 0; v < energy::kVariantCount; ++v) {
-      std::vector<std::string> row{v == 0 ? kPostures[p].name : "", energy::kVariants[v].name};
-      for (int j = 0; j < kDof; ++j) row.push_back(fmt(results[p].variant[v].tau[j], "%.3g"));
+      std::vector<std::string> row{v == 0 ? r.name : "", energy::kVariants[v].name};
+      for (const double tau : r.variant[static_cast<std::size_t>(v)].tau) row.push_back(fmt(tau, "%.3g"));
       joints.push_back(row);
     }
   printColumns(joints, 2);
 }
 
 // The closed loop's internal force per posture.
-void printLoopForces(const std::vector<PostureResult>& results) {
+void DualArmScenario::printLoopForces() const {
   std::printf(
       "\nthe loop's force: nu of the relative rows, the wrench on the left hand (its opposite on the right arm) in\n"
       "right_tool0's axes (z points from the right hand to the left: fz > 0 pulls the hands apart, fz < 0 squeezes;\n"
       "x down); N and N·m; plain solver. It is the task rows' share of the motor torques, internal to the loop (it\n"
-      "puts no torque on the torso); the box's own load is in the wrenches, split evenly, so the box feels no squeeze.\n");
+      "puts no torque on the torso); the box's own load is in the wrenches, split evenly, so the box feels no "
+      "squeeze.\n");
   std::vector<std::vector<std::string>> loop{{"posture", "fx", "fy", "fz", "nx", "ny", "nz", "torso torque of it"}};
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    std::vector<std::string> row{kPostures[p].name};
-    for (int k = 0; k < 6; ++k) row.push_back(fmt(results[p].variant[0].loop[k]));
-    row.push_back(small(results[p].worst_torso_internal));
+  for (std::size_t p = 0; p < postures_.size(); ++p) {
+    std::vector<std::string> row{postures_[p].name};
+    for (int k = 0; k < 6; ++k) row.push_back(fmt(details_[p].loop[0][k]));
+    row.push_back(small(details_[p].worst_torso_internal));
     loop.push_back(row);
   }
   printColumns(loop);
 }
 
-// The effort table and what the checks found at worst.
-void printEffortsAndChecks(const std::vector<PostureResult>& results) {
-  std::vector<std::string> names;
-  std::vector<energy::VariantEfforts> efforts;
-  std::vector<bool> ok;
-  for (std::size_t p = 0; p < results.size(); ++p) {
-    names.push_back(kPostures[p].name);
-    efforts.push_back({results[p].variant[0].effort, results[p].variant[1].effort, results[p].variant[2].effort});
-    ok.push_back(results[p].ok);
-  }
-  energy::printEffortTable("posture", names, efforts, ok);
+// What the checks found at worst.
+void DualArmScenario::printChecks() const {
   double worst[4] = {0, 0, 0, 0};
-  for (const PostureResult& r : results) {
-    worst[0] = std::max(worst[0], r.worst_qdd);
-    worst[1] = std::max(worst[1], r.worst_closed_form);
-    worst[2] = std::max(worst[2], r.worst_closure);
-    worst[3] = std::max(worst[3], r.worst_torso_internal);
+  for (const PostureDetail& d : details_) {
+    worst[0] = std::max(worst[0], d.worst_qdd);
+    worst[1] = std::max(worst[1], d.worst_closed_form);
+    worst[2] = std::max(worst[2], d.worst_closure);
+    worst[3] = std::max(worst[3], d.worst_torso_internal);
   }
   std::printf(
       "check: rank 15 in every solve; within 1e-9: |qdd| (worst %s), tau_control = the closed form from G' = RNEA\n"
@@ -454,22 +361,19 @@ void printEffortsAndChecks(const std::vector<PostureResult>& results) {
       small(worst[0]).c_str(), small(worst[1]).c_str(), small(worst[2]).c_str(), small(worst[3]).c_str());
 }
 
-bool printAndWrite(const ReportCommand& report, const std::filesystem::path& urdf, const Model& model,
-                   const std::vector<PostureResult>& results, bool all_ok, bool plot) {
-  printSetting(urdf, model);
-  printPostures(results);
-  printTorques(results);
-  printLoopForces(results);
-  printEffortsAndChecks(results);
-  writeOutput((report.out / "dual_energy.csv").string(), csvText(results));
-  std::printf(
-      "wrote %s/dual_energy.csv (pose, variant, q1-15, tau1-15 = tau_control, mu1-15, tau_norm, tau_sq, tau_abs_sum,\n"
-      "loop_fx..loop_nz)\n",
-      report.out.string().c_str());
-  writePlots(report, "dual_energy.gp", plotScript(model, results), "dual_energy.png, dual_energy_joints.png", plot);
-  return all_ok;
+void DualArmScenario::print() const {
+  printSetting();
+  printPostures();
+  printTorques();
+  printLoopForces();
+  energy::printEffortTable("posture", postures_);
+  printChecks();
 }
 
 }  // namespace
+
+std::unique_ptr<energy::Scenario> energy::dualArmScenario(const ReportCommand& report) {
+  return std::make_unique<DualArmScenario>(report);
+}
 
 }  // namespace zwang::cli

@@ -1,5 +1,6 @@
-// What the scenarios of `zwang energy` share (energy_report.hpp): variants,
-// effort measures, number formats, the effort table and the bar charts' pieces.
+// What the scenarios of `zwang energy` share (energy_report.hpp): the writer,
+// variants, effort measures, number formats, the effort table, the arms' CSV
+// and charts, and the bar charts' pieces.
 #include "energy_report.hpp"
 
 #include <cmath>
@@ -30,6 +31,44 @@ Effort effortOf(const Eigen::VectorXd& tau) {
   return e;
 }
 
+VariantResult variantResult(const Variant& variant, const Eigen::VectorXd& tau, const Workspace& ws) {
+  VariantResult e;
+  e.tau = tau;
+  e.mu = variant.margin < 0 ? Eigen::VectorXd::Zero(tau.size()) : Eigen::VectorXd(ws.friction.mu);
+  e.effort = effortOf(tau);
+  return e;
+}
+
+VariantEfforts PostureResult::efforts() const { return {variant[0].effort, variant[1].effort, variant[2].effort}; }
+
+std::array<Eigen::VectorXd, kVariantCount> PostureResult::torques() const {
+  return {variant[0].tau, variant[1].tau, variant[2].tau};
+}
+
+bool writeScenario(const ReportCommand& report, const Scenario& scenario, bool run_gnuplot) {
+  scenario.print();
+  const ScenarioFiles files = scenario.files();
+  writeOutput((report.out / files.csv).string(), scenario.csvText());
+  std::printf("wrote %s/%s (%s)\n", report.out.string().c_str(), files.csv.c_str(), files.columns.c_str());
+  return writePlots(report, files.script, scenario.plotScript(), files.pngs, run_gnuplot);
+}
+
+Model loadScenarioModel(const ReportCommand& report, const std::string& file, const UrdfOptions& options,
+                        std::filesystem::path& urdf) {
+  urdf = std::filesystem::path(modelsDirectory(report.args, file)) / file;
+  try {
+    return loadUrdfFile(urdf.string(), options);
+  } catch (const ModelError& e) {
+    throw CliError(kExitError, report.name + ": " + e.what() + " (use --models DIR)");
+  }
+}
+
+std::string shownPath(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::path proximate = std::filesystem::proximate(path, ec);
+  return (ec ? path : proximate).string();
+}
+
 std::string fmt(double x, const char* format) {
   char buffer[40];
   std::snprintf(buffer, sizeof buffer, format, std::abs(x) < 1e-12 ? 0.0 : x);
@@ -54,8 +93,7 @@ std::string dataCell(double x) {
   return buffer;
 }
 
-void printEffortTable(const std::string& noun, const std::vector<std::string>& names,
-                      const std::vector<VariantEfforts>& efforts, const std::vector<bool>& ok) {
+void printEffortTable(const std::string& noun, const std::vector<PostureResult>& postures) {
   std::printf(
       "\nactuator effort: |tau| = 2-norm of tau_control [N·m], sum|tau| [N·m], |tau|^2 [N²m²];\n"
       "m = margin of the friction-aware solve; saved = how much less |tau|^2 with m=1 than plain\n");
@@ -63,15 +101,15 @@ void printEffortTable(const std::string& noun, const std::vector<std::string>& n
                                                "sum|tau| m=0.5", "sum|tau| m=1", "|tau|^2 plain", "|tau|^2 m=0.5",
                                                "|tau|^2 m=1", "saved m=1", "check"}};
   double total[kVariantCount] = {0, 0, 0};
-  for (std::size_t p = 0; p < names.size(); ++p) {
-    const VariantEfforts& e = efforts[p];
-    std::vector<std::string> row{names[p]};
+  for (const PostureResult& posture : postures) {
+    const VariantEfforts e = posture.efforts();
+    std::vector<std::string> row{posture.name};
     for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(e[v].norm));
     for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(e[v].abs_sum));
     for (int v = 0; v < kVariantCount; ++v) row.push_back(fmt(e[v].sq));
     for (int v = 0; v < kVariantCount; ++v) total[v] += e[v].sq;
     row.push_back(fmt(100.0 * (1.0 - e[2].sq / e[0].sq), "%.1f") + " %");
-    row.push_back(ok[p] ? "ok" : "MISMATCH");
+    row.push_back(posture.ok ? "ok" : "MISMATCH");
     table.push_back(row);
   }
   printColumns(table);
@@ -81,13 +119,71 @@ void printEffortTable(const std::string& noun, const std::vector<std::string>& n
               fmt(100.0 * (1.0 - total[2] / total[0]), "%.1f").c_str());
 }
 
-std::string normsData(const std::string& block, const std::string& noun, const std::vector<std::string>& names,
-                      const std::vector<VariantEfforts>& efforts) {
+std::string armCsv(const std::vector<PostureResult>& postures, const std::string& extra_columns,
+                   const ExtraCells& extra) {
+  const Eigen::Index dof = postures.empty() ? 0 : postures[0].q.size();
+  std::ostringstream out;
+  out << "pose,variant";
+  for (const char* column : {"q", "tau", "mu"})
+    for (Eigen::Index j = 1; j <= dof; ++j) out << "," << column << j;
+  out << ",tau_norm,tau_sq,tau_abs_sum" << extra_columns << "\n";
+  for (std::size_t p = 0; p < postures.size(); ++p)
+    for (int v = 0; v < kVariantCount; ++v) {
+      const VariantResult& e = postures[p].variant[static_cast<std::size_t>(v)];
+      out << postures[p].name << "," << kVariants[v].name;
+      for (const Eigen::VectorXd* cells : {&postures[p].q, &e.tau, &e.mu})
+        for (const double x : *cells) out << csvCell(x);
+      out << csvCell(e.effort.norm) << csvCell(e.effort.sq) << csvCell(e.effort.abs_sum);
+      if (extra)
+        for (const double x : extra(p, v)) out << csvCell(x);
+      out << "\n";
+    }
+  return out.str();
+}
+
+std::string armPlotScript(const std::string& script, const ArmCharts& charts,
+                          const std::vector<PostureResult>& postures, const Model& model,
+                          std::string (*label)(int joint)) {
+  std::vector<std::string> labels;
+  Eigen::VectorXd breakaway(model.dof());
+  for (int j = 0; j < model.dof(); ++j) {
+    labels.push_back(label(j));
+    breakaway[j] = model.joint(j).breakaway_friction;
+  }
+  std::ostringstream s;
+  s << scriptHeader(script) << normsData("$norms", charts.noun, postures);
+  for (const PostureResult& posture : postures)
+    s << jointsData("$joints_" + posture.name, labels, posture.torques(), breakaway);
+  s << histogramStyle(postures.size()) << "\n"
+    << "set terminal pngcairo size 900,520 font \"DejaVu Sans,11\"\n"
+    << "set output \"" << charts.efforts_png << "\"\n"
+    << "set title \"" << charts.efforts_title << "\"\n"
+    << "set ylabel \"‖τ_{control}‖ [N·m]\"\n"
+       "set xtics noenhanced\n"
+    << normsPlot("$norms") << "\n"
+    << "set terminal pngcairo size " << charts.joints_size << " font \"DejaVu Sans,10\"\n"
+    << "set output \"" << charts.joints_png << "\"\n"
+    << "set multiplot layout 2,3 title \"" << charts.joints_title << "\"\n"
+    << jointsPanelStyle(labels.size());
+  for (std::size_t p = 0; p < postures.size(); ++p)
+    s << jointsPanel("$joints_" + postures[p].name, postures[p].name, p == 0);
+  s << "unset multiplot\nunset output\n";
+  return s.str();
+}
+
+std::string scriptHeader(const std::string& script) {
+  return "# Generated by `zwang energy`; run it in this directory: gnuplot " + script +
+         "\n"
+         "set encoding utf8\n"
+         "set datafile separator whitespace\n";
+}
+
+std::string normsData(const std::string& block, const std::string& noun, const std::vector<PostureResult>& postures) {
   std::ostringstream s;
   s << "# columns: " << noun << ", |tau_control| plain, margin 0.5, margin 1 [N·m]\n" << block << " << EOD\n";
-  for (std::size_t p = 0; p < names.size(); ++p) {
-    s << names[p];
-    for (int v = 0; v < kVariantCount; ++v) s << dataCell(efforts[p][v].norm);
+  for (const PostureResult& posture : postures) {
+    s << posture.name;
+    for (const Effort& effort : posture.efforts()) s << dataCell(effort.norm);
     s << "\n";
   }
   s << "EOD\n";

@@ -1,15 +1,20 @@
 // What the scenarios of `zwang energy` share (energy.cpp: the Panda,
 // energy_dual.cpp: the dual arm holding a box, energy_standing.cpp: the
-// humanoid and Solo 12 standing): the three variants compared, the effort
-// measures of τ_control, the number formats of the tables, CSVs and gnuplot
-// data, the effort table every scenario prints, and the pieces of the
-// gnuplot bar charts (docs/evaluation.md, sections 2-4).
+// humanoid and Solo 12 standing): the scenario interface and its writer, the
+// three variants compared, the effort measures of τ_control, the number
+// formats of the tables, CSVs and gnuplot data, the effort table every
+// scenario prints, the arms' CSV and charts, and the pieces of the gnuplot
+// bar charts (docs/evaluation.md, sections 2-4).
 #pragma once
 
 #include <array>
+#include <filesystem>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "cli.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli::energy {
@@ -36,6 +41,62 @@ struct Effort {
 Effort effortOf(const Eigen::VectorXd& tau);
 using VariantEfforts = std::array<Effort, kVariantCount>;
 
+// One solve of a posture: τ_control and μ* of the joints (μ = 0 for plain) and τ_control's effort.
+struct VariantResult {
+  Eigen::VectorXd tau, mu;
+  Effort effort;
+};
+// The joints' τ_control `tau` of a solve of `variant`, with μ* from ws.friction.
+VariantResult variantResult(const Variant& variant, const Eigen::VectorXd& tau, const Workspace& ws);
+
+// A posture's three solves: what the effort table, the CSVs and the charts take.
+struct PostureResult {
+  std::string name;
+  Eigen::VectorXd q;
+  std::array<VariantResult, kVariantCount> variant;
+  bool ok = false;  // every check of the posture passed
+  VariantEfforts efforts() const;
+  std::array<Eigen::VectorXd, kVariantCount> torques() const;
+};
+
+// The files a scenario writes into --out, and what the report says of them.
+struct ScenarioFiles {
+  std::string csv;      // the CSV's file name
+  std::string columns;  // its columns, as the "wrote" line lists them
+  std::string script;   // the gnuplot script's file name
+  std::string pngs;     // the plots it draws
+};
+
+// One scenario of `zwang energy`. It is solved and checked when it is made
+// (CliError when something cannot be solved), so nothing is written until
+// every scenario is; writeScenario then prints and writes it.
+class Scenario {
+ public:
+  virtual ~Scenario() = default;
+  virtual ScenarioFiles files() const = 0;
+  virtual bool ok() const = 0;     // every check passed
+  virtual void print() const = 0;  // the report's tables
+  virtual std::string csvText() const = 0;
+  virtual std::string plotScript() const = 0;
+};
+
+// Print the scenario, write its CSV and say so, then its plots (writePlots,
+// run_gnuplot as there). Returns whether there are plots.
+bool writeScenario(const ReportCommand& report, const Scenario& scenario, bool run_gnuplot);
+
+// The scenarios after the Panda: the dual arm holding a box (energy_dual.cpp)
+// and the humanoid and Solo 12 standing (energy_standing.cpp). Each loads its
+// models from the models directory (CliError when one does not load or is
+// not the expected one).
+std::unique_ptr<Scenario> dualArmScenario(const ReportCommand& report);
+std::unique_ptr<Scenario> standingScenario(const ReportCommand& report);
+
+// A scenario's model `file` from the models directory; `urdf` is set to its path.
+Model loadScenarioModel(const ReportCommand& report, const std::string& file, const UrdfOptions& options,
+                        std::filesystem::path& urdf);
+// A path as the report shows it: relative to the working directory when it can be.
+std::string shownPath(const std::filesystem::path& path);
+
 // A number for the tables: printf `format`, with |x| < 1e-12 shown as 0.
 std::string fmt(double x, const char* format = "%.4g");
 // A check's residual, as it is ("%.1e"; fmt would show |x| < 1e-12 as 0).
@@ -45,16 +106,40 @@ std::string csvCell(double x);
 // " x" with 17 significant digits, |x| < 1e-12 as 0: a gnuplot data cell.
 std::string dataCell(double x);
 
-// The effort table: one row per entry of `names` (‖τ‖, Σ|τ|, ‖τ‖² of each
-// variant, how much less ‖τ‖² margin 1 needs than plain, "ok" or "MISMATCH"),
-// then the line summing ‖τ‖² over the rows. `noun` names a row ("pose").
-void printEffortTable(const std::string& noun, const std::vector<std::string>& names,
-                      const std::vector<VariantEfforts>& efforts, const std::vector<bool>& ok);
+// The effort table: one row per posture (‖τ‖, Σ|τ|, ‖τ‖² of each variant,
+// how much less ‖τ‖² margin 1 needs than plain, "ok" or "MISMATCH"), then the
+// line summing ‖τ‖² over the rows. `noun` names a row ("pose").
+void printEffortTable(const std::string& noun, const std::vector<PostureResult>& postures);
+
+// The arms' CSV (the Panda, the dual arm): one row per posture and variant
+// with q, τ_control, μ and the efforts, then `extra` of that posture and
+// variant, whose columns `extra_columns` names (",a,b"; "" for none).
+using ExtraCells = std::function<Eigen::VectorXd(std::size_t posture, int variant)>;
+std::string armCsv(const std::vector<PostureResult>& postures, const std::string& extra_columns = "",
+                   const ExtraCells& extra = nullptr);
+
+// What the arms' two bar charts say: ‖τ_control‖ per posture and variant, and
+// |τ_control,j| per joint and posture with the breakaway torques.
+struct ArmCharts {
+  std::string noun;           // a posture in the data's comment ("pose")
+  std::string efforts_png;    // the effort chart's file
+  std::string efforts_title;  // and its title
+  std::string joints_size;    // the per-joint chart's size in pixels ("1200,760")
+  std::string joints_png;     // its file
+  std::string joints_title;   // and its title
+};
+// The arms' gnuplot script: the data inline (17 digits, the CSV's numbers), the
+// two charts in the style of docs/energy/energy.gp; joint j is shown as label(j)
+// with the model's breakaway friction.
+std::string armPlotScript(const std::string& script, const ArmCharts& charts,
+                          const std::vector<PostureResult>& postures, const Model& model,
+                          std::string (*label)(int joint));
 
 // gnuplot pieces, in the style of docs/energy/energy.gp.
-// "$norms": one line per name, ‖τ_control‖ of each variant.
-std::string normsData(const std::string& block, const std::string& noun, const std::vector<std::string>& names,
-                      const std::vector<VariantEfforts>& efforts);
+// The script's first lines: what made it and how to run it, utf8, whitespace-separated data.
+std::string scriptHeader(const std::string& script);
+// "$norms": one line per posture, ‖τ_control‖ of each variant.
+std::string normsData(const std::string& block, const std::string& noun, const std::vector<PostureResult>& postures);
 // One joint per line: its label, |τ_control,j| of each variant and f_j.
 std::string jointsData(const std::string& block, const std::vector<std::string>& labels,
                        const std::array<Eigen::VectorXd, kVariantCount>& tau, const Eigen::VectorXd& breakaway);

@@ -25,7 +25,8 @@
 // rank nv and |q̈|; RNEA with the ground wrenches (ν of the contacts) on the
 // feet gives 0 on the base and τ_control − μ on the joints; ν is the
 // least-norm solution of the dense balance Gᵀν = RNEA(q, 0, 0) + [0; μ]
-// (G from frameJacobian, Eigen's complete orthogonal decomposition); with
+// (G from frameJacobian, Eigen's complete orthogonal decomposition: the
+// dense reference of standing_reference.hpp); with
 // friction, |μ_j| ≤ margin·f_j, μ meets the optimality (KKT) conditions of
 // min ‖τ_control(μ)‖² over that box with τ_control(μ) from the same dense
 // map, and ‖τ_control‖² is not above the plain one.
@@ -40,21 +41,19 @@
 // too (neither URDF has any) and given per solve (FrictionOptions::breakaway):
 // see humanoidBreakaway and soloBreakaway.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
-#include <Eigen/QR>
-
 #include "cli.hpp"
 #include "energy_report.hpp"
+#include "standing_reference.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli {
@@ -68,7 +67,6 @@ constexpr double kCheckTolerance = 1e-9;       // the checks: torques [N·m], fo
 constexpr double kPlacementTolerance = 1e-12;  // feet off z = 0 or off level after placing the base [m, rad]:
                                                // a few transforms of numbers below 1 round to ~1e-16
 constexpr double kLimitDistance = 0.05;        // every joint at least this far inside its limits [rad]
-constexpr double kBoundTolerance = 1e-9;       // μ within this of ±margin·f counts as on the bound [N·m]
 
 struct JointValue {
   std::string joint;
@@ -171,31 +169,23 @@ const StandingRobot kRobots[] = {
      &kSoloPostures},
 };
 
-struct VariantResult {
-  Eigen::VectorXd tau, mu;  // τ_control and μ* of the joints (n)
-  Eigen::VectorXd ground;   // ν of the contact rows: per foot [f; n] or [f], world axes at the foot origin
-  energy::Effort effort;
-  double least_sq = 0;  // friction variants: the least ‖τ_control‖² over the margin box (leastEffort)
-  double kkt = 0;       // friction variants: how far μ is from minimising ‖τ_control‖² there (kktViolation)
+// What the standing report adds to a variant's solve (energy::VariantResult).
+struct VariantDetail {
+  Eigen::VectorXd ground;  // ν of the contact rows: per foot [f; n] or [f], world axes at the foot origin
+  double least_sq = 0;     // friction variants: the least ‖τ_control‖² over the margin box (leastEffort)
+  double kkt = 0;          // friction variants: how far μ is from minimising ‖τ_control‖² there (kktViolation)
 };
 
-// Plain, with the split of the ground's force that needs the least motor effort (bestSplit).
-struct BestSplit {
-  double sq = 0;          // ‖τ_control‖²
-  double tangential = 0;  // the largest |horizontal force| / vertical force on a foot
-};
-
-struct PostureResult {
-  Eigen::VectorXd q;
+// What the standing report adds to a posture's solves (energy::PostureResult).
+struct PostureDetail {
   double placement_error = 0, limit_distance = 0;
   Eigen::Vector2d com = Eigen::Vector2d::Zero();  // the centre of mass across gravity [m], world x, y
   double mass = 0;                                // [kg], from RNEA's base force
-  VariantResult variant[energy::kVariantCount];
+  std::array<VariantDetail, energy::kVariantCount> variant;
   int rank = 0;
   double worst_qdd = 0, worst_rnea = 0, worst_split = 0, worst_bound = 0, split_shift = 0;
   double worst_reference_kkt = 0;  // of the least-effort reference (leastEffort)
-  BestSplit best_split;            // plain: the least ‖τ_control‖² over every split of the ground's force
-  bool ok = false;
+  standing::BestSplit best_split;  // plain: the least ‖τ_control‖² over every split of the ground's force
 };
 
 struct RobotResult {
@@ -203,7 +193,8 @@ struct RobotResult {
   std::filesystem::path urdf;
   Model model;
   Eigen::VectorXd breakaway;
-  std::vector<PostureResult> postures;
+  std::vector<energy::PostureResult> postures;
+  std::vector<PostureDetail> details;  // one per posture
 };
 
 // Feet with six contact rows carry a moment: they stand flat, level on the ground.
@@ -283,7 +274,7 @@ double limitDistance(const Model& model, const Eigen::VectorXd& q) {
 }
 
 Eigen::VectorXd postureConfiguration(const Model& model, Workspace& ws, const StandingRobot& robot,
-                                     const Posture& posture, PostureResult& r) {
+                                     const Posture& posture, PostureDetail& r) {
   const std::string context = where(robot, posture);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq());
   for (const JointValue& value : posture.joints)
@@ -306,122 +297,14 @@ Task standingTask(const Model& model, const StandingRobot& robot) {
   return task;
 }
 
-// Gᵀ of the task's rows, built densely from the feet's world Jacobians and
-// the joint rows' unit torques, independently of the solver's sweeps.
-Eigen::MatrixXd balanceTranspose(const Model& model, Workspace& ws, const StandingRobot& robot,
-                                 const Eigen::VectorXd& q) {
-  const int contacts = robot.contact_rows * static_cast<int>(robot.feet.size()), n = model.dof(), nv = model.nv();
-  Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(nv, contacts + n);
-  Eigen::MatrixXd J(6, nv);
-  for (std::size_t k = 0; k < robot.feet.size(); ++k) {
-    require(frameJacobian(model, ws, q, model.frameIndex(robot.feet[k]), Expressed::World, J), "energy: ");
-    Gt.middleCols(robot.contact_rows * static_cast<int>(k), robot.contact_rows) =
-        J.topRows(robot.contact_rows).transpose();
-  }
-  Gt.bottomRightCorner(n, n).setIdentity();
-  return Gt;
-}
-
-// RNEA with the ground wrenches on the feet: the generalized force the
-// motors and friction must supply for q̈ = 0 (0 on the base when the ground
-// carries the robot).
-Eigen::VectorXd torquesWithGround(const Model& model, Workspace& ws, const StandingRobot& robot,
-                                  const Eigen::VectorXd& q, const Eigen::VectorXd& ground) {
-  Task loaded(model);
-  for (std::size_t k = 0; k < robot.feet.size(); ++k) {
-    Vec6 w = Vec6::Zero();
-    w.head(robot.contact_rows) = ground.segment(robot.contact_rows * static_cast<Eigen::Index>(k), robot.contact_rows);
-    loaded.wrench(loaded.addWrench(robot.feet[k], Expressed::World)) = w;
-  }
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, loaded, q, zero, zero, ws), "energy: RNEA: ");
-  return ws.tau;
-}
-
-// The standing balance written densely, independently of the solver's
-// sweeps: the least-norm ν for a friction torque μ is Gᵀ⁺ (RNEA(q, 0, 0) +
-// [0; μ]), so τ_control(μ) = τ₀ + M μ, its joint rows' part, is affine in μ.
-struct DenseBalance {
-  Eigen::MatrixXd Gt_matrix;  // Gᵀ: nv × rows, the contacts' columns first, then the joint rows'
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Gt;
-  Eigen::VectorXd gravity;  // RNEA(q, 0, 0), nv
-  Eigen::VectorXd tau0;     // τ_control(0)
-  Eigen::MatrixXd M;        // ∂τ_control/∂μ (n × n; the identity if the split did not move)
-};
-
-DenseBalance denseBalance(const Model& model, Workspace& ws, const StandingRobot& robot, const Eigen::VectorXd& q,
-                          const std::string& context) {
-  const int n = model.dof();
-  DenseBalance d;
-  d.Gt_matrix = balanceTranspose(model, ws, robot, q);
-  d.Gt.compute(d.Gt_matrix);
-  const Task gravity_only(model);
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, gravity_only, q, zero, zero, ws), context + "RNEA: ");
-  d.gravity = ws.tau;
-  d.tau0 = d.Gt.solve(d.gravity).tail(n);
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(model.nv(), n);
-  unit.bottomRows(n).setIdentity();
-  d.M = d.Gt.solve(unit).bottomRows(n);
-  return d;
-}
-
-// The least ‖τ_control‖² over every split of the ground's force, without
-// friction: ν = ν₀ + N z solves the balance for any z (N spans null(Gᵀ), the
-// internal forces), and z is chosen for the least motor torques.
-BestSplit bestSplit(const DenseBalance& d, int contact_rows) {
-  const Eigen::Index n = d.tau0.size();
-  const Eigen::MatrixXd internal = Eigen::FullPivLU<Eigen::MatrixXd>(d.Gt_matrix).kernel();
-  const Eigen::MatrixXd on_joints = internal.bottomRows(n);
-  const Eigen::VectorXd z = -on_joints.completeOrthogonalDecomposition().solve(d.tau0);
-  const Eigen::VectorXd nu = d.Gt.solve(d.gravity) + internal * z;
-  BestSplit best;
-  best.sq = nu.tail(n).squaredNorm();
-  for (Eigen::Index foot = 0; foot + contact_rows <= nu.size() - n; foot += contact_rows)
-    best.tangential = std::max(best.tangential, nu.segment<2>(foot).norm() / nu[foot + 2]);
-  return best;
-}
-
-// The worst violation of the optimality conditions of min ½‖τ₀ + M μ‖² over
-// |μ_j| ≤ bound_j: the gradient Mᵀτ is 0 inside the box and points out of
-// it on a bound [N·m].
-double kktViolation(const DenseBalance& d, const Eigen::VectorXd& mu, const Eigen::VectorXd& bound) {
-  const Eigen::VectorXd gradient = d.M.transpose() * (d.tau0 + d.M * mu);
-  double worst = 0;
-  for (Eigen::Index j = 0; j < mu.size(); ++j) {
-    if (mu[j] >= bound[j] - kBoundTolerance)
-      worst = std::max(worst, gradient[j]);
-    else if (mu[j] <= -bound[j] + kBoundTolerance)
-      worst = std::max(worst, -gradient[j]);
-    else
-      worst = std::max(worst, std::abs(gradient[j]));
-  }
-  return worst;
-}
-
-// The least ‖τ_control(μ)‖² over the margin box, by projected gradient with
-// the step 1/λ_max(MᵀM) (a convex quadratic: every step lowers it), until
-// the optimality conditions hold to 1e-12 N·m (the gradient sums torques of
-// at most a few hundred N·m, rounding at ~1e-13; the result is judged at
-// kCheckTolerance) or 10⁵ steps. The reference for the friction-aware
-// solve's pick.
-Eigen::VectorXd leastEffort(const DenseBalance& d, const Eigen::VectorXd& bound) {
-  const Eigen::MatrixXd MtM = d.M.transpose() * d.M;
-  const double step = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(MtM).eigenvalues().maxCoeff();
-  Eigen::VectorXd mu = Eigen::VectorXd::Zero(bound.size());
-  for (int iteration = 0; iteration < 100000 && kktViolation(d, mu, bound) > 1e-12; ++iteration)
-    mu = (mu - step * (d.M.transpose() * (d.tau0 + d.M * mu))).cwiseMax(-bound).cwiseMin(bound);
-  return mu;
-}
-
 void checkVariant(const Model& model, Workspace& ws, const StandingRobot& robot, const Eigen::VectorXd& q,
-                  const DenseBalance& dense, const Eigen::VectorXd& breakaway, int v, const Solution& solution,
-                  PostureResult& r) {
+                  const standing::DenseBalance& dense, const Eigen::VectorXd& breakaway, int v,
+                  const Solution& solution, const energy::VariantResult& e, PostureDetail& r) {
   const int n = model.dof(), kb = model.baseVelocitySize();
   const energy::Variant& variant = energy::kVariants[v];
-  VariantResult& e = r.variant[v];
+  VariantDetail& g = r.variant[static_cast<std::size_t>(v)];
   // The ground's wrenches hold the robot; the joints feel τ_control − μ.
-  const Eigen::VectorXd needed = torquesWithGround(model, ws, robot, q, e.ground);
+  const Eigen::VectorXd needed = standing::torquesWithGround(model, ws, robot.feet, robot.contact_rows, q, g.ground);
   r.worst_rnea = std::max({r.worst_rnea, needed.head(kb).cwiseAbs().maxCoeff(),
                            (needed.tail(n) - (e.tau - e.mu)).cwiseAbs().maxCoeff(),
                            solution.tau_control.head(kb).cwiseAbs().maxCoeff()});
@@ -433,64 +316,64 @@ void checkVariant(const Model& model, Workspace& ws, const StandingRobot& robot,
   // Friction: inside the margin box; how far from the least ‖τ_control‖² there.
   const Eigen::VectorXd bound = variant.margin * breakaway;
   r.worst_bound = std::max(r.worst_bound, (e.mu.cwiseAbs() - bound).maxCoeff());
-  e.kkt = kktViolation(dense, e.mu, bound);
-  const Eigen::VectorXd least = leastEffort(dense, bound);
-  r.worst_reference_kkt = std::max(r.worst_reference_kkt, kktViolation(dense, least, bound));
-  e.least_sq = (dense.tau0 + dense.M * least).squaredNorm();
+  g.kkt = standing::kktViolation(dense, e.mu, bound);
+  const Eigen::VectorXd least = standing::leastEffort(dense, bound);
+  r.worst_reference_kkt = std::max(r.worst_reference_kkt, standing::kktViolation(dense, least, bound));
+  g.least_sq = (dense.tau0 + dense.M * least).squaredNorm();
 }
 
-PostureResult runPosture(const Model& model, const StandingRobot& robot, const Eigen::VectorXd& breakaway,
-                         const Posture& posture) {
-  PostureResult r;
+// Whether the friction-aware picks' ‖τ_control‖² lie between the least
+// possible and plain's (μ = 0 is in the box); 1e-12 relative: the sweeps and
+// the dense QP round the same optimum differently (~1e-15).
+bool effortsOrdered(const energy::PostureResult& s, const PostureDetail& r) {
+  bool ordered = true;
+  for (std::size_t v = 1; v < energy::kVariantCount; ++v)
+    ordered = ordered && r.variant[v].least_sq <= s.variant[v].effort.sq * (1 + 1e-12) &&
+              s.variant[v].effort.sq <= s.variant[0].effort.sq;
+  return ordered;
+}
+
+energy::PostureResult runPosture(const Model& model, const StandingRobot& robot, const Eigen::VectorXd& breakaway,
+                                 const Posture& posture, PostureDetail& r) {
+  energy::PostureResult s;
+  s.name = posture.name;
   Workspace check_ws(model, 0);
-  r.q = postureConfiguration(model, check_ws, robot, posture, r);
+  s.q = postureConfiguration(model, check_ws, robot, posture, r);
   const std::string context = where(robot, posture);
-  const DenseBalance dense = denseBalance(model, check_ws, robot, r.q, context);
-  r.best_split = bestSplit(dense, robot.contact_rows);
+  const standing::DenseBalance dense =
+      standing::denseBalance(model, check_ws, robot.feet, robot.contact_rows, s.q, context);
+  r.best_split = standing::bestSplit(dense, robot.contact_rows);
   const Task task = standingTask(model, robot);
   Workspace ws(model, task);
   const int n = model.dof(), contacts = robot.contact_rows * static_cast<int>(robot.feet.size());
   for (int v = 0; v < energy::kVariantCount; ++v) {
     const energy::Variant& variant = energy::kVariants[v];
-    require(energy::solveAtRest(model, task, r.q, ws, variant, breakaway), context + variant.name + ": ");
+    require(energy::solveAtRest(model, task, s.q, ws, variant, breakaway), context + variant.name + ": ");
     if (ws.solution.balance.rank != model.nv())
       throw CliError(kExitError, context + variant.name + ": the standing task has rank " +
                                      std::to_string(ws.solution.balance.rank) +
                                      ", not nv = " + std::to_string(model.nv()) + " (q̈ is not fully determined)");
-    VariantResult& e = r.variant[v];
-    e.tau = ws.solution.tau_control.tail(n);
-    e.mu = variant.margin < 0 ? Eigen::VectorXd::Zero(n) : Eigen::VectorXd(ws.friction.mu);
-    e.ground = ws.solution.nu.head(contacts);
-    e.effort = energy::effortOf(e.tau);
+    const auto k = static_cast<std::size_t>(v);
+    s.variant[k] = energy::variantResult(variant, ws.solution.tau_control.tail(n), ws);
+    r.variant[k].ground = ws.solution.nu.head(contacts);
     r.rank = ws.solution.balance.rank;
     r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
-    checkVariant(model, check_ws, robot, r.q, dense, breakaway, v, ws.solution, r);
+    checkVariant(model, check_ws, robot, s.q, dense, breakaway, v, ws.solution, s.variant[k], r);
   }
   // How far the split moved with friction: the joints' τ_control − μ at margin 1 against plain (0 for a fixed split).
-  r.split_shift = ((r.variant[2].tau - r.variant[2].mu) - r.variant[0].tau).cwiseAbs().maxCoeff();
-  // The pick's ‖τ_control‖² lies between the least possible and plain's (μ = 0 is in the box);
-  // 1e-12 relative: the sweeps and the dense QP round the same optimum differently (~1e-15).
-  bool ordered = true;
-  for (int v = 1; v < energy::kVariantCount; ++v)
-    ordered = ordered && r.variant[v].least_sq <= r.variant[v].effort.sq * (1 + 1e-12) &&
-              r.variant[v].effort.sq <= r.variant[0].effort.sq;
-  r.ok = r.rank == model.nv() && r.worst_qdd < kCheckTolerance && r.worst_rnea < kCheckTolerance &&
+  r.split_shift = ((s.variant[2].tau - s.variant[2].mu) - s.variant[0].tau).cwiseAbs().maxCoeff();
+  s.ok = r.rank == model.nv() && r.worst_qdd < kCheckTolerance && r.worst_rnea < kCheckTolerance &&
          r.worst_split < kCheckTolerance && r.worst_bound < kCheckTolerance &&
-         r.worst_reference_kkt < kCheckTolerance && ordered;
-  return r;
+         r.worst_reference_kkt < kCheckTolerance && effortsOrdered(s, r);
+  return s;
 }
 
 RobotResult runRobot(const ReportCommand& report, const StandingRobot& robot) {
   RobotResult result;
   result.robot = &robot;
-  result.urdf = std::filesystem::path(modelsDirectory(report.args, robot.file)) / robot.file;
   UrdfOptions options;
   options.base = BaseType::Free;
-  try {
-    result.model = loadUrdfFile(result.urdf.string(), options);
-  } catch (const ModelError& e) {
-    throw CliError(kExitError, report.name + ": " + e.what() + " (use --models DIR)");
-  }
+  result.model = energy::loadScenarioModel(report, robot.file, options, result.urdf);
   bool as_expected = result.model.dof() == robot.dof;
   for (const std::string& foot : robot.feet) as_expected = as_expected && result.model.hasFrame(foot);
   for (const Posture& posture : *robot.postures)
@@ -500,8 +383,10 @@ RobotResult runRobot(const ReportCommand& report, const StandingRobot& robot) {
                                    std::to_string(robot.dof) + " joints and the feet of docs/evaluation.md, section 4");
   result.breakaway.resize(robot.dof);
   for (int j = 0; j < robot.dof; ++j) result.breakaway[j] = robot.breakaway(result.model.joint(j).name);
-  for (const Posture& posture : *robot.postures)
-    result.postures.push_back(runPosture(result.model, robot, result.breakaway, posture));
+  for (const Posture& posture : *robot.postures) {
+    result.details.emplace_back();
+    result.postures.push_back(runPosture(result.model, robot, result.breakaway, posture, result.details.back()));
+  }
   return result;
 }
 
@@ -526,47 +411,36 @@ void csvRobot(std::ostringstream& out, const RobotResult& robot) {
   const std::string label = robot.robot->label;
   for (int j = 0; j < model.dof(); ++j) csvRow(out, label + ",-,-,breakaway", model.joint(j).name, robot.breakaway[j]);
   for (std::size_t p = 0; p < robot.postures.size(); ++p) {
-    const PostureResult& r = robot.postures[p];
-    const std::string posture = label + "," + (*robot.robot->postures)[p].name;
+    const energy::PostureResult& r = robot.postures[p];
+    const PostureDetail& d = robot.details[p];
+    const std::string posture = label + "," + r.name;
     for (int k = 0; k < model.nq(); ++k) csvRow(out, posture + ",-,q", qName(model, k), r.q[k]);
     for (int v = 0; v < energy::kVariantCount; ++v) {
-      const VariantResult& e = r.variant[v];
+      const energy::VariantResult& e = r.variant[static_cast<std::size_t>(v)];
+      const VariantDetail& g = d.variant[static_cast<std::size_t>(v)];
       const std::string key = posture + "," + energy::kVariants[v].name;
       for (int j = 0; j < model.dof(); ++j) csvRow(out, key + ",tau", model.joint(j).name, e.tau[j]);
       for (int j = 0; j < model.dof(); ++j) csvRow(out, key + ",mu", model.joint(j).name, e.mu[j]);
-      for (Eigen::Index k = 0; k < e.ground.size(); ++k)
-        csvRow(out, key + ",ground", groundName(*robot.robot, k), e.ground[k]);
+      for (Eigen::Index k = 0; k < g.ground.size(); ++k)
+        csvRow(out, key + ",ground", groundName(*robot.robot, k), g.ground[k]);
       csvRow(out, key + ",effort", "tau_norm", e.effort.norm);
       csvRow(out, key + ",effort", "tau_sq", e.effort.sq);
       csvRow(out, key + ",effort", "tau_abs_sum", e.effort.abs_sum);
-      if (energy::kVariants[v].margin >= 0) csvRow(out, key + ",effort", "tau_sq_least", e.least_sq);
-      if (energy::kVariants[v].margin < 0) csvRow(out, key + ",effort", "tau_sq_best_split", r.best_split.sq);
+      if (energy::kVariants[v].margin >= 0) csvRow(out, key + ",effort", "tau_sq_least", g.least_sq);
+      if (energy::kVariants[v].margin < 0) csvRow(out, key + ",effort", "tau_sq_best_split", d.best_split.sq);
     }
   }
 }
 
-std::string csvText(const std::vector<RobotResult>& robots) {
+std::string standingCsv(const std::vector<RobotResult>& robots) {
   std::ostringstream out;
   out << "robot,posture,variant,quantity,name,value\n";
   for (const RobotResult& robot : robots) csvRobot(out, robot);
   return out.str();
 }
 
-std::vector<std::string> postureNames(const RobotResult& robot) {
-  std::vector<std::string> names;
-  for (const Posture& posture : *robot.robot->postures) names.push_back(posture.name);
-  return names;
-}
-
-std::vector<energy::VariantEfforts> effortsOf(const RobotResult& robot) {
-  std::vector<energy::VariantEfforts> efforts;
-  for (const PostureResult& r : robot.postures)
-    efforts.push_back({r.variant[0].effort, r.variant[1].effort, r.variant[2].effort});
-  return efforts;
-}
-
 std::string jointsBlock(const RobotResult& robot, std::size_t p) {
-  return std::string("$joints_") + robot.robot->label + "_" + (*robot.robot->postures)[p].name;
+  return std::string("$joints_") + robot.robot->label + "_" + robot.postures[p].name;
 }
 
 // Text for a gnuplot title in enhanced mode: "_" would start a subscript.
@@ -577,21 +451,15 @@ std::string enhancedText(const std::string& text) {
 }
 
 // The effort chart (one panel per robot) and one per-joint chart per robot.
-std::string plotScript(const std::vector<RobotResult>& robots) {
+std::string standingPlotScript(const std::string& script, const std::vector<RobotResult>& robots) {
   std::ostringstream s;
-  s << "# Generated by `zwang energy`; run it in this directory: gnuplot standing_energy.gp\n"
-       "set encoding utf8\n"
-       "set datafile separator whitespace\n";
+  s << energy::scriptHeader(script);
   for (const RobotResult& robot : robots) {
-    s << energy::normsData(std::string("$norms_") + robot.robot->label, "posture", postureNames(robot),
-                           effortsOf(robot));
+    s << energy::normsData(std::string("$norms_") + robot.robot->label, "posture", robot.postures);
     std::vector<std::string> labels;
     for (const Joint& joint : robot.model.joints()) labels.push_back(joint.name);
-    for (std::size_t p = 0; p < robot.postures.size(); ++p) {
-      const PostureResult& r = robot.postures[p];
-      s << energy::jointsData(jointsBlock(robot, p), labels, {r.variant[0].tau, r.variant[1].tau, r.variant[2].tau},
-                              robot.breakaway);
-    }
+    for (std::size_t p = 0; p < robot.postures.size(); ++p)
+      s << energy::jointsData(jointsBlock(robot, p), labels, robot.postures[p].torques(), robot.breakaway);
   }
   s << energy::histogramStyle(robots[0].postures.size())
     << "\n"
@@ -618,7 +486,7 @@ std::string plotScript(const std::vector<RobotResult>& robots) {
          "set xtics rotate by -45 noenhanced font \",8\"\n"
       << "set bmargin 6\n";
     for (std::size_t p = 0; p < robot.postures.size(); ++p)
-      s << energy::jointsPanel(jointsBlock(robot, p), (*robot.robot->postures)[p].name, p == 0);
+      s << energy::jointsPanel(jointsBlock(robot, p), robot.postures[p].name, p == 0);
     s << "unset multiplot\n";
   }
   s << "unset output\n";
@@ -634,13 +502,13 @@ void printPostures(const RobotResult& robot) {
                                               robot.robot->waist ? "waist" : "", "feet off", "com x", "com y", "mass",
                                               "closest limit"}};
   for (std::size_t p = 0; p < robot.postures.size(); ++p) {
-    const PostureResult& r = robot.postures[p];
-    const Eigen::Quaterniond orientation(r.q[3], r.q[4], r.q[5], r.q[6]);
+    const Eigen::VectorXd& q = robot.postures[p].q;
+    const PostureDetail& r = robot.details[p];
+    const Eigen::Quaterniond orientation(q[3], q[4], q[5], q[6]);
     const double pitch = std::atan2(-orientation.toRotationMatrix()(2, 0), orientation.toRotationMatrix()(2, 2));
-    const std::string waist =
-        robot.robot->waist ? fmt(r.q[7 + robot.model.jointIndex(robot.robot->waist)], "%.4f") : "";
-    rows.push_back({(*robot.robot->postures)[p].name, (*robot.robot->postures)[p].what, fmt(r.q[2], "%.4f"),
-                    fmt(pitch, "%.4f"), waist, small(r.placement_error), fmt(r.com.x(), "%.3f"), fmt(r.com.y(), "%.3f"),
+    const std::string waist = robot.robot->waist ? fmt(q[7 + robot.model.jointIndex(robot.robot->waist)], "%.4f") : "";
+    rows.push_back({robot.postures[p].name, (*robot.robot->postures)[p].what, fmt(q[2], "%.4f"), fmt(pitch, "%.4f"),
+                    waist, small(r.placement_error), fmt(r.com.x(), "%.3f"), fmt(r.com.y(), "%.3f"),
                     fmt(r.mass, "%.2f"), fmt(r.limit_distance, "%.3f")});
   }
   printColumns(rows, 2);
@@ -656,8 +524,8 @@ void printTorques(const RobotResult& robot) {
     }
   for (int j = 0; j < robot.model.dof(); ++j) {
     std::vector<std::string> row{robot.model.joint(j).name};
-    for (const PostureResult& r : robot.postures)
-      for (const VariantResult& e : r.variant) row.push_back(fmt(e.tau[j], "%.3g"));
+    for (const energy::PostureResult& r : robot.postures)
+      for (const energy::VariantResult& e : r.variant) row.push_back(fmt(e.tau[j], "%.3g"));
     rows.push_back(row);
   }
   printColumns(rows);
@@ -670,8 +538,8 @@ void printEffortLimits(const RobotResult& robot) {
     for (int j = 0; j < robot.model.dof(); ++j) {
       const double tau = robot.postures[p].variant[0].tau[j], limit = robot.model.joint(j).effort_limit;
       if (std::abs(tau) > limit)
-        over += std::string(over.empty() ? "" : ", ") + (*robot.robot->postures)[p].name + " " +
-                robot.model.joint(j).name + " " + fmt(std::abs(tau), "%.3g") + " > " + fmt(limit);
+        over += std::string(over.empty() ? "" : ", ") + robot.postures[p].name + " " + robot.model.joint(j).name + " " +
+                fmt(std::abs(tau), "%.3g") + " > " + fmt(limit);
     }
   std::printf("above the URDF's effort limit (|tau| plain > <limit effort>) [N·m]: %s\n",
               over.empty() ? "none" : over.c_str());
@@ -686,9 +554,9 @@ void printGround(const RobotResult& robot) {
   for (std::size_t p = 0; p < robot.postures.size(); ++p)
     for (int v = 0; v < energy::kVariantCount; v += 2)  // plain and margin 1
       for (std::size_t k = 0; k < robot.robot->feet.size(); ++k) {
-        const Eigen::VectorXd w = robot.postures[p].variant[v].ground.segment(
+        const Eigen::VectorXd w = robot.details[p].variant[static_cast<std::size_t>(v)].ground.segment(
             robot.robot->contact_rows * static_cast<Eigen::Index>(k), robot.robot->contact_rows);
-        std::vector<std::string> row{k == 0 && v == 0 ? (*robot.robot->postures)[p].name : "",
+        std::vector<std::string> row{k == 0 && v == 0 ? robot.postures[p].name : "",
                                      k == 0 ? energy::kVariants[v].name : "", robot.robot->feet[k]};
         for (Eigen::Index c = 0; c < w.size(); ++c) row.push_back(fmt(w[c], "%.4g"));
         if (flat) row.insert(row.end(), {fmt(-w[4] / w[2], "%.4f"), fmt(w[3] / w[2], "%.4f")});
@@ -710,16 +578,17 @@ void printLeastEffort(const RobotResult& robot) {
                                               "least m=0.5", "above", "kkt m=0.5", "|tau|^2 m=1", "least m=1", "above",
                                               "kkt m=1"}};
   for (std::size_t p = 0; p < robot.postures.size(); ++p) {
-    const PostureResult& r = robot.postures[p];
-    std::vector<std::string> row{(*robot.robot->postures)[p].name, fmt(r.variant[0].effort.sq), fmt(r.best_split.sq),
-                                 fmt(r.best_split.tangential, "%.3f")};
-    for (int v = 1; v < energy::kVariantCount; ++v) {
-      const VariantResult& e = r.variant[v];
-      row.push_back(fmt(e.effort.sq));
-      row.push_back(fmt(e.least_sq));
-      const double above = 100.0 * (e.effort.sq / e.least_sq - 1.0);  // %; below 5e-4 % is rounding of the two QPs
+    const energy::PostureResult& r = robot.postures[p];
+    const PostureDetail& d = robot.details[p];
+    std::vector<std::string> row{r.name, fmt(r.variant[0].effort.sq), fmt(d.best_split.sq),
+                                 fmt(d.best_split.tangential, "%.3f")};
+    for (std::size_t v = 1; v < energy::kVariantCount; ++v) {
+      const double sq = r.variant[v].effort.sq, least_sq = d.variant[v].least_sq;
+      row.push_back(fmt(sq));
+      row.push_back(fmt(least_sq));
+      const double above = 100.0 * (sq / least_sq - 1.0);  // %; below 5e-4 % is rounding of the two QPs
       row.push_back(fmt(std::abs(above) < 5e-4 ? 0.0 : above, "%.3f") + " %");
-      row.push_back(small(e.kkt));
+      row.push_back(small(d.variant[v].kkt));
     }
     rows.push_back(row);
   }
@@ -728,7 +597,7 @@ void printLeastEffort(const RobotResult& robot) {
 
 void printChecks(const RobotResult& robot) {
   double worst[6] = {0, 0, 0, 0, 0, 0};
-  for (const PostureResult& p : robot.postures) {
+  for (const PostureDetail& p : robot.details) {
     const double values[6] = {p.worst_qdd,   p.worst_rnea,          p.worst_split,
                               p.worst_bound, p.worst_reference_kkt, p.split_shift};
     for (int k = 0; k < 6; ++k) worst[k] = std::max(worst[k], values[k]);
@@ -743,13 +612,11 @@ void printChecks(const RobotResult& robot) {
       small(worst[3]).c_str(), small(worst[4]).c_str(), fmt(worst[5], "%.3g").c_str());
 }
 
-bool printRobot(const RobotResult& robot) {
+void printRobot(const RobotResult& robot) {
   const StandingRobot& r = *robot.robot;
   const Model& model = robot.model;
-  std::error_code ec;
-  const std::filesystem::path proximate = std::filesystem::proximate(robot.urdf, ec);
   std::printf("\nzwang energy: %s on a free base (%d joints, nv %d) standing still, at rest, gravity (0, 0, -9.81)\n",
-              (ec ? robot.urdf : proximate).string().c_str(), model.dof(), model.nv());
+              energy::shownPath(robot.urdf).c_str(), model.dof(), model.nv());
   const int contacts = r.contact_rows * static_cast<int>(r.feet.size());
   std::printf(
       "task: %zu feet fixed, %d contact rows each (%s, world axes; the ground's force, not in tau_control) + one\n"
@@ -764,33 +631,43 @@ bool printRobot(const RobotResult& robot) {
   printTorques(robot);
   printEffortLimits(robot);
   printGround(robot);
-  std::vector<bool> ok;
-  for (const PostureResult& p : robot.postures) ok.push_back(p.ok);
-  energy::printEffortTable("posture", postureNames(robot), effortsOf(robot), ok);
+  energy::printEffortTable("posture", robot.postures);
   printLeastEffort(robot);
   printChecks(robot);
-  return std::all_of(ok.begin(), ok.end(), [](bool b) { return b; });
 }
 
-bool printAndWrite(const ReportCommand& report, const std::vector<RobotResult>& robots, bool plot) {
-  bool all_ok = true;
-  for (const RobotResult& robot : robots) all_ok = printRobot(robot) && all_ok;
-  writeOutput((report.out / "standing_energy.csv").string(), csvText(robots));
-  std::printf(
-      "wrote %s/standing_energy.csv (robot, posture, variant, quantity, name, value: q, tau = tau_control, mu,\n"
-      "ground = nu of the contacts, effort; breakaway per joint)\n",
-      report.out.string().c_str());
-  writePlots(report, "standing_energy.gp", plotScript(robots),
-             "standing_energy.png, standing_humanoid_joints.png, standing_solo12_joints.png", plot);
-  return all_ok;
-}
+// Each robot of kRobots standing still in each of its postures.
+class StandingScenario final : public energy::Scenario {
+ public:
+  explicit StandingScenario(const ReportCommand& report) {
+    for (const StandingRobot& robot : kRobots) robots_.push_back(runRobot(report, robot));
+  }
+  energy::ScenarioFiles files() const override {
+    return {"standing_energy.csv",
+            "robot, posture, variant, quantity, name, value: q, tau = tau_control, mu,\nground = nu of the contacts, "
+            "effort; breakaway per joint",
+            "standing_energy.gp", "standing_energy.png, standing_humanoid_joints.png, standing_solo12_joints.png"};
+  }
+  bool ok() const override {
+    bool all_ok = true;
+    for (const RobotResult& robot : robots_)
+      for (const energy::PostureResult& posture : robot.postures) all_ok = all_ok && posture.ok;
+    return all_ok;
+  }
+  void print() const override {
+    for (const RobotResult& robot : robots_) printRobot(robot);
+  }
+  std::string csvText() const override { return standingCsv(robots_); }
+  std::string plotScript() const override { return standingPlotScript(files().script, robots_); }
+
+ private:
+  std::vector<RobotResult> robots_;
+};
 
 }  // namespace
 
-std::function<bool(bool)> prepareStandingEnergy(const ReportCommand& report) {
-  std::vector<RobotResult> robots;
-  for (const StandingRobot& robot : kRobots) robots.push_back(runRobot(report, robot));
-  return [&report, robots = std::move(robots)](bool plot) { return printAndWrite(report, robots, plot); };
+std::unique_ptr<energy::Scenario> energy::standingScenario(const ReportCommand& report) {
+  return std::make_unique<StandingScenario>(report);
 }
 
 }  // namespace zwang::cli

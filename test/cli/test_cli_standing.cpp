@@ -116,6 +116,33 @@ Eigen::VectorXd torquesWithGround(const zwang::Model& model, zwang::Workspace& w
   return ws.tau;
 }
 
+// The dense map μ ↦ τ_control(μ) of the standing balance: the joint rows'
+// part of the least-norm ν with Gᵀν = RNEA(q, 0, 0) + [0; μ], affine in μ.
+struct EffortMap {
+  Eigen::VectorXd tau0;  // τ_control(0)
+  Eigen::MatrixXd M;     // ∂τ_control/∂μ
+};
+
+EffortMap effortMap(const zwang::Model& model, zwang::Workspace& ws, const Robot& robot, const Eigen::VectorXd& q) {
+  const int n = model.dof();
+  const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Gt(balanceTranspose(model, ws, robot, q));
+  const zwang::Task gravity_only(model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  REQUIRE(zwang::inverseDynamics(model, gravity_only, q, zero, zero, ws));
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(model.nv(), n + 1);
+  rhs.col(0) = ws.tau;
+  rhs.bottomRightCorner(n, n).setIdentity();
+  const Eigen::MatrixXd nu = Gt.solve(rhs);
+  return {nu.col(0).tail(n), nu.bottomRightCorner(n, n)};
+}
+
+// The natural residual of the optimality (KKT) conditions of
+// min ½‖τ₀ + Mμ‖² over |μ_j| ≤ bound_j: μ − Π(μ − ∇), zero at the minimiser only [N·m].
+double kktResidual(const EffortMap& map, const Eigen::VectorXd& mu, const Eigen::VectorXd& bound) {
+  const Eigen::VectorXd gradient = map.M.transpose() * (map.tau0 + map.M * mu);
+  return (mu - (mu - gradient).cwiseMax(-bound).cwiseMin(bound)).cwiseAbs().maxCoeff();
+}
+
 }  // namespace
 
 TEST_CASE("energy: the humanoid and Solo 12 standing regenerate the committed CSV within 1e-12", "[energy]") {
@@ -172,6 +199,7 @@ TEST_CASE("energy: the humanoid and Solo 12 standing regenerate the committed CS
       REQUIRE(internal.cols() == contacts + n - model.nv());  // 6: the split between the feet
       const Eigen::MatrixXd basis =
           internal.householderQr().householderQ() * Eigen::MatrixXd::Identity(internal.rows(), internal.cols());
+      const EffortMap map = effortMap(model, ws, robot, q);
       double sq[3];
       for (int v = 0; v < 3; ++v) {
         INFO(variants[v]);
@@ -202,9 +230,25 @@ TEST_CASE("energy: the humanoid and Solo 12 standing regenerate the committed CS
         // optimality conditions to 1e-12 N·m on torques of up to 130 N·m, and the
         // two QPs round the same optimum (measured: 7.7e-14 relative apart).
         if (v > 0) CHECK(sq[v] <= effort.values[3] * (1 + 1e-11));
+        // The pick is the least effort by the dense KKT conditions, without
+        // the tool's reference: the dense map gives its τ_control, and its μ
+        // is optimal over the margin box (1e-9 N·m: rounding of sums of ~1e2 N·m).
+        if (v > 0) {
+          CHECK((map.tau0 + map.M * mu - tau).cwiseAbs().maxCoeff() < 1e-9);
+          CHECK(kktResidual(map, mu, margins[v] * breakaway.vector()) < 1e-9);
+        }
       }
       CHECK(sq[2] < sq[1]);
       CHECK(sq[1] < sq[0]);
+      // The best split without friction, independently of the tool's: the
+      // internal forces move the joints' share along basis' joint rows, so the
+      // least ‖τ_control‖² is what of plain's τ_control they cannot cancel.
+      const Eigen::VectorXd tau_plain = fresh.at(at + "plain,tau").vector();
+      const Eigen::MatrixXd on_joints = basis.bottomRows(n);
+      const Eigen::VectorXd rest = tau_plain - on_joints * (on_joints.transpose() * on_joints)
+                                                               .completeOrthogonalDecomposition()
+                                                               .solve(on_joints.transpose() * tau_plain);
+      CHECK(fresh.at(at + "plain,effort").values[3] == Approx(rest.squaredNorm()).epsilon(1e-9));
     }
   }
 }

@@ -1,0 +1,105 @@
+// The standing balance's dense reference (standing_reference.hpp).
+#include "standing_reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "cli.hpp"
+
+namespace zwang::cli::standing {
+
+namespace {
+
+constexpr double kBoundTolerance = 1e-9;  // μ within this of ±margin·f counts as on the bound [N·m]
+
+void require(const Status& s, const std::string& context) {
+  if (!s) throw CliError(kExitError, context + s.message);
+}
+
+// Gᵀ of the task's rows, built densely from the feet's world Jacobians and
+// the joint rows' unit torques, independently of the solver's sweeps.
+Eigen::MatrixXd balanceTranspose(const Model& model, Workspace& ws, const std::vector<std::string>& feet,
+                                 int contact_rows, const Eigen::VectorXd& q) {
+  const int contacts = contact_rows * static_cast<int>(feet.size()), n = model.dof(), nv = model.nv();
+  Eigen::MatrixXd Gt = Eigen::MatrixXd::Zero(nv, contacts + n);
+  Eigen::MatrixXd J(6, nv);
+  for (std::size_t k = 0; k < feet.size(); ++k) {
+    require(frameJacobian(model, ws, q, model.frameIndex(feet[k]), Expressed::World, J), "energy: ");
+    Gt.middleCols(contact_rows * static_cast<int>(k), contact_rows) = J.topRows(contact_rows).transpose();
+  }
+  Gt.bottomRightCorner(n, n).setIdentity();
+  return Gt;
+}
+
+}  // namespace
+
+Eigen::VectorXd torquesWithGround(const Model& model, Workspace& ws, const std::vector<std::string>& feet,
+                                  int contact_rows, const Eigen::VectorXd& q, const Eigen::VectorXd& ground) {
+  Task loaded(model);
+  for (std::size_t k = 0; k < feet.size(); ++k) {
+    Vec6 w = Vec6::Zero();
+    w.head(contact_rows) = ground.segment(contact_rows * static_cast<Eigen::Index>(k), contact_rows);
+    loaded.wrench(loaded.addWrench(feet[k], Expressed::World)) = w;
+  }
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  require(inverseDynamics(model, loaded, q, zero, zero, ws), "energy: RNEA: ");
+  return ws.tau;
+}
+
+DenseBalance denseBalance(const Model& model, Workspace& ws, const std::vector<std::string>& feet, int contact_rows,
+                          const Eigen::VectorXd& q, const std::string& context) {
+  const int n = model.dof();
+  DenseBalance d;
+  d.Gt_matrix = balanceTranspose(model, ws, feet, contact_rows, q);
+  d.Gt.compute(d.Gt_matrix);
+  const Task gravity_only(model);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  require(inverseDynamics(model, gravity_only, q, zero, zero, ws), context + "RNEA: ");
+  d.gravity = ws.tau;
+  d.tau0 = d.Gt.solve(d.gravity).tail(n);
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(model.nv(), n);
+  unit.bottomRows(n).setIdentity();
+  d.M = d.Gt.solve(unit).bottomRows(n);
+  return d;
+}
+
+BestSplit bestSplit(const DenseBalance& d, int contact_rows) {
+  const Eigen::Index n = d.tau0.size();
+  const Eigen::MatrixXd internal = Eigen::FullPivLU<Eigen::MatrixXd>(d.Gt_matrix).kernel();
+  const Eigen::MatrixXd on_joints = internal.bottomRows(n);
+  const Eigen::VectorXd z = -on_joints.completeOrthogonalDecomposition().solve(d.tau0);
+  const Eigen::VectorXd nu = d.Gt.solve(d.gravity) + internal * z;
+  BestSplit best;
+  best.sq = nu.tail(n).squaredNorm();
+  for (Eigen::Index foot = 0; foot + contact_rows <= nu.size() - n; foot += contact_rows)
+    best.tangential = std::max(best.tangential, nu.segment<2>(foot).norm() / nu[foot + 2]);
+  return best;
+}
+
+double kktViolation(const DenseBalance& d, const Eigen::VectorXd& mu, const Eigen::VectorXd& bound) {
+  const Eigen::VectorXd gradient = d.M.transpose() * (d.tau0 + d.M * mu);
+  double worst = 0;
+  for (Eigen::Index j = 0; j < mu.size(); ++j) {
+    if (mu[j] >= bound[j] - kBoundTolerance)
+      worst = std::max(worst, gradient[j]);
+    else if (mu[j] <= -bound[j] + kBoundTolerance)
+      worst = std::max(worst, -gradient[j]);
+    else
+      worst = std::max(worst, std::abs(gradient[j]));
+  }
+  return worst;
+}
+
+Eigen::VectorXd leastEffort(const DenseBalance& d, const Eigen::VectorXd& bound) {
+  const Eigen::MatrixXd MtM = d.M.transpose() * d.M;
+  const double step = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(MtM).eigenvalues().maxCoeff();
+  Eigen::VectorXd mu = Eigen::VectorXd::Zero(bound.size());
+  for (int iteration = 0; iteration < 100000 && kktViolation(d, mu, bound) > 1e-12; ++iteration)
+    mu = (mu - step * (d.M.transpose() * (d.tau0 + d.M * mu))).cwiseMax(-bound).cwiseMin(bound);
+  return mu;
+}
+
+}  // namespace zwang::cli::standing

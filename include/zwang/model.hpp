@@ -268,6 +268,18 @@ class Model {
   int parent(int b) const { return parents_[static_cast<std::size_t>(b)]; }
   /// One past the last body of b's subtree: the subtree is [b, subtreeEnd(b)).
   int subtreeEnd(int b) const { return subtree_end_[static_cast<std::size_t>(b)]; }
+  /// The first DOF body of the joint that moves body b (b ≥ 1): b itself for a
+  /// one-DOF joint; a joint of nv DOFs moves bodies jointStart(b) … jointStart(b) + nv − 1.
+  int jointStart(int b) const { return joint_start_[static_cast<std::size_t>(b)]; }
+  /// A one-DOF joint's position limits, with the index of its coordinate in q.
+  struct PositionLimits {
+    int joint = -1;                   ///< its index in joints()
+    int q_index = 0;                  ///< its coordinate in q
+    double lower = 0.0, upper = 0.0;  ///< q[q_index] ∈ [lower, upper] (one of them may be infinite)
+  };
+  /// The joints with a finite position limit, in joints() order: a compact
+  /// array for the check every solve makes (multi-DOF joints have none).
+  const std::vector<PositionLimits>& positionLimits() const { return position_limits_; }
   /// True when body `a` is body `b` or one of its ancestors (b lies in a's subtree).
   bool supports(int a, int b) const { return a <= b && b < subtreeEnd(a); }
   /// True when every body's parent is the body before it: a serial chain.
@@ -329,6 +341,8 @@ class Model {
   std::vector<int> body_frames_{0};
   std::vector<int> parents_{-1};     // bodyCount() entries, parents_[0] = −1
   std::vector<int> subtree_end_{1};  // bodyCount() entries
+  std::vector<int> joint_start_{0};  // bodyCount() entries
+  std::vector<PositionLimits> position_limits_;
   bool is_chain_ = true;
   std::vector<int> mimic_joints_;
 };

@@ -388,7 +388,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
   ws.Ahat.leftCols(m) = ws.A_body.leftCols(m);  // A_i, each column updated in place on its way to the base
   // Joint by joint from the leaves; body i is a joint's last DOF body.
   for (int i = N; i >= 1;) {
-    const int first = i - dofs[at(i - 1)].index_in_joint;
+    const int first = model.jointStart(i);
     if (model.subtreeEnd(i) == i + 1) {  // a leaf: lines 8–9, I^A = I, F^A = F_bias
       ws.IA[at(i)] = ws.I[at(i)].matrix();
       ws.FA[at(i)] = ws.Fbias[at(i)];
@@ -705,9 +705,8 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   dU.setZero();
   s.dF.leftCols(k).setZero();  // du is written where it is read: on each body's run of columns
   columnRuns(model, dofs, s);
-  const std::vector<Dof>& model_dofs = model.dofs();
   for (int i = model.nv(); i >= 1;) {  // joint by joint from the leaves; body i is a joint's last DOF body
-    const int first = i - model_dofs[at(i - 1)].index_in_joint;
+    const int first = model.jointStart(i);
     if (first == i)
       oneDofColumns(model, task, ws, dofs, i, s);
     else
@@ -753,12 +752,10 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
 void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out) {
   out.joints_outside_limits = 0;
   out.first_joint_outside_limits = -1;
-  const std::vector<Joint>& joints = model.joints();
-  for (int j = 0; j < static_cast<int>(joints.size()); ++j) {
-    const Joint& joint = joints[at(j)];  // a multi-DOF joint has no limits: ±∞
-    const double q_j = q[joint.q_index];
-    if (q_j >= joint.lower && q_j <= joint.upper) continue;
-    if (out.joints_outside_limits++ == 0) out.first_joint_outside_limits = j;
+  for (const Model::PositionLimits& limits : model.positionLimits()) {  // a compact array: one pass per solve
+    const double q_j = q[limits.q_index];
+    if (q_j >= limits.lower && q_j <= limits.upper) continue;
+    if (out.joints_outside_limits++ == 0) out.first_joint_outside_limits = limits.joint;
   }
 }
 

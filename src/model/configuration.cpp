@@ -399,6 +399,7 @@ Status checkConfigurationNamed(const Model& model, const char* what, const Const
     if (!std::isfinite(q[k]))
       return Status::error(StatusCode::NonFinite, "%s[%ld] (%s) is %g (not finite)", what, static_cast<long>(k),
                            configurationEntry(model, k).text, q[k]);
+  if (model.nq() == model.nv()) return {};  // no quaternion (each has one entry more than its velocity)
   for (const Joint& joint : model.allJoints()) {
     const int at = quaternionOffset(joint.type);
     if (at < 0) continue;

@@ -497,6 +497,7 @@ void ModelBuilder::layOutBodies(Model& model) {
   const std::size_t links = model.link_parents_.size();
   std::vector<int> link_body(links, 0);
   model.dofs_.clear();
+  model.joint_start_.assign(1, 0);
   model.parents_.assign(1, -1);
   model.inertias_.assign(1, RigidInertia{});
   model.body_frames_.assign(1, model.link_frames_[0]);
@@ -510,6 +511,7 @@ void ModelBuilder::layOutBodies(Model& model) {
     joint.v_index = nv;
     appendDofs(joint, static_cast<int>(j) - static_cast<int>(model.root_.size()), model.dofs_);
     for (int k = 0; k < joint.nv(); ++k) {
+      model.joint_start_.push_back(nv + 1);
       model.parents_.push_back(k == 0 ? parent_body : nv + k);
       model.inertias_.push_back(RigidInertia{});
       model.body_frames_.push_back(model.link_frames_[link]);
@@ -526,6 +528,12 @@ void ModelBuilder::layOutBodies(Model& model) {
             model.joints_.begin());
   for (std::size_t f = 0; f < model.frames_.size(); ++f)
     model.frames_[f].body = link_body[static_cast<std::size_t>(model.frame_links_[f])];
+  model.position_limits_.clear();
+  for (std::size_t j = 0; j < model.joints_.size(); ++j) {
+    const Joint& joint = model.joints_[j];
+    if (std::isfinite(joint.lower) || std::isfinite(joint.upper))
+      model.position_limits_.push_back({static_cast<int>(j), joint.q_index, joint.lower, joint.upper});
+  }
   // Subtrees: bodies are in depth-first order, so each body's subtree ends
   // where the next body not below it starts.
   const int bodies = nv + 1;

@@ -273,9 +273,10 @@ class Model {
   int jointStart(int b) const { return joint_start_[static_cast<std::size_t>(b)]; }
   /// A one-DOF joint's position limits, with the index of its coordinate in q.
   struct PositionLimits {
-    int joint = -1;                   ///< its index in joints()
-    int q_index = 0;                  ///< its coordinate in q
-    double lower = 0.0, upper = 0.0;  ///< q[q_index] ∈ [lower, upper] (one of them may be infinite)
+    int joint = -1;      ///< its index in joints()
+    int q_index = 0;     ///< its coordinate in q
+    double lower = 0.0;  ///< q[q_index] ≥ lower (−∞: none)
+    double upper = 0.0;  ///< q[q_index] ≤ upper (+∞: none)
   };
   /// The joints with a finite position limit, in joints() order: a compact
   /// array for the check every solve makes (multi-DOF joints have none).

@@ -153,6 +153,33 @@ struct JointRows {
   Eigen::VectorXd b;
 };
 
+// Friction data for n DOFs, to be filled.
+FrictionSetup sizedFrictionSetup(int n) {
+  FrictionSetup setup;
+  setup.breakaway.resize(n);
+  setup.kinetic.resize(n);
+  setup.viscous.resize(n);
+  return setup;
+}
+
+// Every joint DOF (after the base's nb) moving at 0.1–2 either way.
+void moveEveryDof(std::mt19937_64& rng, int nb, int n, FloatingInput& in) {
+  for (int k = 0; k < n; ++k) in.v(nb + k) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
+}
+
+// A random state of the tree on `base` with the loads and frame rows of randomProblem (its q unused), in that
+// order of draws.
+FloatingInput loadedInput(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& base,
+                          const RandomProblemOptions& options) {
+  const DynamicsInput loads = randomProblem(rng, spec, options);
+  FloatingInput in;
+  drawState(rng, spec, base, in);
+  in.gravity = loads.gravity;
+  in.wrenches = loads.wrenches;
+  in.constraints = loads.constraints;
+  return in;
+}
+
 JointRows randomJointRows(std::mt19937_64& rng, const ChainSpec& spec) {
   const std::vector<int> moving = spec.movingJoints();
   const int pick = uniformInt(rng, 0, static_cast<int>(moving.size()) - 1);
@@ -198,12 +225,7 @@ TEST_CASE("joint types: solveHybridDynamics against the dense reference on trees
     options.max_constraint_rows = 8;
     options.max_constraint_frames = 3;
     options.relative_probability = 0.3;
-    const DynamicsInput loads = randomProblem(rng, spec, options);  // gravity, wrenches, frame rows (q unused)
-    FloatingInput in;
-    drawState(rng, spec, base, in);
-    in.gravity = loads.gravity;
-    in.wrenches = loads.wrenches;
-    in.constraints = loads.constraints;
+    FloatingInput in = loadedInput(rng, spec, base, options);
     std::vector<JointRows> joint_rows;
     if (uniform01(rng) < 0.3) joint_rows.push_back(randomJointRows(rng, spec));
     const Model model = floatingModelFromSpec(spec, base);
@@ -265,20 +287,12 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
     options.max_constraint_rows = std::min(4, n);
     options.max_constraint_frames = 2;
     options.relative_probability = 0.2;
-    const DynamicsInput loads = randomProblem(rng, spec, options);
-    FloatingInput in;
-    drawState(rng, spec, base, in);
-    in.gravity = loads.gravity;
-    in.wrenches = loads.wrenches;
-    in.constraints = loads.constraints;
+    FloatingInput in = loadedInput(rng, spec, base, options);
     const int nb = base.nvBase();
 
     // Every DOF moving at 0.1–2, then 1..min(6, n) DOFs stuck exactly; a spherical joint often all three at once.
-    FrictionSetup setup;
-    setup.breakaway.resize(n);
-    setup.kinetic.resize(n);
-    setup.viscous.resize(n);
-    for (int k = 0; k < n; ++k) in.v(nb + k) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
+    FrictionSetup setup = sizedFrictionSetup(n);
+    moveEveryDof(rng, nb, n, in);
     std::vector<bool> stuck(static_cast<std::size_t>(n), false);
     const bool own = uniform01(rng) < 0.5;  // the model's friction (per joint, on each DOF), else overrides per DOF
     own_friction += own ? 1 : 0;
@@ -428,19 +442,11 @@ TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the
     RandomProblemOptions options;
     options.max_constraint_rows = std::min(3, n);
     options.max_constraint_frames = 1;
-    const DynamicsInput loads = randomProblem(rng, spec, options);
-    FloatingInput in;
-    drawState(rng, spec, base, in);
-    in.gravity = loads.gravity;
-    in.wrenches = loads.wrenches;
-    in.constraints = loads.constraints;
+    FloatingInput in = loadedInput(rng, spec, base, options);
     const int nb = base.nvBase();
-    FrictionSetup setup;
-    setup.breakaway.resize(n);
-    setup.kinetic.resize(n);
-    setup.viscous.resize(n);
+    FrictionSetup setup = sizedFrictionSetup(n);
+    moveEveryDof(rng, nb, n, in);
     for (int k = 0; k < n; ++k) {
-      in.v(nb + k) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
       setup.breakaway(k) = uniform(rng, 0.0, 20.0);
       setup.kinetic(k) = uniform(rng, 0.0, setup.breakaway(k));
       setup.viscous(k) = uniform(rng, 0.0, 1.0);

@@ -281,7 +281,7 @@ std::string dualPandaHands(const Problem& p) {
   std::string out;
   for (const std::string& hand : {p.tip, p.tip2}) {
     Eigen::Isometry3d pose;
-    if (!framePose(p.model, ws, p.model.frameIndex(hand), pose)) return "framePose failed";
+    if (!framePose(p.model, ws, p.q, p.model.frameIndex(hand), pose)) return "framePose failed";
     char buffer[160];
     std::snprintf(buffer, sizeof buffer, "%s%s at (%.4f, %.4f, %.4f) m, z axis (%.3f, %.3f, %.3f)",
                   out.empty() ? "" : "; ", hand.c_str(), pose.translation().x(), pose.translation().y(),
@@ -316,7 +316,7 @@ std::string standOnFeet(Problem& p) {
   double lowest = std::numeric_limits<double>::infinity();
   for (const auto& foot : p.feet) {
     Eigen::Isometry3d pose;
-    if (!framePose(p.model, ws, p.model.frameIndex(foot.first), pose))
+    if (!framePose(p.model, ws, p.q, p.model.frameIndex(foot.first), pose))
       throw std::runtime_error(p.label + ": framePose failed");
     feet.push_back(pose.translation());
     lowest = std::min(lowest, pose.translation().z());
@@ -501,7 +501,7 @@ bool firstSolveSucceeded(benchmark::State& state, const Status& first) {
 void timeHybridSolves(benchmark::State& state, const Problem& p, const Task& task, const Eigen::VectorXd& qd,
                       Workspace& ws) {
   for (auto _ : state) {
-    const Status s = solveHybridDynamics(p.model, task, p.q, qd, p.tau, ws);
+    const Status s = solveHybridDynamics(p.model, ws, p.q, qd, p.tau, task);
     benchmark::DoNotOptimize(s.code);
     benchmark::DoNotOptimize(ws.solution.qdd.data());
     benchmark::ClobberMemory();
@@ -511,7 +511,7 @@ void timeHybridSolves(benchmark::State& state, const Problem& p, const Task& tas
 void timeFrictionSolves(benchmark::State& state, const Problem& p, const Task& task, const Eigen::VectorXd& qd,
                         const FrictionOptions& options, Workspace& ws) {
   for (auto _ : state) {
-    const Status s = solveWithFriction(p.model, task, p.q, qd, p.tau, ws, options);
+    const Status s = solveWithFriction(p.model, ws, p.q, qd, p.tau, task, options);
     benchmark::DoNotOptimize(s.code);
     benchmark::DoNotOptimize(ws.solution.qdd.data());
     benchmark::ClobberMemory();
@@ -525,7 +525,7 @@ void benchOursHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
   const DynamicsInput in = makeInput(*p, kind, p->qd);
   const Task task = taskFromInput(p->model, in);
   Workspace ws(p->model, task);
-  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws))) return;
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, ws, p->q, p->qd, p->tau, task))) return;
   timeHybridSolves(state, *p, task, p->qd, ws);
   setCounters(state, *p, task.constraintRows(), 0);
 }
@@ -534,7 +534,7 @@ void benchOursHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
 void benchTreeHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
   const Task task = taskFromInput(p->model, makeInput(*p, kind, p->qd));
   Workspace ws(p->model, task);
-  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws))) return;
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, ws, p->q, p->qd, p->tau, task))) return;
   const int rank = ws.solution.balance.rank;
   timeHybridSolves(state, *p, task, p->qd, ws);
   setCounters(state, *p, task.constraintRows(), 0);
@@ -547,7 +547,7 @@ void benchOursRnea(benchmark::State& state, const Problem* p) {
   const Task task(p->model);  // gravity (0, 0, −9.81), no wrenches
   Workspace ws(p->model, task);
   for (auto _ : state) {
-    const Status s = inverseDynamics(p->model, task, p->q, p->qd, p->qdd, ws);
+    const Status s = inverseDynamics(p->model, ws, p->q, p->qd, p->qdd, task);
     benchmark::DoNotOptimize(s.code);
     benchmark::DoNotOptimize(ws.tau.data());
     benchmark::ClobberMemory();
@@ -558,7 +558,7 @@ void benchOursRnea(benchmark::State& state, const Problem* p) {
 void benchOursCrba(benchmark::State& state, const Problem* p) {
   Workspace ws(p->model, 0);
   for (auto _ : state) {
-    const Status s = jointSpaceInertia(p->model, p->q, ws);
+    const Status s = jointSpaceInertia(p->model, ws, p->q);
     benchmark::DoNotOptimize(s.code);
     benchmark::DoNotOptimize(ws.H.data());
     benchmark::ClobberMemory();
@@ -624,7 +624,7 @@ void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int
   Workspace ws(p->model, task);
   FrictionOptions options;
   options.method = method;
-  if (!firstSolveSucceeded(state, solveWithFriction(p->model, task, p->q, qd, p->tau, ws, options))) return;
+  if (!firstSolveSucceeded(state, solveWithFriction(p->model, ws, p->q, qd, p->tau, task, options))) return;
   if (static_cast<int>(ws.friction.stuck.size()) != k) {
     state.SkipWithError("stuck set has the wrong size");
     return;
@@ -648,7 +648,7 @@ void benchWorstCase(benchmark::State& state, const Problem* p, TaskKind kind, in
   for (auto _ : state) {
     for (int c = 0; c < calls; ++c) {
       const auto t0 = std::chrono::steady_clock::now();
-      const Status s = solveWithFriction(p->model, task, p->q, qd, p->tau, ws);
+      const Status s = solveWithFriction(p->model, ws, p->q, qd, p->tau, task);
       const auto t1 = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(s.code);
       benchmark::DoNotOptimize(ws.solution.qdd.data());
@@ -687,7 +687,7 @@ void setFloatingCounters(benchmark::State& state, const Problem& p, int m, int k
 void benchFloatingHybrid(benchmark::State& state, const Problem* p, bool held) {
   const Task task = floatingTask(*p, held);
   Workspace ws(p->model, task);
-  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, task, p->q, p->qd, p->tau, ws))) return;
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, ws, p->q, p->qd, p->tau, task))) return;
   const int rank = ws.solution.balance.rank;
   timeHybridSolves(state, *p, task, p->qd, ws);
   setFloatingCounters(state, *p, task.constraintRows(), 0);
@@ -698,7 +698,7 @@ void benchFloatingFriction(benchmark::State& state, const Problem* p, bool held)
   const Task task = floatingTask(*p, held);
   Workspace ws(p->model, task);
   const FrictionOptions options;
-  if (!firstSolveSucceeded(state, solveWithFriction(p->model, task, p->q, p->qd, p->tau, ws, options))) return;
+  if (!firstSolveSucceeded(state, solveWithFriction(p->model, ws, p->q, p->qd, p->tau, task, options))) return;
   // Every joint stuck (q̇ = 0) and staying stuck: what the benchmark is about.
   if (static_cast<int>(ws.friction.stuck.size()) != p->n ||
       std::any_of(ws.friction.state.begin(), ws.friction.state.end(),
@@ -745,7 +745,7 @@ double exactDual(const Problem& p, const Task& task, const FrictionSetupOurs& s,
   Workspace ws(p.model, task);
   FrictionOptions options;
   options.joint_limits = false;
-  if (Status st = solveWithFriction(p.model, task, p.q, s.qd, p.tau, ws, options); !st) return std::nan("");
+  if (Status st = solveWithFriction(p.model, ws, p.q, s.qd, p.tau, task, options); !st) return std::nan("");
   mu_star->resize(static_cast<Eigen::Index>(s.stuck.size()));
   for (std::size_t a = 0; a < s.stuck.size(); ++a)
     (*mu_star)[static_cast<Eigen::Index>(a)] = ws.friction.mu[s.stuck[a]];
@@ -770,7 +770,7 @@ void benchGrid(benchmark::State& state, const Problem* p, TaskKind kind, int k) 
         mu[a] = s.f[a] * (-1.0 + 2.0 * (rest % kGridPoints) / (kGridPoints - 1));
         torque[s.stuck[static_cast<std::size_t>(a)]] -= mu[a];
       }
-      const Status st = solveHybridDynamics(p->model, task, p->q, s.qd, torque, ws);
+      const Status st = solveHybridDynamics(p->model, ws, p->q, s.qd, torque, task);
       benchmark::DoNotOptimize(st.code);
       if (ws.solution.gauss > best) {
         best = ws.solution.gauss;
@@ -801,7 +801,7 @@ void benchNaiveGradient(benchmark::State& state, const Problem* p, TaskKind kind
   int solves = 0, iterations = 0;
   bool converged = false;
   auto solve = [&](const Eigen::VectorXd& t) {
-    const Status st = solveHybridDynamics(p->model, task, p->q, s.qd, t, ws);
+    const Status st = solveHybridDynamics(p->model, ws, p->q, s.qd, t, task);
     benchmark::DoNotOptimize(st.code);
     ++solves;
   };
@@ -871,12 +871,12 @@ Check checkAgainstKdl(const Problem& p) {
     const DynamicsInput in = makeInput(p, kind, p.qd);
     const Task task = taskFromInput(p.model, in);
     Workspace ws(p.model, task);
-    if (!solveHybridDynamics(p.model, task, p.q, p.qd, p.tau, ws)) return {std::nan(""), std::nan("")};
+    if (!solveHybridDynamics(p.model, ws, p.q, p.qd, p.tau, task)) return {std::nan(""), std::nan("")};
     c.hd = std::max(c.hd, relativeError(ws.solution.qdd, kdlHybridDynamics(p.spec, in).qdd));
   }
   const Task task(p.model);
   Workspace ws(p.model, task);
-  if (!inverseDynamics(p.model, task, p.q, p.qd, p.qdd, ws)) return {std::nan(""), std::nan("")};
+  if (!inverseDynamics(p.model, ws, p.q, p.qd, p.qdd, task)) return {std::nan(""), std::nan("")};
   c.rnea = relativeError(ws.tau, kdlInverseDynamics(p.spec, p.q, p.qd, p.qdd, p.gravity));
   return c;
 }

@@ -15,6 +15,9 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   solution.nu.setZero(0);
   solution.tau_constraint.setZero(nv);
   solution.tau_control.setZero(nv);
+  kinematics.q.setZero(model.nq());
+  kinematics.qd.setZero(nv);
+  default_task_ = std::make_unique<Task>(model);
 
   Xworld.assign(bodies, Transform{});
   S.assign(bodies, Vec6::Zero());

@@ -39,7 +39,7 @@ TEST_CASE("hybrid dynamics matches the dense KKT solution on 500+ random chains"
     const Model model = modelFromSpec(spec);
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
-    const Status status = solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws);
+    const Status status = solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task);
     INFO("chain " << accepted << ": " << spec.dof() << " dof, " << in.constraintRows() << " rows; " << status.message);
     REQUIRE(status.ok());
     const Solution& s = ws.solution;
@@ -60,7 +60,7 @@ TEST_CASE("hybrid dynamics matches the dense KKT solution on 500+ random chains"
     free_input.constraints.clear();
     const Task free_task = taskFromInput(model, free_input);
     const Eigen::VectorXd qdd = s.qdd, tau_control = s.tau_control;
-    REQUIRE(solveHybridDynamics(model, free_task, in.q, in.qd, tau_control, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, tau_control, free_task));
     closure_err.add(relativeError(ws.solution.qdd, qdd));
   }
   std::printf(
@@ -93,7 +93,7 @@ TEST_CASE("RNEA, CRBA, Jacobians and poses match the dense reference") {
 
     const DenseKinematics kin = denseKinematics(spec, in.q, in.qd);
     const DenseResult ref = denseDynamics(spec, in);
-    REQUIRE(jointSpaceInertia(model, in.q, ws));
+    REQUIRE(jointSpaceInertia(model, ws, in.q));
     crba_err.add((ws.H - ref.H).cwiseAbs().maxCoeff() / std::max(1.0, ref.H.cwiseAbs().maxCoeff()));
 
     Eigen::MatrixXd J(6, spec.dof());
@@ -147,7 +147,7 @@ TEST_CASE("constraint columns of any length: a column scaled by c scales its row
     const Model model = modelFromSpec(spec);
     const Task task = taskFromInput(model, scaled);
     Workspace ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     const Solution& s = ws.solution;
     qdd_err.add(relativeError(s.qdd, ref.qdd));
     tauc_err.add(relativeError(s.tau_constraint, ref.tau_c));

@@ -58,11 +58,11 @@ std::uint64_t solveAll(const Model& model, const Task& task, const DynamicsInput
     for (int f = 0; f < static_cast<int>(model.frames().size()); ++f)
       hash.add(accelerationOf(model, ws, f, Expressed::World).data(), sizeof(double) * 6);
   };
-  addSolution(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+  addSolution(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
   for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
     FrictionOptions options;
     options.method = method;
-    addSolution(solveWithFriction(model, task, in.q, in.qd, in.tau, ws, options));
+    addSolution(solveWithFriction(model, ws, in.q, in.qd, in.tau, task, options));
     hash.add(ws.friction.mu);
     hash.add(ws.friction.tau_friction);
     hash.add(ws.friction.dqdd_dmu);
@@ -71,9 +71,9 @@ std::uint64_t solveAll(const Model& model, const Task& task, const DynamicsInput
     hash.add(ws.friction.iterations);
     hash.add(static_cast<int>(ws.friction.indeterminate));
   }
-  hash.add(static_cast<int>(inverseDynamics(model, task, in.q, in.qd, in.tau, ws).code));
+  hash.add(static_cast<int>(inverseDynamics(model, ws, in.q, in.qd, in.tau, task).code));
   hash.add(ws.tau);
-  hash.add(static_cast<int>(jointSpaceInertia(model, in.q, ws).code));
+  hash.add(static_cast<int>(jointSpaceInertia(model, ws, in.q).code));
   hash.add(ws.H);
   Eigen::MatrixXd J(6, model.dof());
   hash.add(static_cast<int>(

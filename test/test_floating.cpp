@@ -47,7 +47,7 @@ TEST_CASE("floating trees: solveHybridDynamics against the dense floating-base r
     const Model model = floatingModelFromSpec(p.spec, p.base);
     const Task task = floatingTaskFromInput(model, p.input);
     Workspace ws(model, task);
-    const Status s = solveHybridDynamics(model, task, p.input.q, p.input.v, p.input.tau, ws);
+    const Status s = solveHybridDynamics(model, ws, p.input.q, p.input.v, p.input.tau, task);
     INFO("draw " << draws << ": " << s.message);
     REQUIRE(s);
     ++compared;
@@ -104,7 +104,7 @@ TEST_CASE("floating trees: physics without a reference model", "[floating]") {
     // reference's momentum along the motion.
     task.gravity.setZero();
     Eigen::VectorXd tau = Eigen::VectorXd::Zero(model.nv());
-    REQUIRE(solveHybridDynamics(model, task, p.input.q, p.input.v, tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, p.input.q, p.input.v, tau, task));
     const double h = 1e-6;
     const Eigen::VectorXd qdd = ws.solution.qdd;
     const auto momentumAt = [&](double t) {
@@ -117,10 +117,10 @@ TEST_CASE("floating trees: physics without a reference model", "[floating]") {
     // At rest under gravity with no torque: every body falls at g.
     task.gravity = Vec3(0.3, -1.0, -9.81);
     const Eigen::VectorXd zero_v = Eigen::VectorXd::Zero(model.nv());
-    REQUIRE(solveHybridDynamics(model, task, p.input.q, zero_v, tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, p.input.q, zero_v, tau, task));
     for (int f = 0; f < static_cast<int>(model.frames().size()); ++f) {
       Vec6 a;
-      REQUIRE(frameAcceleration(model, ws, f, Expressed::World, a));
+      REQUIRE(frameAcceleration(model, ws, p.input.q, zero_v, f, Expressed::World, a));
       e_fall = std::max(e_fall, (a.head<3>() - task.gravity).norm() / 9.81 + a.tail<3>().norm());
     }
   }
@@ -167,7 +167,7 @@ TEST_CASE("floating trees: friction through the same sweeps, checked by the dens
     fo.joint_limits = false;
     const Task task = floatingTaskFromInput(plain, p.input);
     Workspace ws(plain, task);
-    const Status s = solveWithFriction(plain, task, p.input.q, p.input.v, p.input.tau, ws, fo);
+    const Status s = solveWithFriction(plain, ws, p.input.q, p.input.v, p.input.tau, task, fo);
     INFO("draw " << draws << ": " << s.message);
     REQUIRE(s);
     ++compared;
@@ -250,7 +250,7 @@ TEST_CASE("floating trees: standing on contacts, every joint held by its motor (
     task.addContact(foot_b, ConstraintMatrix::Identity(6, 6), Expressed::World);
     for (int j = 0; j < model.dof(); ++j) task.addJointConstraint(j);
     Workspace ws(model, task);
-    const Status s = solveHybridDynamics(model, task, contacts.q, contacts.v, contacts.tau, ws);
+    const Status s = solveHybridDynamics(model, ws, contacts.q, contacts.v, contacts.tau, task);
     INFO("draw " << draws << ": " << s.message);
     REQUIRE(s);
     ++compared;

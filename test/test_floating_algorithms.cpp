@@ -116,7 +116,7 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
     // RNEA for a random q̈, against τ = H q̈ + C of the reference (wrenches
     // and gravity of the task, base entries included).
     const Eigen::VectorXd& qdd = d.qdd;
-    REQUIRE(inverseDynamics(model, task, in.q, in.v, qdd, ws));
+    REQUIRE(inverseDynamics(model, ws, in.q, in.v, qdd, task));
     const Eigen::VectorXd tau = ws.tau;
     e_tau = std::max(
         e_tau, relativeError(tau, floatingInverseDynamics(p.spec, p.base, in.q, in.v, qdd, in.gravity, in.wrenches)));
@@ -124,17 +124,17 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
     for (const LinkSpec& link : p.spec.links) {
       const int f = model.frameIndex(link.name);
       Vec6 acc;
-      REQUIRE(frameAcceleration(model, ws, f, Expressed::World, acc));
+      REQUIRE(frameAcceleration(model, ws, in.q, in.v, f, Expressed::World, acc));
       const Vector6d ref = floatingLinkAcceleration(p.spec, p.base, in.q, in.v, qdd, link.name, Axes::World);
       e_acc = std::max(e_acc, relativeError(acc, ref));
     }
 
     // H q̈ + C, C = RNEA(q, q̇, 0): the CRBA and RNEA agree.
-    REQUIRE(inverseDynamics(model, task, in.q, in.v, Eigen::VectorXd::Zero(nv), ws));
+    REQUIRE(inverseDynamics(model, ws, in.q, in.v, Eigen::VectorXd::Zero(nv), task));
     const Eigen::VectorXd C = ws.tau;
 
     // CRBA: the whole H, and exact zeros between branches.
-    REQUIRE(jointSpaceInertia(model, in.q, ws));
+    REQUIRE(jointSpaceInertia(model, ws, in.q));
     const Eigen::MatrixXd H_ref = floatingMassMatrix(p.spec, p.base, in.q);
     e_H = std::max(e_H, matrixError(ws.H, H_ref));
     e_sym = std::max(e_sym, matrixError(ws.H, ws.H.transpose()));
@@ -156,11 +156,11 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
       if (model.frame(f).body == model.baseBody()) ++base_frames;
       const Eigen::Isometry3d& T = kin.poses[l];
       Eigen::Isometry3d pose;
-      REQUIRE(framePose(model, ws, f, pose));
+      REQUIRE(framePose(model, ws, in.q, f, pose));
       e_pose = std::max(e_pose, matrixError(pose.matrix(), T.matrix()));
       for (const Expressed expressed : {Expressed::Local, Expressed::World}) {
         Vec6 v;
-        REQUIRE(frameVelocity(model, ws, f, expressed, v));
+        REQUIRE(frameVelocity(model, ws, in.q, in.v, f, expressed, v));
         e_vel = std::max(e_vel, relativeError(v, atPoint(kin.v[l], T.translation(), T.linear(), expressed)));
       }
     }
@@ -179,15 +179,15 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
     // Closure: the solver's q̈ through RNEA gives back τ_control, the
     // generalized force that drives the unconstrained robot along it (τ when
     // the task has no rows).
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.v, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.v, in.tau, task));
     const Eigen::VectorXd qdd_solve = ws.solution.qdd, tau_control = ws.solution.tau_control;
     Vec6 acc_solve;
     const int probe = model.frameIndex(p.spec.links.back().name);
-    REQUIRE(frameAcceleration(model, ws, probe, Expressed::Local, acc_solve));
+    REQUIRE(frameAcceleration(model, ws, in.q, in.v, probe, Expressed::Local, acc_solve));
     e_acc_solve = std::max(e_acc_solve,
                            relativeError(acc_solve, floatingLinkAcceleration(p.spec, p.base, in.q, in.v, qdd_solve,
                                                                              p.spec.links.back().name, Axes::Local)));
-    REQUIRE(inverseDynamics(model, task, in.q, in.v, qdd_solve, ws));
+    REQUIRE(inverseDynamics(model, ws, in.q, in.v, qdd_solve, task));
     if (task.constraintRows() == 0) {
       ++closures;
       e_closure = std::max(e_closure, relativeError(ws.tau, in.tau));
@@ -243,23 +243,23 @@ TEST_CASE("floating trees: sizes are named by nq and nv; a workspace of the same
   Workspace ws(model, task), fixed_ws(fixed);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(11), v = Eigen::VectorXd::Zero(10);
   q[3] = 1.0;
-  REQUIRE(inverseDynamics(model, task, q, v, v, ws));
+  REQUIRE(inverseDynamics(model, ws, q, v, v, task));
 
-  Status s = inverseDynamics(model, task, v, v, v, ws);
+  Status s = inverseDynamics(model, ws, v, v, v, task);
   CHECK(s.code == StatusCode::SizeMismatch);
   CHECK_THAT(s.message, Contains("q has 10 entries, the model has nq = 11 (7 base coordinates + 4 joints)"));
-  s = inverseDynamics(model, task, q, q, v, ws);
+  s = inverseDynamics(model, ws, q, q, v, task);
   CHECK(s.code == StatusCode::SizeMismatch);
   CHECK_THAT(s.message, Contains("qd has 11 entries, the model has nv = 10 (6 base velocity coordinates + 4 joints)"));
-  s = inverseDynamics(model, task, q, v, Eigen::VectorXd::Zero(4), ws);
+  s = inverseDynamics(model, ws, q, v, Eigen::VectorXd::Zero(4), task);
   CHECK_THAT(s.message, Contains("qdd has 4 entries, the model has nv = 10"));
   Eigen::VectorXd bad = v;
   bad[7] = std::nan("");
-  s = inverseDynamics(model, task, q, v, bad, ws);
+  s = inverseDynamics(model, ws, q, v, bad, task);
   CHECK(s.code == StatusCode::NonFinite);
   CHECK_THAT(s.message, Contains("qdd[7]"));
   q[3] = 2.0;  // a quaternion of norm 2
-  s = jointSpaceInertia(model, q, ws);
+  s = jointSpaceInertia(model, ws, q);
   CHECK(s.code == StatusCode::BadConfiguration);
   s = forwardKinematics(model, ws, q);
   CHECK(s.code == StatusCode::BadConfiguration);
@@ -274,17 +274,17 @@ TEST_CASE("floating trees: sizes are named by nq and nv; a workspace of the same
 
   // The fixed arm's workspace has the same joints: refused before H (4 × 4)
   // or τ is written as if it were 10 × 10.
-  s = jointSpaceInertia(model, q, fixed_ws);
+  s = jointSpaceInertia(model, fixed_ws, q);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("workspace was made for a model with nv = 4, this one has nv = 10 (a free base"));
-  s = inverseDynamics(model, task, q, v, v, fixed_ws);
+  s = inverseDynamics(model, fixed_ws, q, v, v, task);
   CHECK(s.code == StatusCode::ModelMismatch);
   s = forwardKinematics(model, fixed_ws, q);
   CHECK(s.code == StatusCode::ModelMismatch);
   Eigen::Isometry3d pose;
-  s = framePose(model, fixed_ws, 0, pose);
+  s = framePose(model, fixed_ws, q, 0, pose);
   CHECK(s.code == StatusCode::ModelMismatch);
-  s = jointSpaceInertia(fixed, Eigen::VectorXd::Zero(4), ws);
+  s = jointSpaceInertia(fixed, ws, Eigen::VectorXd::Zero(4));
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("workspace was made for a model with nv = 10, this one has nv = 4 (a fixed base"));
 }
@@ -310,12 +310,12 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians allocate nothing
     Vec6 v, a;
     bool ok = true;
     const long count = allocationsDuring([&] {
-      ok = inverseDynamics(model, task, in.q, in.v, in.v, ws).ok() && ok;
-      ok = frameAcceleration(model, ws, frame, Expressed::Local, a).ok() && ok;
-      ok = jointSpaceInertia(model, in.q, ws).ok() && ok;
+      ok = inverseDynamics(model, ws, in.q, in.v, in.v, task).ok() && ok;
+      ok = frameAcceleration(model, ws, in.q, in.v, frame, Expressed::Local, a).ok() && ok;
+      ok = jointSpaceInertia(model, ws, in.q).ok() && ok;
       ok = forwardKinematics(model, ws, in.q, in.v).ok() && ok;
-      ok = framePose(model, ws, frame, pose).ok() && ok;
-      ok = frameVelocity(model, ws, frame, Expressed::World, v).ok() && ok;
+      ok = framePose(model, ws, in.q, frame, pose).ok() && ok;
+      ok = frameVelocity(model, ws, in.q, in.v, frame, Expressed::World, v).ok() && ok;
       ok = frameJacobian(model, ws, in.q, frame, Expressed::Local, J).ok() && ok;
       ok = frameJacobian(model, ws, in.q, frame, Expressed::Local, J.leftCols(3)).code == StatusCode::SizeMismatch &&
            ok;  // an error return allocates nothing either
@@ -345,7 +345,7 @@ TEST_CASE("floating trees: an unreachable relative row is singular on a free bas
   const Model model = floatingModelFromSpec(p.spec, p.base);
   const Task task = floatingTaskFromInput(model, p.input);
   Workspace ws(model, task);
-  REQUIRE(solveHybridDynamics(model, task, p.input.q, p.input.v, p.input.tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, p.input.q, p.input.v, p.input.tau, task));
   FloatingInput free_motion = p.input;  // the row can do nothing: the robot moves as without it
   free_motion.constraints.clear();
   const FloatingResult dense = floatingDynamics(p.spec, p.base, free_motion);

@@ -307,7 +307,7 @@ struct LibraryRun {
         task(floatingTaskFromInput(model, d.problem.input)),
         ws(model, task),
         status(
-            solveWithFriction(model, task, d.problem.input.q, d.problem.input.v, d.problem.input.tau, ws, d.options)) {}
+            solveWithFriction(model, ws, d.problem.input.q, d.problem.input.v, d.problem.input.tau, task, d.options)) {}
   const Model model;
   const Task task;
   Workspace ws;
@@ -671,7 +671,7 @@ void compareHeldOnLimits(const FloatingProblem& p, HeldTally& t) {
   for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
     FrictionOptions options;
     options.method = method;
-    const Status status = solveWithFriction(model, task, p.input.q, p.input.v, p.input.tau, ws, options);
+    const Status status = solveWithFriction(model, ws, p.input.q, p.input.v, p.input.tau, task, options);
     const int m = method == FrictionMethod::ActiveSet ? 0 : 1;
     INFO((m == 0 ? "active set" : "projected gradient")
          << ": " << status.message << "; reference pattern " << ref.pattern << ", mu " << ref.mu.transpose()

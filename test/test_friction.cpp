@@ -40,7 +40,7 @@ Solved solveChecked(const Model& model, const Task& task, const Eigen::VectorXd&
                     const DissipationTolerances& tolerances = {}) {
   Workspace ws(model, task);
   Solved s;
-  s.status = solveWithFriction(model, task, q, qd, tau, ws, options);
+  s.status = solveWithFriction(model, ws, q, qd, tau, task, options);
   s.friction = ws.friction;
   s.solution = ws.solution;
   if (s.status.ok()) {
@@ -291,9 +291,9 @@ TEST_CASE("dqdd/dmu from the sweeps matches finite differences; K_ThTh is symmet
       Eigen::VectorXd tp = d.input.tau, tm = d.input.tau;
       tp(j) -= h;  // μ_j = +h
       tm(j) += h;  // μ_j = −h
-      REQUIRE(solveHybridDynamics(model, task, d.input.q, d.input.qd, tp, ws));
+      REQUIRE(solveHybridDynamics(model, ws, d.input.q, d.input.qd, tp, task));
       const Eigen::VectorXd qp = ws.solution.qdd;
-      REQUIRE(solveHybridDynamics(model, task, d.input.q, d.input.qd, tm, ws));
+      REQUIRE(solveHybridDynamics(model, ws, d.input.q, d.input.qd, tm, task));
       const Eigen::VectorXd fd = (qp - ws.solution.qdd) / (2.0 * h);
       const double e = (D.col(j) - fd).cwiseAbs().maxCoeff() / scale;
       CHECK(e < 1e-6);
@@ -376,7 +376,7 @@ TEST_CASE("indeterminate hold-still on the Panda: friction carries load, effort 
     const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(pose.data(), 7);
     const Eigen::VectorXd qd = Eigen::VectorXd::Zero(7), tau = Eigen::VectorXd::Zero(7);
     Workspace free_ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, q, qd, tau, free_ws));
+    REQUIRE(solveHybridDynamics(model, free_ws, q, qd, tau, task));
     REQUIRE(free_ws.solution.balance.rank == 7);  // every joint's acceleration is fixed
     REQUIRE_FALSE(free_ws.solution.balance.singular);
     const Eigen::VectorXd G = free_ws.solution.tau_control;  // gravity torques, held by the motors
@@ -435,7 +435,7 @@ TEST_CASE("bad friction options are refused with BadOption") {
   Workspace ws(model, task);
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(1), qd = Eigen::VectorXd::Zero(1), tau = Eigen::VectorXd::Zero(1);
   auto refused = [&](const FrictionOptions& o, const char* word) {
-    const Status st = solveWithFriction(model, task, q, qd, tau, ws, o);
+    const Status st = solveWithFriction(model, ws, q, qd, tau, task, o);
     INFO("message: " << st.message);
     CHECK(st.code == StatusCode::BadOption);
     CHECK(std::strlen(st.message) > 10);

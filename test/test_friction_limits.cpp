@@ -56,7 +56,7 @@ Case solveArm(const LimitedArm& arm, const Task& task, double q0, double qd0, co
   const Eigen::VectorXd q = Eigen::VectorXd::Constant(1, q0), qd = Eigen::VectorXd::Constant(1, qd0);
   const Eigen::VectorXd tau = Eigen::VectorXd::Zero(1);
   Case c{Status{}, Workspace(arm.model, task), "", 0.0};
-  c.status = solveWithFriction(arm.model, task, q, qd, tau, c.ws, options);
+  c.status = solveWithFriction(arm.model, c.ws, q, qd, tau, task, options);
   if (c.status.ok()) {
     c.violation = checkMaximumDissipation(c.ws.friction, c.ws.solution, expectFriction(arm.model, q, qd, tau, options));
     c.closure = frictionClosureError(arm.model, task, q, qd, c.ws.friction, c.ws.solution);
@@ -224,7 +224,7 @@ TEST_CASE("limits on random chains match the brute force with one-sided bounds")
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
-    const Status status = solveWithFriction(model, task, d.input.q, d.input.qd, d.input.tau, ws);
+    const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task);
     INFO("draw " << accepted << ": " << d.spec.dof() << " dof, " << d.input.constraintRows() << " rows, "
                  << d.setup.stuck.size() << " stuck, reference pattern " << ref.pattern << "; " << status.message);
     CHECK_FALSE(ws.friction.limit_impact);

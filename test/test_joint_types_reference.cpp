@@ -233,7 +233,7 @@ TEST_CASE("joint types: solveHybridDynamics against the dense reference on trees
     const FloatingResult dense = floatingDynamics(spec, base, in);
     if (!wellPosed(dense)) continue;
     Workspace ws(model, task);
-    const Status s = solveHybridDynamics(model, task, in.q, in.v, in.tau, ws);
+    const Status s = solveHybridDynamics(model, ws, in.q, in.v, in.tau, task);
     INFO("draw " << draws << " (" << toString(base.kind) << " base, " << model.nv() << " DOFs): " << s.message);
     REQUIRE(s);
     ++compared;
@@ -342,7 +342,7 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
       fo.viscous = setup.viscous;
     }
     Workspace ws(model, task);
-    const Status s = solveWithFriction(model, task, in.q, in.v, in.tau, ws, fo);
+    const Status s = solveWithFriction(model, ws, in.q, in.v, in.tau, task, fo);
     INFO("draw " << draws << " (" << toString(base.kind) << " base, " << n << " DOFs, " << count
                  << " stuck): reference pattern " << ref.pattern << " of " << ref.valid_patterns
                  << " valid; status: " << s.message);
@@ -469,7 +469,7 @@ TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the
     fo.kinetic = setup.kinetic;
     fo.viscous = setup.viscous;
     Workspace ws(model, task);
-    const Status s = solveWithFriction(model, task, in.q, in.v, in.tau, ws, fo);
+    const Status s = solveWithFriction(model, ws, in.q, in.v, in.tau, task, fo);
     INFO("draw " << draws << " (" << toString(base.kind) << " base, " << n << " DOFs, joint rows on '"
                  << joint_rows.joint << "'): reference pattern " << ref.pattern << "; status: " << s.message);
     REQUIRE(s);

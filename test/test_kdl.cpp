@@ -39,7 +39,7 @@ TEST_CASE("hybrid dynamics matches KDL's Vereshchagin solver on 200+ random chai
     const Model model = modelFromSpec(spec);
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     qdd_err = std::max(qdd_err, relativeError(ws.solution.qdd, kdl.qdd));
     nu_err = std::max(nu_err, relativeError(ws.solution.nu, kdl.nu));
     // Our τ_c against Jᵀ(A ν) formed from KDL's own ν (KDL's constraint_torques
@@ -53,7 +53,7 @@ TEST_CASE("hybrid dynamics matches KDL's Vereshchagin solver on 200+ random chai
       replay.constraints.clear();
       replay.tau = in.tau + kdl.constraint_torques_kdl;
       const Task free_task = taskFromInput(model, replay);
-      REQUIRE(solveHybridDynamics(model, free_task, in.q, in.qd, replay.tau, ws));
+      REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, replay.tau, free_task));
       kdl_torque_replay_miss = std::max(kdl_torque_replay_miss, (ws.solution.qdd - kdl.qdd).cwiseAbs().maxCoeff());
     }
   }

@@ -228,7 +228,7 @@ TEST_CASE("gripper, closed form: two prismatic fingers along different axes, one
         tau << uniform(rng, -5.0, 5.0), uniform(rng, -5.0, 5.0);
         q(1) = a * q(0) + b;
         qd(1) = a * qd(0);
-        REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+        REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
         const FingerTerms t1 = fingerTerms(f1, q(0), g), t2 = fingerTerms(f2, q(1), g);
         const double qdd1 = (tau(0) + t1.gravity + a * (tau(1) + t2.gravity)) / (t1.inertia + a * a * t2.inertia);
         Eigen::VectorXd qdd_ref(2), tau_control_ref(2);
@@ -295,7 +295,7 @@ TEST_CASE("gripper, closed form: revolute fingers about parallel axes, COM offse
         model.followLeaders(q, qd);  // (the spec's law by hand is checked below)
         CHECK(std::abs(q(1) - (a * q(0) + b)) <= 1e-15 * (1.0 + std::abs(q(1))));
         CHECK(qd(1) == a * qd(0));
-        REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+        REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
         const FingerTerms t1 = fingerTerms(f1, q(0), g), t2 = fingerTerms(f2, q(1), g);
         const double drive = tau(0) + t1.gravity + a * (tau(1) + t2.gravity);
         const double qdd1 = drive / (t1.inertia + a * a * t2.inertia);
@@ -396,7 +396,7 @@ TEST_CASE("gripper, closed form: a chain of mimics m → k → l resolves to the
           q(k) = law.a * q(l) + law.b;
           qd(k) = law.a * qd(l);
         }
-        REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+        REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
         double drive = 0.0, inertia = 0.0, tau_l = 0.0;
         for (int k = 0; k < 3; ++k) {
           const Law& law = laws[static_cast<std::size_t>(k)];
@@ -467,7 +467,7 @@ TEST_CASE("mimic trees: q̈, ν and τ_control match the dense KKT reference (30
     const Task task = taskFromInput(model, in);
     REQUIRE(task.mimicRows() == k);
     Workspace ws(model, task);
-    const Status status = solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws);
+    const Status status = solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task);
     INFO("tree " << accepted << " (draw " << attempts << "): " << spec.dof() << " joints, " << k << " mimic, "
                  << in.constraintRows() << " rows: " << statusText(status));
     REQUIRE(status);
@@ -581,7 +581,7 @@ TEST_CASE("balance report: rows and rank are the task's, not the mimic rows (Bax
 
   const Task none(model);
   REQUIRE(none.mimicRows() == 2);
-  REQUIRE(solveHybridDynamics(model, none, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, none));
   CHECK(ws.solution.balance.rows == 0);
   CHECK(ws.solution.balance.rank == 0);
   CHECK(ws.solution.balance.nu_unique);
@@ -603,7 +603,7 @@ TEST_CASE("balance report: rows and rank are the task's, not the mimic rows (Bax
   std::printf("Baxter, both grippers held: the Jacobian's singular values %.3g … %.3g, rank %d\n", sv[0],
               sv[sv.size() - 1], jacobian_rank);
   REQUIRE(jacobian_rank == 12);
-  REQUIRE(solveHybridDynamics(model, grippers, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, grippers));
   CHECK(ws.solution.balance.rows == 12);
   CHECK(ws.solution.balance.rank == 12);
   CHECK(ws.solution.balance.nu_unique);
@@ -615,7 +615,7 @@ TEST_CASE("balance report: rows and rank are the task's, not the mimic rows (Bax
     fingers.addJointConstraint(finger_r);
     fingers.targets() << 1.0, right;
     INFO("qdd_left = 1, qdd_right = " << right);
-    REQUIRE(solveHybridDynamics(model, fingers, q, qd, tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, fingers));
     const BalanceReport& report = ws.solution.balance;
     CHECK(report.rows == 2);
     CHECK(report.rank == 1);
@@ -651,7 +651,7 @@ TEST_CASE("mimic trees: friction matches the brute-force enumeration of stick/sl
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
-    const Status status = solveWithFriction(model, task, d.input.q, d.input.qd, d.input.tau, ws);
+    const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task);
     INFO("tree " << accepted << " (draw " << attempts << "): " << d.spec.dof() << " joints, "
                  << d.input.constraintRows() << " rows, pattern " << ref.pattern << ": " << statusText(status));
     REQUIRE(status);
@@ -794,7 +794,7 @@ TEST_CASE("mimic trees: friction with per-solve overrides and a stuck leader on 
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
-    const Status status = solveWithFriction(model, task, d.input.q, d.input.qd, d.input.tau, ws, draw.options);
+    const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task, draw.options);
     INFO("tree " << accepted << " (draw " << attempts << "): " << d.spec.dof() << " joints, leader " << draw.limited
                  << " on its " << (draw.side < 0 ? "lower" : "upper") << " limit, pattern " << ref.pattern << ": "
                  << statusText(status));
@@ -871,7 +871,7 @@ TEST_CASE("friction: a task that drives a stuck leader into its limit through tw
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
-    const Status status = solveWithFriction(model, task, d.input.q, d.input.qd, d.input.tau, ws, draw.options);
+    const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task, draw.options);
     INFO((with_mimic ? "with" : "without")
          << " the mimic joint: status " << static_cast<int>(status.code) << " '" << status.message
          << "', mu at the leader " << ws.friction.mu(2) << ", qdd " << ws.solution.qdd.transpose());
@@ -925,20 +925,20 @@ TEST_CASE("mimic errors: q or q̇ off the law is MimicMismatch, naming both join
   model.followLeaders(q, qd);
   CHECK(q(1) == -0.3 + 0.1);
   CHECK(qd(1) == 0.7);
-  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
-  REQUIRE(solveWithFriction(model, task, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
+  REQUIRE(solveWithFriction(model, ws, q, qd, tau, task));
   // Within the allowed rounding (1e-9 of the terms' size): accepted.
   Eigen::VectorXd q_near = q, qd_near = qd;
   q_near(1) += 1e-12;
   qd_near(1) -= 1e-12;
-  CHECK(solveHybridDynamics(model, task, q_near, qd_near, tau, ws));
+  CHECK(solveHybridDynamics(model, ws, q_near, qd_near, tau, task));
 
   for (const bool velocity : {false, true}) {
     Eigen::VectorXd q_off = q, qd_off = qd;
     (velocity ? qd_off : q_off)(1) += 1e-6;
     for (const bool friction : {false, true}) {
-      const Status s = friction ? solveWithFriction(model, task, q_off, qd_off, tau, ws)
-                                : solveHybridDynamics(model, task, q_off, qd_off, tau, ws);
+      const Status s = friction ? solveWithFriction(model, ws, q_off, qd_off, tau, task)
+                                : solveHybridDynamics(model, ws, q_off, qd_off, tau, task);
       INFO((velocity ? "qd" : "q") << " off, " << (friction ? "solveWithFriction" : "solveHybridDynamics") << ": "
                                    << s.message);
       CHECK(s.code == StatusCode::MimicMismatch);
@@ -950,7 +950,7 @@ TEST_CASE("mimic errors: q or q̇ off the law is MimicMismatch, naming both join
   // The leader moved without its mimic: the same.
   Eigen::VectorXd q_lead = q;
   q_lead(0) += 0.01;
-  const Status s = solveHybridDynamics(model, task, q_lead, qd, tau, ws);
+  const Status s = solveHybridDynamics(model, ws, q_lead, qd, tau, task);
   CHECK(s.code == StatusCode::MimicMismatch);
   std::printf("mimic mismatch message: %s\n", s.message);
 }
@@ -1031,16 +1031,16 @@ TEST_CASE("mimic errors: a task or workspace made for the model without mimic jo
     // The plain task on the mimic model (either workspace): ModelMismatch.
     for (const bool mimic_ws : {false, true}) {
       Workspace ws = mimic_ws ? Workspace(mimic, rows) : Workspace(plain, rows);
-      const Status s = solveHybridDynamics(mimic, plain_task, in.q, in.qd, in.tau, ws);
+      const Status s = solveHybridDynamics(mimic, ws, in.q, in.qd, in.tau, plain_task);
       CHECK(s.code == StatusCode::ModelMismatch);
-      const Status f = solveWithFriction(mimic, plain_task, in.q, in.qd, in.tau, ws);
+      const Status f = solveWithFriction(mimic, ws, in.q, in.qd, in.tau, plain_task);
       CHECK(f.code == StatusCode::ModelMismatch);
       refused_task += s.code == StatusCode::ModelMismatch ? 1 : 0;
       ++cases;
     }
     // The right workspace solves it.
     Workspace ws(mimic, mimic_task);
-    CHECK(solveHybridDynamics(mimic, mimic_task, in.q, in.qd, in.tau, ws));
+    CHECK(solveHybridDynamics(mimic, ws, in.q, in.qd, in.tau, mimic_task));
     ++solved;
   }
   std::printf("mimic errors, a plain task on a mimic model: %d cases, refused %d; the right workspace solved %d\n",
@@ -1075,7 +1075,7 @@ TEST_CASE("mimic errors: a workspace made for the model without mimic joints has
                        << ws.columnCapacity() << " columns; task: " << task.balanceRows() << " balance rows, "
                        << task.solverColumns() << " columns");
     const Status s =
-        friction ? solveWithFriction(mimic, task, q, qd, tau, ws) : solveHybridDynamics(mimic, task, q, qd, tau, ws);
+        friction ? solveWithFriction(mimic, ws, q, qd, tau, task) : solveHybridDynamics(mimic, ws, q, qd, tau, task);
     INFO((friction ? "solveWithFriction: " : "solveHybridDynamics: ") << s.message);
     CHECK((s.code == StatusCode::WorkspaceTooSmall || s.code == StatusCode::ModelMismatch));
   }
@@ -1103,13 +1103,13 @@ TEST_CASE("a solve on a model with mimic joints allocates nothing (with and with
   const int l = spec.mimicLaws()[0].leader;
   in.qd(l) = 0.0;  // a stuck leader with its mimic joint
   spec.followMimicLaws(in.q, in.qd);
-  REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));  // warm
-  REQUIRE(solveWithFriction(model, task, in.q, in.qd, in.tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));  // warm
+  REQUIRE(solveWithFriction(model, ws, in.q, in.qd, in.tau, task));
   bool all_ok = true;
   const long count = allocationsDuring([&] {
     for (int k = 0; k < 10; ++k) {
-      all_ok = solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws).ok() && all_ok;
-      all_ok = solveWithFriction(model, task, in.q, in.qd, in.tau, ws).ok() && all_ok;
+      all_ok = solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task).ok() && all_ok;
+      all_ok = solveWithFriction(model, ws, in.q, in.qd, in.tau, task).ok() && all_ok;
     }
   });
   CHECK(all_ok);
@@ -1119,7 +1119,7 @@ TEST_CASE("a solve on a model with mimic joints allocates nothing (with and with
   q_off(spec.mimicLaws()[0].joint) += 1.0;
   Status status;
   const long error_count =
-      allocationsDuring([&] { status = solveHybridDynamics(model, task, q_off, in.qd, in.tau, ws); });
+      allocationsDuring([&] { status = solveHybridDynamics(model, ws, q_off, in.qd, in.tau, task); });
   CHECK(status.code == StatusCode::MimicMismatch);
   CHECK(error_count == 0);
   std::printf("mimic allocations: %ld in 20 solves (10 with friction), %ld for a MimicMismatch\n", count, error_count);
@@ -1150,7 +1150,7 @@ TEST_CASE("mimic errors: a task made for a model with other mimic laws is refuse
   in.gravity = task_a.gravity;
   spec_b.followMimicLaws(in.q, in.qd);
   Workspace ws(model_b, task_a);
-  const Status s = solveHybridDynamics(model_b, task_a, in.q, in.qd, in.tau, ws);
+  const Status s = solveHybridDynamics(model_b, ws, in.q, in.qd, in.tau, task_a);
   const DenseResult dense = denseDynamics(spec_b, in);
   INFO("status " << static_cast<int>(s.code) << " '" << s.message << "', qdd " << ws.solution.qdd.transpose()
                  << ", model B's dynamics " << dense.qdd.transpose());

@@ -86,9 +86,9 @@ Comparison compare(const ChainSpec& spec, const ChainSpec& oracle_spec, const St
   Task task(model);  // no constraints, no wrenches
   task.gravity = s.gravity;
   Workspace ws(model, task);
-  REQUIRE(solveHybridDynamics(model, task, s.q, s.qd, s.tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, s.q, s.qd, s.tau, task));
   const Eigen::VectorXd qdd = ws.solution.qdd;
-  REQUIRE(inverseDynamics(model, task, s.q, s.qd, s.qdd, ws));
+  REQUIRE(inverseDynamics(model, ws, s.q, s.qd, s.qdd, task));
   const Eigen::VectorXd tau = ws.tau;
 
   const Mujoco mj(toMjcf(oracle_spec, s.gravity));

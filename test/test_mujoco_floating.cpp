@@ -113,12 +113,13 @@ struct Answers {
 };
 
 // zwang's link velocities and accelerations after a solve (frameVelocity, frameAcceleration of each link's frame).
-void zwangLinkMotions(const ChainSpec& spec, const Model& model, const Workspace& ws, Answers& a) {
+void zwangLinkMotions(const ChainSpec& spec, const Model& model, const Workspace& ws, const FloatingInput& input,
+                      Answers& a) {
   for (const LinkSpec& link : spec.links) {
     const int frame = model.frameIndex(link.name);
     Vec6 velocity, acceleration;
-    REQUIRE(frameVelocity(model, ws, frame, Expressed::World, velocity));
-    REQUIRE(frameAcceleration(model, ws, frame, Expressed::World, acceleration));
+    REQUIRE(frameVelocity(model, ws, input.q, input.v, frame, Expressed::World, velocity));
+    REQUIRE(frameAcceleration(model, ws, input.q, input.v, frame, Expressed::World, acceleration));
     a.link_velocity.push_back(velocity);
     a.link_acceleration.push_back(acceleration);
   }
@@ -131,15 +132,15 @@ Answers solveWithZwang(const FloatingProblem& p, const Eigen::VectorXd& qdd_inve
   REQUIRE(task.constraintRows() == 0);
   Workspace ws(model, task);
   Answers a;
-  const Status solved = solveHybridDynamics(model, task, p.input.q, p.input.v, p.input.tau, ws);
+  const Status solved = solveHybridDynamics(model, ws, p.input.q, p.input.v, p.input.tau, task);
   INFO(solved.message);
   REQUIRE(solved);
   a.qdd = ws.solution.qdd;
   a.base_world = ws.solution.base_acceleration_world;
-  zwangLinkMotions(p.spec, model, ws, a);
-  REQUIRE(inverseDynamics(model, task, p.input.q, p.input.v, qdd_inverse, ws));
+  zwangLinkMotions(p.spec, model, ws, p.input, a);
+  REQUIRE(inverseDynamics(model, ws, p.input.q, p.input.v, qdd_inverse, task));
   a.tau = ws.tau;
-  REQUIRE(jointSpaceInertia(model, p.input.q, ws));
+  REQUIRE(jointSpaceInertia(model, ws, p.input.q));
   a.H = ws.H;
   return a;
 }

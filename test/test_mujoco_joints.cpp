@@ -252,21 +252,21 @@ Answers solveWithZwang(const JointsProblem& p) {
   REQUIRE(task.constraintRows() == 0);
   Workspace ws(model, task);
   Answers a;
-  const Status solved = solveHybridDynamics(model, task, p.input.q, p.input.v, p.input.tau, ws);
+  const Status solved = solveHybridDynamics(model, ws, p.input.q, p.input.v, p.input.tau, task);
   INFO(solved.message);
   REQUIRE(solved);
   a.qdd = ws.solution.qdd;
   for (const LinkSpec& link : p.spec.links) {
     const int frame = model.frameIndex(link.name);
     Vec6 velocity, acceleration;
-    REQUIRE(frameVelocity(model, ws, frame, Expressed::World, velocity));
-    REQUIRE(frameAcceleration(model, ws, frame, Expressed::World, acceleration));
+    REQUIRE(frameVelocity(model, ws, p.input.q, p.input.v, frame, Expressed::World, velocity));
+    REQUIRE(frameAcceleration(model, ws, p.input.q, p.input.v, frame, Expressed::World, acceleration));
     a.link_velocity.push_back(velocity);
     a.link_acceleration.push_back(acceleration);
   }
-  REQUIRE(inverseDynamics(model, task, p.input.q, p.input.v, p.qdd_inverse, ws));
+  REQUIRE(inverseDynamics(model, ws, p.input.q, p.input.v, p.qdd_inverse, task));
   a.tau = ws.tau;
-  REQUIRE(jointSpaceInertia(model, p.input.q, ws));
+  REQUIRE(jointSpaceInertia(model, ws, p.input.q));
   a.H = ws.H;
   return a;
 }

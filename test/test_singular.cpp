@@ -119,7 +119,7 @@ TEST_CASE("more independent constraint rows than joints: finite, singular, least
     const Model model = modelFromSpec(spec);
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     const Solution& s = ws.solution;
     CHECK(allFinite(s));
     CHECK(s.balance.singular);
@@ -150,7 +150,7 @@ TEST_CASE("stretched-out arm: the along-arm tip acceleration is out of reach") {
   in.constraints.push_back(c);
   const Task task = taskFromInput(model, in);
   Workspace ws(model, task);
-  REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
   const Solution& s = ws.solution;
   CHECK(allFinite(s));
   CHECK(s.balance.singular);
@@ -174,8 +174,8 @@ TEST_CASE("a repeated constraint row: rank deficient but consistent, met exactly
   task.addConstraint("link2", A);
   task.targets() << 1.5, 1.5;
   Workspace ws(model, task);
-  REQUIRE(solveHybridDynamics(model, task, Eigen::Vector2d(0.2, 0.9), Eigen::Vector2d(0.1, -0.3),
-                              Eigen::Vector2d::Zero(), ws));
+  REQUIRE(solveHybridDynamics(model, ws, Eigen::Vector2d(0.2, 0.9), Eigen::Vector2d(0.1, -0.3), Eigen::Vector2d::Zero(),
+                              task));
   CHECK(ws.solution.balance.singular);
   CHECK(ws.solution.balance.rank == 1);
   CHECK_FALSE(ws.solution.balance.nu_unique);
@@ -193,9 +193,9 @@ TEST_CASE("a constraint on the fixed base changes nothing and is reported singul
   Task free_task(model);
   Workspace ws(model, task);
   const Eigen::Vector2d q(0.4, -0.2), qd(1, 2), tau(3, -1);
-  REQUIRE(solveHybridDynamics(model, free_task, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, free_task));
   const Eigen::VectorXd free_qdd = ws.solution.qdd;
-  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
   CHECK(ws.solution.balance.singular);
   CHECK(ws.solution.balance.rank == 0);
   CHECK(ws.solution.nu.norm() == 0.0);
@@ -233,7 +233,7 @@ TEST_CASE(
     INFO("left ankle's first row asked for " << left);
     task.targets().setZero();
     task.targets()[0] = left;
-    REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
     const BalanceReport& report = ws.solution.balance;
     CHECK(report.rows == 41);
     CHECK(report.rank == 35);
@@ -282,7 +282,7 @@ TEST_CASE("balance report: Frobenius condition number of the equilibrated 𝓛 a
     const Model model = modelFromSpec(spec);
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     const BalanceReport& d = ws.solution.balance;
     CHECK_FALSE(d.singular);
     CHECK(d.rank == m);
@@ -335,7 +335,7 @@ void checkAgainstPseudoInverse(const ChainSpec& spec, const DynamicsInput& in, b
   const Model model = modelFromSpec(spec);
   const Task task = taskFromInput(model, in);
   Workspace ws(model, task);
-  REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
   const Solution& s = ws.solution;
   REQUIRE(allFinite(s));
   const double scale = ref.gamma.norm() + ref.G.norm() * best.qdd.norm() + 1.0;  // what G q̈ − γ is computed from
@@ -497,7 +497,7 @@ std::vector<SweepSample> wristSweep(int points, double span, const BalanceOption
     SweepSample sample;
     sample.s = -span + 2.0 * span * i / (points - 1);
     q[4] = sample.s;
-    const Status status = solveHybridDynamics(model, task, q, qd, tau, ws);
+    const Status status = solveHybridDynamics(model, ws, q, qd, tau, task);
     if (!status) throw std::runtime_error(status.message);
     sample.nu = ws.solution.nu;
     sample.residual = ws.solution.balance.residual;
@@ -581,7 +581,7 @@ TEST_CASE("friction on a singular task: a held tip with stuck joints on a 5-join
     Workspace ws(model, task);
     const Eigen::VectorXd q = randomVector(rng, 5, 2.5), qd = Eigen::VectorXd::Zero(5);
     const Eigen::VectorXd tau = randomVector(rng, 5, 2.0);
-    REQUIRE(solveWithFriction(model, task, q, qd, tau, ws));
+    REQUIRE(solveWithFriction(model, ws, q, qd, tau, task));
     REQUIRE(ws.friction.stuck.size() == 5u);
     // At rest the task (b = 0) is consistent: q̈ = 0 meets it, and the
     // joints, all stuck, have friction to spare for whatever the held tip
@@ -623,11 +623,11 @@ TEST_CASE("balance options out of range: clear errors") {
   for (const auto& [set, message] : cases) {
     task.balance = BalanceOptions{};
     set(task.balance);
-    const Status plain = solveHybridDynamics(model, task, q, qd, tau, ws);
+    const Status plain = solveHybridDynamics(model, ws, q, qd, tau, task);
     INFO(plain.message);
     CHECK(plain.code == StatusCode::BadOption);
     CHECK(std::string(plain.message).find(message) != std::string::npos);
-    const Status friction = solveWithFriction(model, task, q, qd, tau, ws);
+    const Status friction = solveWithFriction(model, ws, q, qd, tau, task);
     CHECK(friction.code == StatusCode::BadOption);
   }
 }

@@ -23,28 +23,28 @@ TEST_CASE("wrong sizes and non-finite joint vectors are named with their index")
   const Eigen::VectorXd ok = Eigen::VectorXd::Zero(7);
   Eigen::VectorXd bad = ok;
 
-  Status s = solveHybridDynamics(model, task, Eigen::VectorXd::Zero(3), ok, ok, ws);
+  Status s = solveHybridDynamics(model, ws, Eigen::VectorXd::Zero(3), ok, ok, task);
   CHECK(s.code == StatusCode::SizeMismatch);
   CHECK_THAT(s.message, Contains("q has 3 entries") && Contains("7 joints"));
 
-  s = solveHybridDynamics(model, task, ok, ok, Eigen::VectorXd::Zero(8), ws);
+  s = solveHybridDynamics(model, ws, ok, ok, Eigen::VectorXd::Zero(8), task);
   CHECK(s.code == StatusCode::SizeMismatch);
   CHECK_THAT(s.message, Contains("tau has 8 entries"));
 
   bad[2] = kNaN;
-  s = solveHybridDynamics(model, task, ok, bad, ok, ws);
+  s = solveHybridDynamics(model, ws, ok, bad, ok, task);
   CHECK(s.code == StatusCode::NonFinite);
   CHECK_THAT(s.message, Contains("qd[2]") && Contains("not finite"));
 
   bad[2] = 0.0;
   bad[6] = -kInf;
-  s = solveHybridDynamics(model, task, ok, ok, bad, ws);
+  s = solveHybridDynamics(model, ws, ok, ok, bad, task);
   CHECK(s.code == StatusCode::NonFinite);
   CHECK_THAT(s.message, Contains("tau[6]") && Contains("-inf"));
 
-  s = inverseDynamics(model, task, ok, ok, bad, ws);
+  s = inverseDynamics(model, ws, ok, ok, bad, task);
   CHECK_THAT(s.message, Contains("qdd[6]"));
-  s = jointSpaceInertia(model, Eigen::VectorXd::Zero(2), ws);
+  s = jointSpaceInertia(model, ws, Eigen::VectorXd::Zero(2));
   CHECK_THAT(s.message, Contains("q has 2 entries"));
   Eigen::MatrixXd J(6, 6);
   s = frameJacobian(model, ws, ok, 0, Expressed::World, J);
@@ -60,15 +60,15 @@ TEST_CASE("non-finite gravity, targets and wrenches are named") {
   const Eigen::VectorXd z = Eigen::VectorXd::Zero(7);
 
   task.gravity.z() = kNaN;
-  CHECK_THAT(solveHybridDynamics(model, task, z, z, z, ws).message, Contains("gravity"));
+  CHECK_THAT(solveHybridDynamics(model, ws, z, z, z, task).message, Contains("gravity"));
   task.gravity.z() = -9.81;
   task.targets()[1] = kInf;
-  CHECK_THAT(solveHybridDynamics(model, task, z, z, z, ws).message, Contains("constraint targets b"));
+  CHECK_THAT(solveHybridDynamics(model, ws, z, z, z, task).message, Contains("constraint targets b"));
   task.targets()[1] = 0.0;
   task.wrench(w)[4] = kNaN;
-  CHECK_THAT(solveHybridDynamics(model, task, z, z, z, ws).message, Contains("wrench 0") && Contains("panda_link5"));
+  CHECK_THAT(solveHybridDynamics(model, ws, z, z, z, task).message, Contains("wrench 0") && Contains("panda_link5"));
   task.wrench(w)[4] = 0.0;
-  CHECK(solveHybridDynamics(model, task, z, z, z, ws).ok());
+  CHECK(solveHybridDynamics(model, ws, z, z, z, task).ok());
   CHECK(ws.solution.qdd.allFinite());
 }
 
@@ -78,18 +78,18 @@ TEST_CASE("a workspace too small or made for another model is refused") {
   task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6));
   Workspace small(model, 3);
   const Eigen::VectorXd z = Eigen::VectorXd::Zero(7);
-  Status s = solveHybridDynamics(model, task, z, z, z, small);
+  Status s = solveHybridDynamics(model, small, z, z, z, task);
   CHECK(s.code == StatusCode::WorkspaceTooSmall);
   CHECK_THAT(s.message, Contains("6 constraint rows") && Contains("at most 3"));
 
   const Model other = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf");
   Workspace other_ws(other, 6);
-  s = solveHybridDynamics(model, task, z, z, z, other_ws);
+  s = solveHybridDynamics(model, other_ws, z, z, z, task);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("workspace was made for 1 joints"));
   Task other_task(other);
   Workspace ws(model, 6);
-  s = solveHybridDynamics(model, other_task, z, z, z, ws);
+  s = solveHybridDynamics(model, ws, z, z, z, other_task);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("task was made for another model"));
 }
@@ -112,16 +112,16 @@ TEST_CASE("q outside the joint limits: solved as given, the solution says which 
   Task task(model);
   Workspace ws(model, task);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(7), zero = Eigen::VectorXd::Zero(7);
-  REQUIRE(solveHybridDynamics(model, task, q, zero, zero, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, zero, zero, task));
   CHECK(ws.solution.joints_outside_limits == 1);  // panda_joint4's range is [-3.0718, -0.0698]: 0 is outside
   CHECK(ws.solution.first_joint_outside_limits == 3);
   q[3] = -1.5;
   q[5] = 5.0;  // panda_joint6: [-0.0175, 3.7525]
-  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws));
+  REQUIRE(solveWithFriction(model, ws, q, zero, zero, task));
   CHECK(ws.solution.joints_outside_limits == 1);
   CHECK(ws.solution.first_joint_outside_limits == 5);
   q[5] = 1.0;
-  REQUIRE(solveHybridDynamics(model, task, q, zero, zero, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, zero, zero, task));
   CHECK(ws.solution.joints_outside_limits == 0);
   CHECK(ws.solution.first_joint_outside_limits == -1);
 }

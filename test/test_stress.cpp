@@ -197,11 +197,11 @@ struct Residuals {
 Residuals residuals(const Model& model, const Task& task, const DynamicsInput& in, const DenseResult& dense,
                     const Solution& s, const Eigen::VectorXd& tau_friction, Workspace& scratch) {
   Residuals r;
-  REQUIRE(jointSpaceInertia(model, in.q, scratch));
+  REQUIRE(jointSpaceInertia(model, scratch, in.q));
   const Eigen::MatrixXd H = scratch.H;
-  REQUIRE(inverseDynamics(model, task, in.q, in.qd, Eigen::VectorXd::Zero(in.q.size()), scratch));
+  REQUIRE(inverseDynamics(model, scratch, in.q, in.qd, Eigen::VectorXd::Zero(in.q.size()), task));
   const Eigen::VectorXd C = scratch.tau;
-  REQUIRE(inverseDynamics(model, task, in.q, in.qd, s.qdd, scratch));
+  REQUIRE(inverseDynamics(model, scratch, in.q, in.qd, s.qdd, task));
   const Eigen::VectorXd id = scratch.tau;
   // (‖G‖∞‖ν‖∞ too: τ_control holds Gᵀν, whose rounding is ε‖G‖‖ν‖ even when
   // it cancels to a small torque, as on a damped singular task with large ν.)
@@ -279,7 +279,7 @@ void runStress(unsigned long long seed, const std::vector<Draw>& only = {}) {
                     << task.constraintRows() << " rows");
 
       // --- plain hybrid dynamics
-      Status status = solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws);
+      Status status = solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task);
       ++worst.solves;
       INFO("status: " << status.message);
       if (status.code == StatusCode::Degenerate) {  // documented: a joint with no inertia to move
@@ -315,7 +315,7 @@ void runStress(unsigned long long seed, const std::vector<Draw>& only = {}) {
         options.joint_limits = false;  // limits: test_friction_limits; here q is anywhere
         const bool active = method == FrictionMethod::ActiveSet;
         INFO((active ? "active set" : "projected gradient"));
-        status = solveWithFriction(model, task, in.q, in.qd, in.tau, ws, options);
+        status = solveWithFriction(model, ws, in.q, in.qd, in.tau, task, options);
         ++worst.solves;
         INFO("status: " << status.message);
         REQUIRE(status.ok());
@@ -504,11 +504,11 @@ TEST_CASE("numerical stress: non-finite and wrongly sized inputs come back as a 
     for (int which = 0; which < 3; ++which) {
       Eigen::VectorXd v[3] = {ok, ok, ok};
       v[which][3] = bad;
-      CHECK(solveHybridDynamics(model, task, v[0], v[1], v[2], ws).code == StatusCode::NonFinite);
-      CHECK(solveWithFriction(model, task, v[0], v[1], v[2], ws).code == StatusCode::NonFinite);
+      CHECK(solveHybridDynamics(model, ws, v[0], v[1], v[2], task).code == StatusCode::NonFinite);
+      CHECK(solveWithFriction(model, ws, v[0], v[1], v[2], task).code == StatusCode::NonFinite);
     }
     task.targets()[2] = bad;
-    CHECK(solveHybridDynamics(model, task, ok, ok, ok, ws).code == StatusCode::NonFinite);
+    CHECK(solveHybridDynamics(model, ws, ok, ok, ok, task).code == StatusCode::NonFinite);
     task.targets()[2] = 0.0;
   }
 }
@@ -549,7 +549,7 @@ TEST_CASE("a heavy stuck joint next to a light fast one sticks (friction scales 
   for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
     FrictionOptions options;
     options.method = method;
-    REQUIRE(solveWithFriction(model, task, q, qd, tau, ws, options));
+    REQUIRE(solveWithFriction(model, ws, q, qd, tau, task, options));
     INFO("method " << (method == FrictionMethod::ActiveSet ? "active set" : "projected gradient") << ": mu "
                    << ws.friction.mu.transpose() << ", qdd " << ws.solution.qdd.transpose() << ", state "
                    << toString(ws.friction.state[0]) << ", kkt " << ws.friction.kkt_residual);
@@ -586,9 +586,9 @@ TEST_CASE("a constraint row nothing can move gets nu = 0 (regression: it got 1e3
   qd << 21.158291402917442, 0, 0, 0, 26.694499304429318;
   tau << -0.051337674531538716, 0.0049860000403736792, 0.051695840801024809, 0, -0.0024442861380955883;
   Workspace ws(model, task);
-  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
   const Solution s = ws.solution;
-  REQUIRE(inverseDynamics(model, task, q, qd, s.qdd, ws));
+  REQUIRE(inverseDynamics(model, ws, q, qd, s.qdd, task));
   INFO("nu " << s.nu.transpose() << "\nqdd " << s.qdd.transpose() << "\ntau_c " << s.tau_constraint.transpose()
              << "\nRNEA(qdd) - tau_control " << (ws.tau - s.tau_control).transpose() << "\nrank " << s.balance.rank
              << ", condition " << s.balance.condition << ", damping " << s.balance.damping);
@@ -605,7 +605,7 @@ TEST_CASE("a task no joint can move reports an infinite condition, not NaN") {
   task.addConstraint("base", ConstraintMatrix::Identity(6, 2), Expressed::World);
   Workspace ws(model, task);
   const Eigen::Vector2d q(0.3, 0.2), qd(1.0, 2.0), tau(1.0, 0.5);
-  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
   const BalanceReport& b = ws.solution.balance;
   INFO("condition " << b.condition << ", rank " << b.rank);
   CHECK(b.rank == 0);

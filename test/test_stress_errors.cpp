@@ -57,34 +57,34 @@ TEST_CASE("errors: solve statuses (sizes, non-finite inputs, workspace and task)
   Eigen::VectorXd bad = x;
   bad[2] = kNaN;
 
-  Status s = solveHybridDynamics(model, task, short3, x, x, ws);
+  Status s = solveHybridDynamics(model, ws, short3, x, x, task);
   CHECK(s.code == StatusCode::SizeMismatch);
   CHECK_THAT(s.message, Contains("q has 3 entries, the model has 7 joints"));
-  s = solveHybridDynamics(model, task, x, bad, x, ws);
+  s = solveHybridDynamics(model, ws, x, bad, x, task);
   CHECK(s.code == StatusCode::NonFinite);
   CHECK_THAT(s.message, Contains("qd[2] is nan (not finite)"));
   task.gravity[1] = kInf;
-  s = solveHybridDynamics(model, task, x, x, x, ws);
+  s = solveHybridDynamics(model, ws, x, x, x, task);
   CHECK(s.code == StatusCode::NonFinite);
   CHECK_THAT(s.message, Contains("gravity holds a non-finite value (inf) at entry 1"));
   task.gravity[1] = 0.0;
   task.targets()[4] = kNaN;
-  s = solveHybridDynamics(model, task, x, x, x, ws);
+  s = solveHybridDynamics(model, ws, x, x, x, task);
   CHECK_THAT(s.message, Contains("constraint targets b holds a non-finite value"));
   task.targets()[4] = 0.0;
   task.wrench(w)[0] = kNaN;
-  s = solveHybridDynamics(model, task, x, x, x, ws);
+  s = solveHybridDynamics(model, ws, x, x, x, task);
   CHECK(s.code == StatusCode::NonFinite);
   CHECK_THAT(s.message, Contains("wrench 0 (on frame 'panda_link5') is not finite"));
   task.wrench(w)[0] = 0.0;
-  s = solveHybridDynamics(model, task, x, x, x, small);
+  s = solveHybridDynamics(model, small, x, x, x, task);
   CHECK(s.code == StatusCode::WorkspaceTooSmall);
   CHECK_THAT(s.message, Contains("task has 6 constraint rows, the workspace was made for at most 2"));
-  s = solveHybridDynamics(model, task, x, x, x, foreign);
+  s = solveHybridDynamics(model, foreign, x, x, x, task);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("workspace was made for 1 joints, the model has 7"));
   const Task arm_task(arm);
-  s = solveHybridDynamics(model, arm_task, x, x, x, ws);
+  s = solveHybridDynamics(model, ws, x, x, x, arm_task);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("task was made for another model (1 joints"));
 }
@@ -95,10 +95,10 @@ TEST_CASE("errors: RNEA, CRBA, kinematics and Jacobian statuses", "[errors]") {
   const Task task(model), arm_task(arm);
   Workspace ws(model, task), foreign(arm, arm_task);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
-  Status s = inverseDynamics(model, arm_task, x, x, x, ws);
+  Status s = inverseDynamics(model, ws, x, x, x, arm_task);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("workspace or task was made for another model"));
-  s = jointSpaceInertia(model, x, foreign);
+  s = jointSpaceInertia(model, foreign, x);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("workspace was made for 1 joints, the model has 7"));
   s = forwardKinematics(model, foreign, x);
@@ -117,9 +117,9 @@ TEST_CASE("errors: RNEA, CRBA, kinematics and Jacobian statuses", "[errors]") {
   J.resize(6, 7);
   const int frames = static_cast<int>(model.frames().size());
   const std::function<Status(const Workspace&, int)> accessors[] = {
-      [&](const Workspace& w, int f) { return framePose(model, w, f, pose); },
-      [&](const Workspace& w, int f) { return frameVelocity(model, w, f, Expressed::Local, out); },
-      [&](const Workspace& w, int f) { return frameAcceleration(model, w, f, Expressed::World, out); }};
+      [&](const Workspace& w, int f) { return framePose(model, w, x, f, pose); },
+      [&](const Workspace& w, int f) { return frameVelocity(model, w, x, x, f, Expressed::Local, out); },
+      [&](const Workspace& w, int f) { return frameAcceleration(model, w, x, x, f, Expressed::World, out); }};
   for (const auto& accessor : accessors) {
     s = accessor(ws, frames);
     CHECK(s.code == StatusCode::ModelMismatch);
@@ -142,14 +142,14 @@ TEST_CASE("errors: friction options and the infeasible task", "[errors]") {
   Workspace ws(model, task);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
   for (const zwang::testing::BadFrictionOption& bad : zwang::testing::badFrictionOptions()) {
-    const Status s = solveWithFriction(model, task, x, x, x, ws, bad.options);
+    const Status s = solveWithFriction(model, ws, x, x, x, task, bad.options);
     CHECK(s.code == StatusCode::BadOption);
     CHECK_THAT(s.message, Contains(bad.message));
   }
 
   // The report's arm on its upper limit, asked to accelerate into it.
   zwang::testing::IntoUpperLimit into;
-  const Status s = solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws);
+  const Status s = solveWithFriction(into.arm, into.ws, into.q, into.zero, into.zero, into.task);
   CHECK(s.code == StatusCode::Infeasible);
   CHECK_THAT(s.message, Contains(into.message));
   CHECK(into.ws.solution.qdd.allFinite());
@@ -167,7 +167,7 @@ TEST_CASE("errors: Degenerate, a joint with no inertia to move", "[errors]") {
   const Task task(model);
   Workspace ws(model, task);
   const Eigen::VectorXd x = Eigen::VectorXd::Zero(2);
-  const Status s = solveHybridDynamics(model, task, x, x, x, ws);
+  const Status s = solveHybridDynamics(model, ws, x, x, x, task);
   CHECK(s.code == StatusCode::Degenerate);
   CHECK_THAT(s.message, Contains("joint 'first' has no inertia to move here (D = "));
 }

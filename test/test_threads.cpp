@@ -136,17 +136,17 @@ Outcome run(const Model& model, const Tasks& tasks, long solves) {
     Status status;
     switch (i % 3) {
       case 0:  // every joint stuck, gravity only (a floating base falls)
-        status = solveWithFriction(model, tasks.free_task, q, zero, tau, ws, options);
+        status = solveWithFriction(model, ws, q, zero, tau, tasks.free_task, options);
         hash.add(ws.friction.mu);
         break;
       case 1:  // constrained, one joint moving, friction
         qd = zero;
         qd[iv + 3] = 0.2;
-        status = solveWithFriction(model, tasks.constrained, q, qd, tau, ws, options);
+        status = solveWithFriction(model, ws, q, qd, tau, tasks.constrained, options);
         hash.add(ws.friction.mu);
         break;
       default:  // constrained, no friction
-        status = solveHybridDynamics(model, tasks.constrained, q, zero, tau, ws);
+        status = solveHybridDynamics(model, ws, q, zero, tau, tasks.constrained);
         hash.add(ws.solution.nu);
         break;
     }

@@ -58,7 +58,7 @@ TEST_CASE("trees: q̈, ν and τ_c match the dense KKT reference (500 random tre
     const Model model = modelFromSpec(spec);
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     const Solution& s = ws.solution;
     INFO("tree " << accepted << ": " << spec.dof() << " joints, " << in.constraintRows() << " rows");
     const double eq = relativeError(s.qdd, dense.qdd), en = relativeError(s.nu, dense.nu);
@@ -107,10 +107,10 @@ TEST_CASE("trees: RNEA, CRBA (zero blocks between branches), Jacobians and frame
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
     const Eigen::VectorXd qdd = randomVector(rng, spec.dof(), 5.0);
-    REQUIRE(inverseDynamics(model, task, in.q, in.qd, qdd, ws));
+    REQUIRE(inverseDynamics(model, ws, in.q, in.qd, qdd, task));
     e_tau =
         std::max(e_tau, relativeError(ws.tau, denseInverseDynamics(spec, in.q, in.qd, qdd, in.gravity, in.wrenches)));
-    REQUIRE(jointSpaceInertia(model, in.q, ws));
+    REQUIRE(jointSpaceInertia(model, ws, in.q));
     const DenseResult dense = denseDynamics(spec, in);
     e_H = std::max(e_H, (ws.H - dense.H).cwiseAbs().maxCoeff() / std::max(1.0, dense.H.cwiseAbs().maxCoeff()));
     for (int i = 0; i < model.dof(); ++i)  // joints on different branches: exactly zero
@@ -125,10 +125,10 @@ TEST_CASE("trees: RNEA, CRBA (zero blocks between branches), Jacobians and frame
       const Eigen::MatrixXd J_ref = linkJacobian(spec, in.q, link.name, Axes::World);
       e_J = std::max(e_J, J.size() ? (J - J_ref).cwiseAbs().maxCoeff() : 0.0);
     }
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     for (const LinkSpec& link : spec.links) {
       Vec6 acc;
-      REQUIRE(frameAcceleration(model, ws, model.frameIndex(link.name), Expressed::World, acc));
+      REQUIRE(frameAcceleration(model, ws, in.q, in.qd, model.frameIndex(link.name), Expressed::World, acc));
       const Vector6d ref = linkAcceleration(spec, in.q, in.qd, ws.solution.qdd, link.name, Axes::World);
       e_acc = std::max(e_acc, (acc - ref).cwiseAbs().maxCoeff() / std::max(1.0, ref.cwiseAbs().maxCoeff()));
     }
@@ -174,7 +174,7 @@ TEST_CASE("relative constraints: the acceleration seen from the reference frame 
     const Model model = modelFromSpec(spec);
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     const Eigen::VectorXd& qdd = ws.solution.qdd;
     const auto a = static_cast<std::size_t>(spec.linkIndex(c.link)),
                r = static_cast<std::size_t>(spec.linkIndex(c.relative_to));
@@ -225,7 +225,7 @@ TEST_CASE("trees: friction matches the brute-force enumeration of stick/slip pat
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
-    REQUIRE(solveWithFriction(model, task, d.input.q, d.input.qd, d.input.tau, ws));
+    REQUIRE(solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task));
     INFO("tree " << accepted << ": " << d.spec.dof() << " joints, " << d.input.constraintRows() << " rows, pattern "
                  << ref.pattern);
     const double eq = relativeError(ws.solution.qdd, ref.qdd);

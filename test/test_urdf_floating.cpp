@@ -74,7 +74,7 @@ Eigen::VectorXd qdd(const Model& m, const State& s, const Vec3& gravity = Vec3(0
   Task task(m);
   task.gravity = gravity;
   Workspace ws(m, task);
-  const Status status = solveHybridDynamics(m, task, s.q, s.v, s.tau, ws);
+  const Status status = solveHybridDynamics(m, ws, s.q, s.v, s.tau, task);
   INFO(status.message);
   REQUIRE(status);
   return ws.solution.qdd;
@@ -224,7 +224,7 @@ TEST_CASE("a planar root joint: the joint frame is the plane", "[urdf][floating]
   State s{Eigen::Vector3d(0.2, -0.1, 0.7), Eigen::VectorXd::Zero(3), Eigen::VectorXd::Zero(3)};
   Task task(m);
   Workspace ws(m, task);
-  REQUIRE(solveHybridDynamics(m, task, s.q, s.v, s.tau, ws));
+  REQUIRE(solveHybridDynamics(m, ws, s.q, s.v, s.tau, task));
   const Vec3 expected = g - g.dot(n) * n;
   const double e_world = (ws.solution.base_acceleration_world.head<3>() - expected).norm() +
                          ws.solution.base_acceleration_world.tail<3>().norm();
@@ -249,11 +249,11 @@ TEST_CASE("a free robot at rest under gravity falls at g", "[urdf][floating]") {
       State s = randomState(m, seed);
       s.v.setZero();
       s.tau.setZero();
-      REQUIRE(solveHybridDynamics(m, task, s.q, s.v, s.tau, ws));
+      REQUIRE(solveHybridDynamics(m, ws, s.q, s.v, s.tau, task));
       worst_qdd = std::max(worst_qdd, ws.solution.qdd.tail(m.dof()).cwiseAbs().maxCoeff());
       for (int f = 0; f < static_cast<int>(m.frames().size()); ++f) {
         Vec6 a;
-        REQUIRE(frameAcceleration(m, ws, f, Expressed::World, a));
+        REQUIRE(frameAcceleration(m, ws, s.q, s.v, f, Expressed::World, a));
         worst = std::max(worst, (a.head<3>() - task.gravity).norm() / task.gravity.norm() + a.tail<3>().norm());
       }
     }
@@ -387,7 +387,7 @@ TEST_CASE("contacts on the humanoid loaded bolted down warn, naming the floating
     const Task task = standing(m, {"l_ankle", "r_ankle"});
     Workspace ws(m, task);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(m.nv());
-    const Status s = solveHybridDynamics(m, task, q, zero, zero, ws);
+    const Status s = solveHybridDynamics(m, ws, q, zero, zero, task);
     INFO(s.message);
     REQUIRE(s);
     return ws.solution.nu[2] + ws.solution.nu[8];  // f_z of each foot (world axes, linear rows first)

@@ -206,14 +206,14 @@ TEST_CASE("solve: the subtree below a mid-tree free joint moves as the same bodi
   tau << 3.0, 0, 0, 0, 0, 0, 0, 0.5, -2.0;
   const Task task_a(a);
   Workspace ws_a(a, task_a);
-  REQUIRE(solveHybridDynamics(a, task_a, q, qd, tau, ws_a));
+  REQUIRE(solveHybridDynamics(a, ws_a, q, qd, tau, task_a));
 
   // The ball's pose and velocity ([v; ω] in its own axes, the free base's coordinates) from model a.
   const int ball_a = a.frameIndex("ball");
   Eigen::Isometry3d pose;
   Vec6 v_ball;
-  REQUIRE(framePose(a, ws_a, ball_a, pose));
-  REQUIRE(frameVelocity(a, ws_a, ball_a, Expressed::Local, v_ball));
+  REQUIRE(framePose(a, ws_a, q, ball_a, pose));
+  REQUIRE(frameVelocity(a, ws_a, q, qd, ball_a, Expressed::Local, v_ball));
   const Eigen::Quaterniond orientation(pose.linear());
   Eigen::VectorXd qb(b.nq()), qdb(b.nv()), taub(b.nv());
   qb << pose.translation(), orientation.w(), orientation.x(), orientation.y(), orientation.z(), q[8];
@@ -221,15 +221,15 @@ TEST_CASE("solve: the subtree below a mid-tree free joint moves as the same bodi
   taub << Vec6::Zero(), tau[7];
   const Task task_b(b);
   Workspace ws_b(b, task_b);
-  REQUIRE(solveHybridDynamics(b, task_b, qb, qdb, taub, ws_b));
+  REQUIRE(solveHybridDynamics(b, ws_b, qb, qdb, taub, task_b));
 
   CHECK(std::abs(ws_a.solution.qdd[7] - ws_b.solution.qdd[6]) < 1e-10);
   double worst = 0.0;
   for (const char* frame : {"ball", "l2"}) {
     INFO(frame);
     Vec6 acc_a, acc_b;
-    REQUIRE(frameAcceleration(a, ws_a, a.frameIndex(frame), Expressed::World, acc_a));
-    REQUIRE(frameAcceleration(b, ws_b, b.frameIndex(frame), Expressed::World, acc_b));
+    REQUIRE(frameAcceleration(a, ws_a, q, qd, a.frameIndex(frame), Expressed::World, acc_a));
+    REQUIRE(frameAcceleration(b, ws_b, qb, qdb, b.frameIndex(frame), Expressed::World, acc_b));
     CHECK((acc_a - acc_b).norm() < 1e-10);  // two sweeps over different trees: rounding only
     worst = std::max(worst, (acc_a - acc_b).norm());
   }
@@ -246,7 +246,7 @@ TEST_CASE("solve: a body on a planar joint follows Newton and Euler in its plane
     const Task task(m);
     Workspace ws(m, task);
     const Eigen::Vector3d q(0.2, -0.1, 0.6), qd(0.3, -0.4, 2.0), tau(1.5, -0.7, 0.25);
-    REQUIRE(solveHybridDynamics(m, task, q, qd, tau, ws));
+    REQUIRE(solveHybridDynamics(m, ws, q, qd, tau, task));
     // The plane's axes and normal in the world (the base is fixed: its frame is the world's).
     const double x[3] = {1, 0, 0}, y[3] = {0, 1, 0}, zero[3] = {0, 0, 0};
     const Eigen::Isometry3d origin = childPose(m, 0, zero);
@@ -310,7 +310,7 @@ TEST_CASE("a planar ROOT joint whose axis is not z is the planar joint below a f
     // At q = 0 the base link is at the URDF's <origin>; x and y move it normal to the axis.
     const Eigen::Vector4d q0 = Eigen::Vector4d::Zero();
     REQUIRE(forwardKinematics(a, ws_a, q0));
-    REQUIRE(framePose(a, ws_a, a.frameIndex("base"), pose));
+    REQUIRE(framePose(a, ws_a, q0, a.frameIndex("base"), pose));
     CHECK((pose.translation() - Vec3(0.1, -0.2, 0.3)).norm() < 1e-15);
     CHECK((pose.linear() - R_origin).norm() < 1e-14);
     for (int k = 0; k < 2; ++k) {
@@ -318,7 +318,7 @@ TEST_CASE("a planar ROOT joint whose axis is not z is the planar joint below a f
       q[k] = 1.0;
       REQUIRE(forwardKinematics(a, ws_a, q));
       Eigen::Isometry3d moved;
-      REQUIRE(framePose(a, ws_a, a.frameIndex("base"), moved));
+      REQUIRE(framePose(a, ws_a, q, a.frameIndex("base"), moved));
       const Vec3 step = moved.translation() - pose.translation();
       CHECK(std::abs(step.norm() - 1.0) < 1e-14);
       CHECK(std::abs(step.dot(normal_world)) < 1e-14);
@@ -329,25 +329,25 @@ TEST_CASE("a planar ROOT joint whose axis is not z is the planar joint below a f
       Eigen::VectorXd q(4), qd = Eigen::VectorXd::Random(4), tau = 5.0 * Eigen::VectorXd::Random(4),
                             qdd = Eigen::VectorXd::Random(4);
       REQUIRE(randomConfiguration(a, seed, q));
-      REQUIRE(solveHybridDynamics(a, task_a, q, qd, tau, ws_a));
-      REQUIRE(solveHybridDynamics(b, task_b, q, qd, tau, ws_b));
+      REQUIRE(solveHybridDynamics(a, ws_a, q, qd, tau, task_a));
+      REQUIRE(solveHybridDynamics(b, ws_b, q, qd, tau, task_b));
       worst = std::max(worst, (ws_a.solution.qdd - ws_b.solution.qdd).cwiseAbs().maxCoeff());
       for (const char* frame : {"base", "tool", "l1"}) {
         INFO(frame);
         Eigen::Isometry3d pa, pb;
         Vec6 acc_a, acc_b;
-        REQUIRE(framePose(a, ws_a, a.frameIndex(frame), pa));
-        REQUIRE(framePose(b, ws_b, b.frameIndex(frame), pb));
-        REQUIRE(frameAcceleration(a, ws_a, a.frameIndex(frame), Expressed::World, acc_a));
-        REQUIRE(frameAcceleration(b, ws_b, b.frameIndex(frame), Expressed::World, acc_b));
+        REQUIRE(framePose(a, ws_a, q, a.frameIndex(frame), pa));
+        REQUIRE(framePose(b, ws_b, q, b.frameIndex(frame), pb));
+        REQUIRE(frameAcceleration(a, ws_a, q, qd, a.frameIndex(frame), Expressed::World, acc_a));
+        REQUIRE(frameAcceleration(b, ws_b, q, qd, b.frameIndex(frame), Expressed::World, acc_b));
         CHECK((pa.matrix() - pb.matrix()).cwiseAbs().maxCoeff() < 1e-14);
         worst = std::max(worst, (acc_a - acc_b).cwiseAbs().maxCoeff());
       }
-      REQUIRE(inverseDynamics(a, task_a, q, qd, qdd, ws_a));
-      REQUIRE(inverseDynamics(b, task_b, q, qd, qdd, ws_b));
+      REQUIRE(inverseDynamics(a, ws_a, q, qd, qdd, task_a));
+      REQUIRE(inverseDynamics(b, ws_b, q, qd, qdd, task_b));
       worst = std::max(worst, (ws_a.tau - ws_b.tau).cwiseAbs().maxCoeff());
-      REQUIRE(jointSpaceInertia(a, q, ws_a));
-      REQUIRE(jointSpaceInertia(b, q, ws_b));
+      REQUIRE(jointSpaceInertia(a, ws_a, q));
+      REQUIRE(jointSpaceInertia(b, ws_b, q));
       worst = std::max(worst, (ws_a.H - ws_b.H).cwiseAbs().maxCoeff());
     }
   }

@@ -242,7 +242,7 @@ TEST_CASE("a loaded tree is the tree built by hand: model data and dynamics", "[
     q << 0.3, -0.4, 0.05, 0.7, -1.1;
     qd << 0.2, -0.1, 0.03, 0.4, 0.5;
     tau << 1, -2, 5, 0.5, -0.3;
-    REQUIRE(solveHybridDynamics(m, task, q, qd, tau, ws));
+    REQUIRE(solveHybridDynamics(m, ws, q, qd, tau, task));
     qdd = ws.solution.qdd;
     nu = ws.solution.nu;
     tau_c = ws.solution.tau_constraint;
@@ -351,12 +351,12 @@ TEST_CASE("random trees through the URDF writer and loader match the ModelBuilde
     }
     Task task_l(loaded), task_b(built);
     Workspace ws_l(loaded, task_l), ws_b(built, task_b);
-    REQUIRE(solveHybridDynamics(loaded, task_l, q, qd, tau, ws_l));
-    REQUIRE(solveHybridDynamics(built, task_b, q_b, qd_b, tau_b, ws_b));
+    REQUIRE(solveHybridDynamics(loaded, ws_l, q, qd, tau, task_l));
+    REQUIRE(solveHybridDynamics(built, ws_b, q_b, qd_b, tau_b, task_b));
     Eigen::VectorXd qdd_b(n);
     for (int j = 0; j < n; ++j) qdd_b[j] = ws_b.solution.qdd[perm[static_cast<std::size_t>(j)]];
     e_qdd = std::max(e_qdd, relativeError(ws_l.solution.qdd, qdd_b));
-    REQUIRE(inverseDynamics(loaded, task_l, q, qd, ws_l.solution.qdd, ws_l));
+    REQUIRE(inverseDynamics(loaded, ws_l, q, qd, ws_l.solution.qdd, task_l));
     e_tau = std::max(e_tau, relativeError(ws_l.tau, tau));
   }
   std::printf(
@@ -411,14 +411,14 @@ TEST_CASE("mimic joints in a tree: modelled (the default), locked or refused", "
     modelled.followLeaders(q, qd);
     CHECK(q[2] == 0.5 * 0.02 + 0.01);
     CHECK(qd[2] == 0.5 * 0.1);
-    REQUIRE(solveHybridDynamics(modelled, task_l, q, qd, tau, ws_l));
-    REQUIRE(solveHybridDynamics(built, task_b, q, qd, tau, ws_b));
+    REQUIRE(solveHybridDynamics(modelled, ws_l, q, qd, tau, task_l));
+    REQUIRE(solveHybridDynamics(built, ws_b, q, qd, tau, task_b));
     CHECK(relativeError(ws_l.solution.qdd, ws_b.solution.qdd) < 1e-14);
     CHECK(std::abs(ws_l.solution.qdd[2] - 0.5 * ws_l.solution.qdd[1]) < 1e-12 * (1 + std::abs(ws_l.solution.qdd[1])));
     CHECK(ws_l.solution.tau_control[2] == 0.0);  // the leader's motor carries it
     Eigen::VectorXd q_off = q;
     q_off[2] = 0.0;  // not where f1 puts it
-    const Status s = solveHybridDynamics(modelled, task_l, q_off, qd, tau, ws_l);
+    const Status s = solveHybridDynamics(modelled, ws_l, q_off, qd, tau, task_l);
     CHECK(s.code == StatusCode::MimicMismatch);
     CHECK_THAT(std::string(s.message), Contains("joint 'f2' mimics 'f1'"));
   }
@@ -555,7 +555,7 @@ TEST_CASE("Baxter: the whole dual-arm tree with its mimic fingers modelled, or l
       tau[j] = 1.0;
     }
     full.followLeaders(q, qd);
-    REQUIRE(solveHybridDynamics(full, task, q, qd, tau, ws));
+    REQUIRE(solveHybridDynamics(full, ws, q, qd, tau, task));
     for (const int j : full.mimicJoints()) {
       const int l = full.joint(j).mimic.leader;
       CHECK(std::abs(ws.solution.qdd[j] + ws.solution.qdd[l]) < 1e-10 * (1 + std::abs(ws.solution.qdd[l])));
@@ -613,8 +613,8 @@ TEST_CASE("Baxter: the whole dual-arm tree with its mimic fingers modelled, or l
   qdd.segment(1, 7) = qdd_arm;
   q(9) = -0.4;  // the right arm moves too; it does not load the left one (the torso is welded to the base)
   qd(10) = 0.5;
-  REQUIRE(inverseDynamics(m, task_tree, q, qd, qdd, ws_tree));
-  REQUIRE(inverseDynamics(arm, task_arm, q_arm, qd_arm, qdd_arm, ws_arm));
+  REQUIRE(inverseDynamics(m, ws_tree, q, qd, qdd, task_tree));
+  REQUIRE(inverseDynamics(arm, ws_arm, q_arm, qd_arm, qdd_arm, task_arm));
   const double e = relativeError(ws_tree.tau.segment(1, 7), ws_arm.tau);
   std::printf(
       "Baxter tree: %d moving joints (2 mimic locked); left arm's RNEA vs its chain with the gripper attached: %.2g\n",

@@ -251,11 +251,11 @@ TEST_CASE("mass beyond the tip: warned, or attached as a payload matching the de
     const Eigen::Vector2d qdd = trial < 10 ? Eigen::Vector2d::Zero() : Eigen::Vector2d(draw(rng), draw(rng));
     const Eigen::Vector3d q3(q[0], q[1], 0.0), qd3(qd[0], qd[1], 0.0), qdd3(qdd[0], qdd[1], 0.0);
     const Eigen::VectorXd dense = denseInverseDynamics(spec, q3, qd3, qdd3, task.gravity).head(2);
-    REQUIRE(inverseDynamics(payload, task, q, qd, qdd, ws));
+    REQUIRE(inverseDynamics(payload, ws, q, qd, qdd, task));
     worst = std::max(worst, relativeError(ws.tau, dense));
     const Task ignored_task(ignored);
     Workspace ignored_ws(ignored, ignored_task);
-    REQUIRE(inverseDynamics(ignored, ignored_task, q, qd, qdd, ignored_ws));
+    REQUIRE(inverseDynamics(ignored, ignored_ws, q, qd, qdd, ignored_task));
     worst_ignored = std::max(worst_ignored, relativeError(ignored_ws.tau, dense));
   }
   CHECK(worst < 1e-12);
@@ -282,7 +282,7 @@ TEST_CASE("point-mass and thin-rod chains agree with the dense reference", "[urd
     ++compared;
     const Task task = taskFromInput(model, in);
     Workspace ws(model, task);
-    REQUIRE(solveHybridDynamics(model, task, in.q, in.qd, in.tau, ws));
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.qd, in.tau, task));
     worst = std::max({worst, relativeError(ws.solution.qdd, ref.qdd), relativeError(ws.solution.nu, ref.nu)});
   }
   INFO(compared << " of 200 draws well posed, worst relative error " << worst);
@@ -311,7 +311,7 @@ TEST_CASE("a payload joint locked at a given position", "[urdf][warnings]") {
   const Task task(m);
   Workspace ws(m, task);
   const Eigen::Vector2d q(0.3, -0.7);
-  REQUIRE(inverseDynamics(m, task, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), ws));
+  REQUIRE(inverseDynamics(m, ws, q, Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(), task));
   const Eigen::VectorXd dense = denseInverseDynamics(spec, Eigen::Vector3d(0.3, -0.7, 0.04), Eigen::Vector3d::Zero(),
                                                      Eigen::Vector3d::Zero(), task.gravity)
                                     .head(2);
@@ -346,13 +346,13 @@ TEST_CASE("world is the root link's frame: a root turned +90 deg about x needs g
   turned_task.gravity = Vec3(0.0, -9.81, 0.0);
   Workspace upright_ws(upright, upright_task), turned_ws(turned, turned_task);
   const Eigen::Vector2d q(0.4, -0.9), zero = Eigen::Vector2d::Zero();
-  REQUIRE(inverseDynamics(upright, upright_task, q, zero, zero, upright_ws));
-  REQUIRE(inverseDynamics(turned, turned_task, q, zero, zero, turned_ws));
+  REQUIRE(inverseDynamics(upright, upright_ws, q, zero, zero, upright_task));
+  REQUIRE(inverseDynamics(turned, turned_ws, q, zero, zero, turned_task));
   CHECK(relativeError(turned_ws.tau, upright_ws.tau) < 1e-12);
   CHECK(upright_ws.tau.cwiseAbs().maxCoeff() > 1.0);  // gravity does load the joints
   // The default gravity on the turned root is wrong, visibly.
   turned_task.gravity = Task(turned).gravity;
-  REQUIRE(inverseDynamics(turned, turned_task, q, zero, zero, turned_ws));
+  REQUIRE(inverseDynamics(turned, turned_ws, q, zero, zero, turned_task));
   CHECK(relativeError(turned_ws.tau, upright_ws.tau) > 0.1);
 }
 
@@ -419,19 +419,19 @@ TEST_CASE("Baxter: each arm loads with the warnings its data calls for and solve
     Workspace ws(model, task);
     Eigen::VectorXd q(7), zero = Eigen::VectorXd::Zero(7);
     q << 0.3, -0.5, 0.2, 1.2, -0.3, 0.8, 0.1;
-    REQUIRE(solveHybridDynamics(model, task, q, zero, zero, ws));
+    REQUIRE(solveHybridDynamics(model, ws, q, zero, zero, task));
     CHECK(ws.solution.balance.consistent);
     const int gripper = model.frameIndex(options.tip);
     Vec6 a;
-    REQUIRE(frameAcceleration(model, ws, gripper, Expressed::World, a));
+    REQUIRE(frameAcceleration(model, ws, q, zero, gripper, Expressed::World, a));
     CHECK(a.norm() < 1e-10);
     Task free_task(model);
     Workspace id(model, free_task);
-    REQUIRE(inverseDynamics(model, free_task, q, zero, ws.solution.qdd, id));
+    REQUIRE(inverseDynamics(model, id, q, zero, ws.solution.qdd, free_task));
     CHECK((id.tau - ws.solution.tau_control).norm() < 1e-9 * (1.0 + id.tau.norm()));
-    REQUIRE(solveWithFriction(model, task, q, zero, zero, ws));  // every joint stuck
+    REQUIRE(solveWithFriction(model, ws, q, zero, zero, task));  // every joint stuck
     CHECK(ws.solution.balance.consistent);
-    REQUIRE(frameAcceleration(model, ws, gripper, Expressed::World, a));
+    REQUIRE(frameAcceleration(model, ws, q, zero, gripper, Expressed::World, a));
     CHECK(a.norm() < 1e-10);
   }
   UrdfOptions through_mimic;

@@ -65,14 +65,14 @@ void countCase(const Case& c) {
       task.addConstraint(frame, A, Expressed::World);
   }
   Workspace ws(m, task);
-  count(c.name + "_hd", [&] { (void)solveHybridDynamics(m, task, s.q, s.qd, s.tau, ws); });
+  count(c.name + "_hd", [&] { (void)solveHybridDynamics(m, ws, s.q, s.qd, s.tau, task); });
   const Eigen::VectorXd at_rest = Eigen::VectorXd::Zero(m.nv());  // every joint with friction stuck
   const FrictionOptions options;
-  count(c.name + "_fric", [&] { (void)solveWithFriction(m, task, s.q, at_rest, s.tau, ws, options); });
+  count(c.name + "_fric", [&] { (void)solveWithFriction(m, ws, s.q, at_rest, s.tau, task, options); });
   if (!c.rows.empty()) return;
   const Eigen::VectorXd qdd = Eigen::VectorXd::Constant(m.nv(), 0.3);
-  count(c.name + "_rnea", [&] { (void)inverseDynamics(m, task, s.q, s.qd, qdd, ws); });
-  count(c.name + "_crba", [&] { (void)jointSpaceInertia(m, s.q, ws); });
+  count(c.name + "_rnea", [&] { (void)inverseDynamics(m, ws, s.q, s.qd, qdd, task); });
+  count(c.name + "_crba", [&] { (void)jointSpaceInertia(m, ws, s.q); });
 }
 
 }  // namespace

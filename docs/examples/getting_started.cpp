@@ -13,11 +13,11 @@ int main(int argc, char** argv) {
   Eigen::VectorXd q(7), qd = Eigen::VectorXd::Zero(7), tau = Eigen::VectorXd::Zero(7);
   q << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;  // the "ready" pose, at rest
 
-  zwang::Status status = zwang::solveHybridDynamics(model, task, q, qd, tau, ws);  // no friction
+  zwang::Status status = zwang::solveHybridDynamics(model, ws, q, qd, tau, task);  // no friction
   if (!status) return std::fprintf(stderr, "%s\n", status.message), 1;
   const Eigen::VectorXd plain = ws.solution.tau_control, plain_qdd = ws.solution.qdd;  // τ_control = τ + τ_c
 
-  status = zwang::solveWithFriction(model, task, q, qd, tau, ws);  // static friction used
+  status = zwang::solveWithFriction(model, ws, q, qd, tau, task);  // static friction used
   if (!status) return std::fprintf(stderr, "%s\n", status.message), 1;
   auto clean = [](double x) { return std::abs(x) < 1e-9 ? 0.0 : x; };  // rounding noise shown as 0
   std::printf("joint         plain: qdd   tau_control | with friction: qdd   tau_control       mu  state\n");

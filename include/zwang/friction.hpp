@@ -50,8 +50,8 @@ struct FrictionOptions {
 /// τ + τ_c, Z with the friction torques) and ws.friction. Never throws, never
 /// allocates. Returns StatusCode::Infeasible (with finite outputs) when the task
 /// drives a joint into a limit (the maximisation is unbounded).
-Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                         Workspace& ws, const FrictionOptions& options = {}) noexcept;
+                         const Task& task, const FrictionOptions& options = {}) noexcept;
 
 }  // namespace zwang

@@ -16,8 +16,24 @@
 namespace zwang {
 
 /// The constrained hybrid dynamics of the file comment: q̈, ν, τ_c, τ_control and Z into ws.solution.
-Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+/// The argument order of every entry point: model, workspace, the state (q, q̇, then τ or q̈), then
+/// what the call is asked to do (the task, options); results land in the workspace.
+Status solveHybridDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                            const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                           Workspace& ws) noexcept;
+                           const Task& task) noexcept;
+
+/// Forward dynamics without constraints (the articulated-body algorithm: the
+/// sweeps with no task rows; a model's mimic couplings still hold): q̈ into
+/// ws.solution.qdd, τ_control = τ, Z. Gravity is Task's default
+/// (Workspace::defaultTask), no external wrenches.
+Status forwardDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd,
+                       const Eigen::Ref<const Eigen::VectorXd>& tau) noexcept;
+/// The same with the task's gravity and external wrenches. A task with
+/// constraint rows is BadOption (forwardDynamics is the unconstrained solve:
+/// solveHybridDynamics meets them).
+Status forwardDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
+                       const Task& task) noexcept;
 
 }  // namespace zwang

@@ -22,15 +22,19 @@ namespace zwang {
 /// plane's axes). The base's q̈ is the derivative of its velocity
 /// coordinates, as solveHybridDynamics returns it. Afterwards
 /// frameAcceleration reads the accelerations of this motion.
-Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+Status inverseDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                        const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& qdd,
-                       Workspace& ws) noexcept;
+                       const Task& task) noexcept;
+/// The same with Task's default gravity and no wrenches (Workspace::defaultTask).
+Status inverseDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd,
+                       const Eigen::Ref<const Eigen::VectorXd>& qdd) noexcept;
 
 /// Composite-rigid-body algorithm: ws.H = H(q) (nv × nv), including rotor
 /// inertias. A floating base's rows and columns come first, in its velocity
 /// coordinates (a free base's block is the whole robot's composite inertia in
 /// base axes at the base origin); entries between joints on different
 /// branches are exactly zero.
-Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q, Workspace& ws) noexcept;
+Status jointSpaceInertia(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q) noexcept;
 
 }  // namespace zwang

@@ -27,12 +27,17 @@ namespace zwang {
 //
 // framePose, frameVelocity and frameAcceleration read what the last call that
 // computes kinematics left in the workspace (Workspace::kinematics, whose
-// comment lists what each call leaves), for the same Model object. Asked for
-// more than that call computed, they return NotComputed naming what to call
-// first, e.g. "frameAcceleration: the workspace holds poses and velocities
-// only (the last call computed no accelerations); call solveHybridDynamics,
-// solveWithFriction or inverseDynamics first". They do not compare states:
-// the results are those of the q (q̇, q̈) of that last call.
+// comment lists what each call leaves), and take the state the caller means:
+// the workspace records the q (and q̇) those results were computed at, so a
+// query after forwardKinematics(model, ws, q, qd) or a solve at (q, qd) only
+// compares the state (nq + nv entries) and reads. A query for another state,
+// another Model object, or more than the last call computed returns
+// NotComputed naming what to call first, e.g. "framePose: the workspace holds
+// kinematics at another q (q[3] = 0.5 held, 0.25 given); call
+// forwardKinematics(model, ws, q) first" or "frameAcceleration: the workspace
+// holds poses and velocities only (the last call computed no accelerations);
+// call solveHybridDynamics, solveWithFriction or inverseDynamics first".
+// States are compared entry by entry, exactly: pass the same vectors.
 
 /// Poses (and velocities when qd is given) of every body into the workspace:
 /// q has nq() entries, qd nv(). Without qd the workspace holds poses only
@@ -40,18 +45,25 @@ namespace zwang {
 Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd = Eigen::VectorXd()) noexcept;
 
-/// After forwardKinematics, frameJacobian, jointSpaceInertia, inverseDynamics
-/// or a solve: the frame's pose in the world.
-Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isometry3d& pose) noexcept;
-/// After forwardKinematics with qd, inverseDynamics or a solve: the frame's velocity.
-Status frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed, Vec6& velocity) noexcept;
-/// After a solve (solveHybridDynamics, solveWithFriction) or inverseDynamics:
-/// the frame's true classical acceleration (gravity's shift of the sweep removed).
-Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed,
+/// The frame's pose in the world at q, after forwardKinematics(q), frameJacobian(q),
+/// jointSpaceInertia(q), inverseDynamics or a solve at q.
+Status framePose(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q, int frame,
+                 Eigen::Isometry3d& pose) noexcept;
+/// The frame's velocity at (q, q̇), after forwardKinematics(q, qd), inverseDynamics or a solve at (q, q̇).
+Status frameVelocity(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                     const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, Expressed expressed,
+                     Vec6& velocity) noexcept;
+/// After a solve (solveHybridDynamics, solveWithFriction, forwardDynamics) or
+/// inverseDynamics at (q, q̇): the frame's true classical acceleration of that
+/// call's motion (gravity's shift of the sweep removed).
+Status frameAcceleration(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                         const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept;
 
-/// J (6 × nv()) with frameVelocity = J q̇. Runs forwardKinematics(q) itself:
-/// afterwards the workspace holds the poses at q only.
+/// J (6 × nv()) with frameVelocity = J q̇. Reads the poses when the workspace
+/// holds them at q (after forwardKinematics(q) or a solve at q: its results are
+/// kept); otherwise runs forwardKinematics(q) first, and the workspace then
+/// holds the poses at q only.
 /// A floating base's columns come first, in the user's velocity coordinates:
 /// d(frame velocity)/d v_base, for a free base v_B = [v; ω] in base axes, for
 /// a planar one [ẋ, ẏ, ψ̇] in the plane's axes; then one column per joint, zero

@@ -118,21 +118,28 @@ enum class KinematicsStage {
 };
 
 /// What the kinematic members of a workspace hold: the results of the last
-/// call that computes kinematics, as far as it got, for the model it was
-/// given. After each call:
+/// call that computes kinematics, as far as it got, for the model and the
+/// state it was given. After each call:
 ///   forwardKinematics(q)                     Poses
 ///   forwardKinematics(q, qd)                 Velocities
-///   frameJacobian, jointSpaceInertia         Poses (their q; velocities are not computed)
+///   frameJacobian, jointSpaceInertia         Poses (their q; velocities are not computed;
+///                                            frameJacobian keeps what the workspace held at q)
 ///   inverseDynamics                          Accelerations (of its q̈)
-///   solveHybridDynamics, solveWithFriction   Accelerations (of the solution; also when
-///                                            solveWithFriction returns Infeasible)
+///   solveHybridDynamics, forwardDynamics,    Accelerations (of the solution; also when
+///   solveWithFriction                        solveWithFriction returns Infeasible)
 /// A call that returns an error holds what it completed: None when it failed
 /// its input checks, Velocities when a solve stopped at Degenerate. The
-/// queries of kinematics.hpp return StatusCode::NotComputed for anything
-/// beyond the stage held, or for a model other than `model`.
+/// queries of kinematics.hpp take the state they mean and return
+/// StatusCode::NotComputed for anything beyond the stage held, for another
+/// state, or for a model other than `model`.
 struct KinematicsHeld {
   KinematicsStage stage = KinematicsStage::None;  ///< how far the results go
   const Model* model = nullptr;                   ///< the model they were computed for (compared by address)
+  /// The q they were computed at (nq entries, sized by the Workspace
+  /// constructor: read it, do not resize it).
+  Eigen::VectorXd q;
+  /// The q̇ (nv entries; meaningful from Velocities on).
+  Eigen::VectorXd qd;
 };
 
 /// All scratch memory of the algorithms, and the results of the last call: see the file comment.
@@ -231,11 +238,16 @@ class Workspace {
   /// Scratch of the friction extension (src/friction/friction.cpp).
   internal::FrictionScratch& frictionScratch() { return *friction_scratch_; }
 
+  /// The task forwardDynamics and inverseDynamics use when given none: Task's
+  /// default gravity, no constraints, no wrenches.
+  const Task& defaultTask() const { return *default_task_; }
+
  private:
   int dof_;
   int capacity_;
   int mimic_rows_;
   std::unique_ptr<internal::FrictionScratch> friction_scratch_;
+  std::unique_ptr<Task> default_task_;
 };
 
 }  // namespace zwang

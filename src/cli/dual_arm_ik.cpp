@@ -39,7 +39,7 @@ double reachHand(const Model& model, Workspace& ws, Eigen::VectorXd& q, int fram
   Vec6 e;
   for (int iteration = 0; iteration < 500; ++iteration) {
     Status s = frameJacobian(model, ws, q, frame, Expressed::World, J);
-    if (s) s = framePose(model, ws, frame, pose);
+    if (s) s = framePose(model, ws, q, frame, pose);
     if (!s) throw CliError(kExitError, where + s.message);
     const Eigen::AngleAxisd rotation(target.linear() * pose.linear().transpose());
     e << target.translation() - pose.translation(), rotation.angle() * rotation.axis();

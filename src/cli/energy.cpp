@@ -72,12 +72,12 @@ energy::PostureResult run(const Model& model, const Pose& pose, PoseDetail& deta
   const std::string where = std::string("energy: pose ") + pose.name + ": ";
 
   Task free_task(model);
-  if (const Status s = inverseDynamics(model, free_task, r.q, zero, zero, ws); !s)
+  if (const Status s = inverseDynamics(model, ws, r.q, zero, zero, free_task); !s)
     throw CliError(kExitError, where + "RNEA: " + s.message);
   const Eigen::VectorXd gravity = ws.tau;  // G(q) from RNEA
   Eigen::Isometry3d tool;
   Status s = forwardKinematics(model, ws, r.q);
-  if (s) s = framePose(model, ws, model.frameIndex("tool0"), tool);
+  if (s) s = framePose(model, ws, r.q, model.frameIndex("tool0"), tool);
   if (!s) throw CliError(kExitError, where + s.message);
   detail.tool = tool.translation();
 

@@ -102,8 +102,8 @@ Eigen::VectorXd constraintTorques(const Model& model, Workspace& ws, const Eigen
   Eigen::Isometry3d pl, pr;
   Status s = frameJacobian(model, ws, q, left, Expressed::World, JL);
   if (s) s = frameJacobian(model, ws, q, right, Expressed::World, JR);
-  if (s) s = framePose(model, ws, left, pl);
-  if (s) s = framePose(model, ws, right, pr);
+  if (s) s = framePose(model, ws, q, left, pl);
+  if (s) s = framePose(model, ws, q, right, pr);
   if (!s) throw CliError(kExitError, std::string("energy: dual arm: ") + s.message);
   // The relative rows: [f; n] in right_tool0's axes, +on the left hand, −on the
   // right arm at the same point (the left hand's origin, carried by the right body).
@@ -179,7 +179,7 @@ energy::PostureResult run(const Model& model, const Posture& posture, PostureDet
 
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(kDof);
   // G'(q): RNEA with the task's gravity and wrenches (constraints ignored).
-  if (const Status s = inverseDynamics(model, task, r.q, zero, zero, ws); !s)
+  if (const Status s = inverseDynamics(model, ws, r.q, zero, zero, task); !s)
     throw CliError(kExitError, where + "RNEA: " + s.message);
   const Eigen::VectorXd gravity = ws.tau;
 

@@ -16,11 +16,11 @@ const Variant kVariants[kVariantCount] = {{"plain", -1.0}, {"friction_margin_0.5
 Status solveAtRest(const Model& model, const Task& task, const Eigen::VectorXd& q, Workspace& ws,
                    const Variant& variant, const Eigen::VectorXd& breakaway) {
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  if (variant.margin < 0) return solveHybridDynamics(model, task, q, zero, zero, ws);
+  if (variant.margin < 0) return solveHybridDynamics(model, ws, q, zero, zero, task);
   FrictionOptions options;
   options.margin = variant.margin;
   options.breakaway = breakaway;
-  return solveWithFriction(model, task, q, zero, zero, ws, options);
+  return solveWithFriction(model, ws, q, zero, zero, task, options);
 }
 
 Effort effortOf(const Eigen::VectorXd& tau) {

@@ -213,7 +213,7 @@ std::vector<Eigen::Isometry3d> footPoses(const Model& model, Workspace& ws, cons
   require(forwardKinematics(model, ws, q), context);
   std::vector<Eigen::Isometry3d> poses(robot.feet.size());
   for (std::size_t k = 0; k < robot.feet.size(); ++k)
-    require(framePose(model, ws, model.frameIndex(robot.feet[k]), poses[k]), context);
+    require(framePose(model, ws, q, model.frameIndex(robot.feet[k]), poses[k]), context);
   return poses;
 }
 
@@ -251,7 +251,7 @@ Eigen::Vector2d centreOfMass(const Model& model, Workspace& ws, const Eigen::Vec
                              const std::string& context) {
   const Task gravity_only(model);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, gravity_only, q, zero, zero, ws), context + "RNEA: ");
+  require(inverseDynamics(model, ws, q, zero, zero, gravity_only), context + "RNEA: ");
   const Eigen::Vector3d f = ws.tau.head<3>(), n = ws.tau.segment<3>(3);
   mass = f.norm() / gravity_only.gravity.norm();
   const Eigen::Quaterniond orientation(q[3], q[4], q[5], q[6]);

@@ -75,14 +75,14 @@ Result run(const Model& model, const Scenario& sc) {
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(n), qd = Eigen::VectorXd::Zero(n), tau0 = Eigen::VectorXd::Zero(n);
 
   Result r;
-  const Status status = solveWithFriction(model, task, q, qd, tau0, ws);
+  const Status status = solveWithFriction(model, ws, q, qd, tau0, task);
   if (!status) throw CliError(kExitError, std::string("scenarios: ") + sc.name + ": " + status.message);
   r.mu = ws.friction.mu[0];
   r.qdd = ws.solution.qdd[0];
   r.tau_control = ws.solution.tau_control[0];
   r.state = toString(ws.friction.state[0]);
   r.g = ws.friction.gauss_dual;
-  if (!inverseDynamics(model, free_task, q, qd, ws.solution.qdd, ws))
+  if (!inverseDynamics(model, ws, q, qd, ws.solution.qdd, free_task))
     throw CliError(kExitError, "scenarios: RNEA failed");
   r.tau_net = ws.tau[0];
 
@@ -93,13 +93,13 @@ Result run(const Model& model, const Scenario& sc) {
     const double mu = f * (i - (kSamples - 1) / 2) / ((kSamples - 1) / 2);
     Eigen::VectorXd tau = tau0;
     tau[0] -= mu;
-    const Status s = solveHybridDynamics(model, task, q, qd, tau, ws);
+    const Status s = solveHybridDynamics(model, ws, q, qd, tau, task);
     if (!s) throw CliError(kExitError, std::string("scenarios: ") + sc.name + ": " + s.message);
     r.mu_grid.push_back(mu);
     r.g_grid.push_back(ws.solution.gauss);
     r.qdd_grid.push_back(ws.solution.qdd[0]);
     r.tau_grid.push_back(tau0[0] + ws.solution.tau_constraint[0]);
-    if (!inverseDynamics(model, free_task, q, qd, ws.solution.qdd, ws))
+    if (!inverseDynamics(model, ws, q, qd, ws.solution.qdd, free_task))
       throw CliError(kExitError, "scenarios: RNEA failed");
     r.net_grid.push_back(ws.tau[0]);
     if (ws.solution.gauss > best) {

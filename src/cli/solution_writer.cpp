@@ -100,7 +100,7 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
   Json frame_map = Json::object();
   for (const int f : frames) {
     Vec6 a;
-    if (const Status s = frameAcceleration(model, ws, f, Expressed::World, a); !s)
+    if (const Status s = frameAcceleration(model, ws, ws.kinematics.q, ws.kinematics.qd, f, Expressed::World, a); !s)
       throw CliError(kExitError, std::string("solve: ") + s.message);
     frame_map[model.frame(f).name] = {{"acceleration_world", array(a)}};
   }

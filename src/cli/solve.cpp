@@ -37,7 +37,7 @@ int commandSolve(int argc, char** argv) {
     std::fprintf(stderr, "zwang: warning: %s: %s\n", problem.file.c_str(), printable(w.message, 4000).c_str());
   warnOutsideLimits(problem.file, bound.model, bound.q);
   Workspace ws(bound.model, *bound.task);
-  const Status status = problem::solve(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws,
+  const Status status = problem::solve(bound.model, ws, bound.q, bound.qd, bound.tau, *bound.task,
                                        bound.with_friction ? &bound.friction_options : nullptr);
   const bool infeasible = status.code == StatusCode::Infeasible;
   if (!status && !infeasible) throw CliError(kExitError, problem.file + ": solve: " + status.message);

@@ -45,7 +45,7 @@ Eigen::VectorXd torquesWithGround(const Model& model, Workspace& ws, const std::
     loaded.wrench(loaded.addWrench(feet[k], Expressed::World)) = w;
   }
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, loaded, q, zero, zero, ws), "energy: RNEA: ");
+  require(inverseDynamics(model, ws, q, zero, zero, loaded), "energy: RNEA: ");
   return ws.tau;
 }
 
@@ -57,7 +57,7 @@ DenseBalance denseBalance(const Model& model, Workspace& ws, const std::vector<s
   d.Gt.compute(d.Gt_matrix);
   const Task gravity_only(model);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, gravity_only, q, zero, zero, ws), context + "RNEA: ");
+  require(inverseDynamics(model, ws, q, zero, zero, gravity_only), context + "RNEA: ");
   d.gravity = ws.tau;
   d.tau0 = d.Gt.solve(d.gravity).tail(n);
   Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(model.nv(), n);

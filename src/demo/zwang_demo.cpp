@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
     if (n == 7) q << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
     const Eigen::VectorXd qd = Eigen::VectorXd::Zero(n), tau = Eigen::VectorXd::Zero(n);
 
-    const zwang::Status status = zwang::solveHybridDynamics(model, task, q, qd, tau, ws);
+    const zwang::Status status = zwang::solveHybridDynamics(model, ws, q, qd, tau, task);
     if (!status) {
       std::fprintf(stderr, "zwang_demo: %s\n", status.message);
       return 1;
@@ -45,8 +45,8 @@ int main(int argc, char** argv) {
     const int tool_frame = model.frameIndex(tool);
     Eigen::Isometry3d pose;
     zwang::Vec6 a_tool;
-    zwang::Status read = zwang::framePose(model, ws, tool_frame, pose);
-    if (read) read = zwang::frameAcceleration(model, ws, tool_frame, zwang::Expressed::World, a_tool);
+    zwang::Status read = zwang::framePose(model, ws, q, tool_frame, pose);
+    if (read) read = zwang::frameAcceleration(model, ws, q, qd, tool_frame, zwang::Expressed::World, a_tool);
     if (!read) {
       std::fprintf(stderr, "zwang_demo: %s\n", read.message);
       return 1;
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
 
     // For comparison: holding every joint still takes the gravity torques.
     zwang::Task free_task(model);
-    if (zwang::inverseDynamics(model, free_task, q, qd, qd, ws)) printVector("gravity torques (RNEA) [Nm]", ws.tau);
+    if (zwang::inverseDynamics(model, ws, q, qd, qd, free_task)) printVector("gravity torques (RNEA) [Nm]", ws.tau);
   } catch (const zwang::ModelError& e) {
     std::fprintf(stderr, "zwang_demo: %s\n", e.what());
     return 1;

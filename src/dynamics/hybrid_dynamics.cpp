@@ -6,9 +6,9 @@
 
 namespace zwang {
 
-Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+Status solveHybridDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                            const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                           Workspace& ws) noexcept {
+                           const Task& task) noexcept {
   using namespace internal;
   ws.kinematics.stage = KinematicsStage::None;  // until the sweeps below compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
@@ -26,6 +26,27 @@ Status solveHybridDynamics(const Model& model, const Task& task, const Eigen::Re
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   out.gauss = gaussFunction(model, task, out.qdd, tau, ws);
   return {};
+}
+
+// The unconstrained solve is the same stages with no task rows (the mimic
+// couplings, which the model carries, stay).
+Status forwardDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
+                       const Task& task) noexcept {
+  if (task.constraintRows() != 0) {
+    ws.kinematics.stage = KinematicsStage::None;  // as any call that fails its input checks
+    return Status::error(StatusCode::BadOption,
+                         "forwardDynamics: the task has %d constraint rows; forwardDynamics is the unconstrained "
+                         "solve (gravity and wrenches only): use solveHybridDynamics to meet them",
+                         task.constraintRows());
+  }
+  return solveHybridDynamics(model, ws, q, qd, tau, task);
+}
+
+Status forwardDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd,
+                       const Eigen::Ref<const Eigen::VectorXd>& tau) noexcept {
+  return solveHybridDynamics(model, ws, q, qd, tau, ws.defaultTask());
 }
 
 }  // namespace zwang

@@ -36,7 +36,8 @@ ZWANG_FLATTEN void recursiveNewtonEuler(const Model& model, const Task& task,
     ws.a[at(i)] = a;
     a_previous = a;
   }
-  ws.kinematics = {KinematicsStage::Accelerations, &model};
+  ws.kinematics.stage = KinematicsStage::Accelerations;
+  ws.kinematics.model = &model;
   internal::applyExternalWrenches(model, task, ws);
   for (int i = 1; i <= N; ++i) ws.f[at(i)] = ws.I[at(i)] * ws.a[at(i)] + ws.Fbias[at(i)];
 
@@ -58,9 +59,9 @@ ZWANG_FLATTEN void recursiveNewtonEuler(const Model& model, const Task& task,
 
 }  // namespace
 
-Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q_all,
+Status inverseDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q_all,
                        const Eigen::Ref<const Eigen::VectorXd>& qd_all,
-                       const Eigen::Ref<const Eigen::VectorXd>& qdd_all, Workspace& ws) noexcept {
+                       const Eigen::Ref<const Eigen::VectorXd>& qdd_all, const Task& task) noexcept {
   ws.kinematics.stage = KinematicsStage::None;  // until the outward stage computes them
   if (ws.dof() != model.dof() || task.modelDof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace or task was made for another model");
@@ -73,6 +74,12 @@ Status inverseDynamics(const Model& model, const Task& task, const Eigen::Ref<co
   return {};
 }
 
+Status inverseDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                       const Eigen::Ref<const Eigen::VectorXd>& qd,
+                       const Eigen::Ref<const Eigen::VectorXd>& qdd) noexcept {
+  return inverseDynamics(model, ws, q, qd, qdd, ws.defaultTask());
+}
+
 namespace {
 
 void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) {
@@ -82,7 +89,8 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
 
   // Outward: poses, motion subspaces and inertias (no velocity: H depends on q only).
   internal::outwardKinematics(model, q_all, Eigen::VectorXd(), ws, true);
-  ws.kinematics = {KinematicsStage::Poses, &model};  // the velocities are left at rest, not the state's
+  ws.kinematics.stage = KinematicsStage::Poses;  // the velocities are left at rest, not the state's
+  ws.kinematics.model = &model;
 
   // Inward: composite inertias, and row i of H from F_i = I^c_i S_i.
   for (int i = 1; i <= N; ++i) ws.Ic[at(i)] = ws.I[at(i)].matrix();
@@ -101,7 +109,7 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
 
 }  // namespace
 
-Status jointSpaceInertia(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) noexcept {
+Status jointSpaceInertia(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q_all) noexcept {
   ws.kinematics.stage = KinematicsStage::None;  // until the outward stage computes the poses
   if (ws.dof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),

@@ -106,6 +106,8 @@ ZWANG_FLATTEN void kinematicsOfJoints(const Model& model, const Eigen::Ref<const
 void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, bool with_inertia) {
   const bool with_velocity = qd.size() == model.nv();
+  ws.kinematics.q = q;  // the state the results are of (the queries compare it); sizes kept, no allocation
+  if (with_velocity) ws.kinematics.qd = qd;
   if (with_inertia)
     with_velocity ? kinematicsOfJoints<true, true>(model, q, qd, ws)
                   : kinematicsOfJoints<true, false>(model, q, qd, ws);
@@ -148,10 +150,33 @@ const char* const kStageNames[] = {"nothing", "poses", "velocities", "accelerati
 const char* const kStageCalls[] = {"", "forwardKinematics or a solve", "forwardKinematics with qd, or a solve",
                                    "solveHybridDynamics, solveWithFriction or inverseDynamics"};
 
-// Both, and that the workspace holds the `needed` results for this model
-// (Workspace::kinematics), for the queries that read a workspace after the
-// call that computed them.
-Status checkQuery(const Model& model, const Workspace& ws, int frame, KinematicsStage needed,
+// The first entry where a given state differs from the one the workspace's
+// kinematics were computed at, −1 when none does (entry by entry, exactly).
+Eigen::Index firstDifference(const Eigen::VectorXd& held, const Eigen::Ref<const Eigen::VectorXd>& given) {
+  for (Eigen::Index k = 0; k < held.size(); ++k)
+    if (!(held[k] == given[k])) return k;
+  return -1;
+}
+
+// NotComputed when the workspace's kinematics are of another `name` (q or qd) than `given`.
+Status checkHeldState(const char* query, const char* name, const Eigen::VectorXd& held,
+                      const Eigen::Ref<const Eigen::VectorXd>& given, const char* call) noexcept {
+  if (given.size() != held.size())
+    return Status::error(StatusCode::SizeMismatch, "%s: %s has %ld entries, expected %ld", query, name,
+                         static_cast<long>(given.size()), static_cast<long>(held.size()));
+  const Eigen::Index k = firstDifference(held, given);
+  if (k < 0) return {};
+  return Status::error(StatusCode::NotComputed,
+                       "%s: the workspace holds kinematics at another %s (%s[%ld] = %.15g held, %.15g given); call %s "
+                       "first",
+                       query, name, name, static_cast<long>(k), held[k], given[k], call);
+}
+
+// Both, and that the workspace holds the `needed` results for this model and
+// this state (Workspace::kinematics), for the queries that read a workspace
+// after the call that computed them. qd is zero-length for a pose query.
+Status checkQuery(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                  const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, KinematicsStage needed,
                   const char* query) noexcept {
   if (Status s = checkFrame(model, frame); !s) return s;
   if (Status s = checkWorkspace(model, ws); !s) return s;
@@ -171,7 +196,20 @@ Status checkQuery(const Model& model, const Workspace& ws, int frame, Kinematics
                          "%s: the workspace holds %s only (the last call computed no %s); call %s first", query,
                          ws.kinematics.stage == KinematicsStage::Poses ? "poses" : "poses and velocities",
                          kStageNames[need], kStageCalls[need]);
+  const bool with_velocity = needed >= KinematicsStage::Velocities;
+  const char* redo = needed == KinematicsStage::Accelerations ? kStageCalls[need]
+                     : with_velocity                          ? "forwardKinematics(model, ws, q, qd)"
+                                                              : "forwardKinematics(model, ws, q)";
+  if (Status s = checkHeldState(query, "q", ws.kinematics.q, q, redo); !s) return s;
+  if (with_velocity)
+    if (Status s = checkHeldState(query, "qd", ws.kinematics.qd, qd, redo); !s) return s;
   return {};
+}
+
+// True when the workspace holds poses of this model at exactly this q.
+bool posesHeldAt(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q) {
+  return ws.kinematics.stage >= KinematicsStage::Poses && ws.kinematics.model == &model &&
+         q.size() == ws.kinematics.q.size() && firstDifference(ws.kinematics.q, q) < 0;
 }
 
 // A classical [linear of the frame origin; angular] 6-vector in world axes,
@@ -217,8 +255,9 @@ Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<con
   return {};
 }
 
-Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isometry3d& pose) noexcept {
-  if (Status s = checkQuery(model, ws, frame, KinematicsStage::Poses, "framePose"); !s) return s;
+Status framePose(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q, int frame,
+                 Eigen::Isometry3d& pose) noexcept {
+  if (Status s = checkQuery(model, ws, q, Eigen::VectorXd(), frame, KinematicsStage::Poses, "framePose"); !s) return s;
   const Transform X = internal::framePlacementInBase(model, ws, frame);  // ᶠX_0
   pose.setIdentity();
   pose.linear() = X.E.transpose();
@@ -226,17 +265,20 @@ Status framePose(const Model& model, const Workspace& ws, int frame, Eigen::Isom
   return {};
 }
 
-Status frameVelocity(const Model& model, const Workspace& ws, int frame, Expressed expressed, Vec6& velocity) noexcept {
-  if (Status s = checkQuery(model, ws, frame, KinematicsStage::Velocities, "frameVelocity"); !s) return s;
+Status frameVelocity(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                     const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, Expressed expressed,
+                     Vec6& velocity) noexcept {
+  if (Status s = checkQuery(model, ws, q, qd, frame, KinematicsStage::Velocities, "frameVelocity"); !s) return s;
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   // Ẋ of the frame's body (a floating base's motion included), seen at the frame origin.
   velocity = express(X, expressed, velocityAtPoint(ws.v[static_cast<std::size_t>(model.frame(frame).body)], X.r));
   return {};
 }
 
-Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Expressed expressed,
+Status frameAcceleration(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                         const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept {
-  if (Status s = checkQuery(model, ws, frame, KinematicsStage::Accelerations, "frameAcceleration"); !s) return s;
+  if (Status s = checkQuery(model, ws, q, qd, frame, KinematicsStage::Accelerations, "frameAcceleration"); !s) return s;
   // ws.a holds the sweep's accelerations, true + [−g; 0] (= ws.a_world).
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   const auto b = static_cast<std::size_t>(model.frame(frame).body);
@@ -246,7 +288,6 @@ Status frameAcceleration(const Model& model, const Workspace& ws, int frame, Exp
 
 Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q, int frame,
                      Expressed expressed, Eigen::Ref<Eigen::MatrixXd> J) noexcept {
-  ws.kinematics.stage = KinematicsStage::None;  // until forwardKinematics below computes the poses
   if (J.rows() != 6 || J.cols() != model.nv()) {
     if (model.baseVelocitySize() == 0)
       return Status::error(StatusCode::SizeMismatch, "Jacobian output is %ldx%ld, expected 6x%d",
@@ -257,7 +298,9 @@ Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const E
                          model.dof(), internal::jointDofsWord(model));
   }
   if (Status s = checkFrame(model, frame); !s) return s;
-  if (Status s = forwardKinematics(model, ws, q); !s) return s;
+  if (Status s = checkWorkspace(model, ws); !s) return s;
+  if (!posesHeldAt(model, ws, q))  // the poses a solve or forwardKinematics left at this q serve as they are
+    if (Status s = forwardKinematics(model, ws, q); !s) return s;
   jacobianColumns(model, ws, frame, expressed, J);
   return {};
 }

@@ -238,7 +238,8 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
 void outwardSweep(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd, Workspace& ws) {
   const bool moving = qd.size() == model.nv();
   outwardKinematics(model, q, qd, ws, true);  // lines 3–7, line 7 without F_ext
-  ws.kinematics = {moving ? KinematicsStage::Velocities : KinematicsStage::Poses, &model};
+  ws.kinematics.stage = moving ? KinematicsStage::Velocities : KinematicsStage::Poses;
+  ws.kinematics.model = &model;
   applyExternalWrenches(model, task, ws);  // line 7: − F_ext
   // Lines 8–9 (I^A_i = I_i, F^A_i = F_bias,i) are folded into the inward
   // sweep, which sets each body's articulated quantities as it reaches them.

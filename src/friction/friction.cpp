@@ -410,9 +410,9 @@ Status limitInfeasible(const Model& model, const QpReport& report, const std::ve
 
 }  // namespace
 
-Status solveWithFriction(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                         Workspace& ws, const FrictionOptions& options) noexcept {
+                         const Task& task, const FrictionOptions& options) noexcept {
   ws.kinematics.stage = KinematicsStage::None;  // until the sweeps compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   if (Status s = checkOptions(model, options); !s) return s;

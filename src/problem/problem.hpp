@@ -102,11 +102,11 @@ void checkBalance(const BalanceOptions& options);
 void checkFriction(const FrictionOptions& options);
 
 // The solve a problem asks for: with friction when it has friction options, else plain.
-inline Status solve(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
+inline Status solve(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                     const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                    Workspace& ws, const FrictionOptions* friction) {
-  return friction ? solveWithFriction(model, task, q, qd, tau, ws, *friction)
-                  : solveHybridDynamics(model, task, q, qd, tau, ws);
+                    const Task& task, const FrictionOptions* friction) {
+  return friction ? solveWithFriction(model, ws, q, qd, tau, task, *friction)
+                  : solveHybridDynamics(model, ws, q, qd, tau, task);
 }
 
 // Each one-DOF joint whose q lies outside its limits (NaN is the solve's to

@@ -230,7 +230,10 @@ Vec6 frameAccelerationOf(const Result& r, int frame, Expressed e) {
   if (r.data) return (e == Expressed::Local ? r.data->frame_acc_local : r.data->frame_acc_world).row(frame).transpose();
   r.solution();  // stale check
   Vec6 a;
-  if (const Status s = frameAcceleration(*r.model, *r.live->ws, frame, e, a); !s) raiseStatus(s, "frame_acceleration");
+  if (const Status s =
+          frameAcceleration(*r.model, *r.live->ws, r.live->ws->kinematics.q, r.live->ws->kinematics.qd, frame, e, a);
+      !s)
+    raiseStatus(s, "frame_acceleration");
   return a;
 }
 
@@ -732,7 +735,7 @@ Result solvePython(std::shared_ptr<Model> model, py::object ws_obj, py::handle q
                    py::handle balance) {
   SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance);
   ++a.pw.generation;
-  const Status status = problem::solve(*model, a.task, a.q, a.qd, a.tau, *a.pw.ws, a.friction);
+  const Status status = problem::solve(*model, *a.pw.ws, a.q, a.qd, a.tau, a.task, a.friction);
   const bool infeasible = status.code == StatusCode::Infeasible;
   if (!status && !infeasible) raiseStatus(status, "solve");
   Result r;
@@ -759,7 +762,7 @@ double timeCppSolve(std::shared_ptr<Model> model, py::object ws_obj, py::handle 
   ++a.pw.generation;
   Status status;
   const auto start = std::chrono::steady_clock::now();
-  for (int k = 0; k < repeat; ++k) status = problem::solve(*model, a.task, a.q, a.qd, a.tau, *a.pw.ws, a.friction);
+  for (int k = 0; k < repeat; ++k) status = problem::solve(*model, *a.pw.ws, a.q, a.qd, a.tau, a.task, a.friction);
   const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
   if (!status) raiseStatus(status, "_time_cpp_solve");
   return elapsed.count() / std::max(repeat, 1);
@@ -790,6 +793,19 @@ void bindSolveFunctions(py::module_& m) {
         "the Python-call overhead in docs/python.md. Not part of the API.");
 }
 
+using VectorView = Eigen::Ref<const Eigen::VectorXd>;
+
+// A kinematics query at (q, qd): read when ws holds that state (after a solve
+// or forward_kinematics there), else forward kinematics first (qd empty: poses only).
+template <class Query>
+Status queryOrCompute(const Model& model, PyWorkspace& pw, const VectorView& q, const VectorView& qd, Query query) {
+  Status s = query(q, qd);
+  if (s.code != StatusCode::NotComputed) return s;
+  ++pw.generation;
+  s = qd.size() == 0 ? forwardKinematics(model, *pw.ws, q) : forwardKinematics(model, *pw.ws, q, qd);
+  return s ? query(q, qd) : s;
+}
+
 // forward_kinematics, frame_pose, frame_velocity, frame_jacobian.
 void bindKinematics(py::module_& m) {
   m.def(
@@ -809,29 +825,30 @@ void bindKinematics(py::module_& m) {
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const int f = frameArg(*model, frame);
-    if (!q.is_none()) {
-      const auto qv = vectorArg("q", q, pw.q_buf);
-      ++pw.generation;
-      if (const Status s = forwardKinematics(*model, *pw.ws, qv); !s) raiseStatus(s, "frame_pose");
-    }
     Eigen::Isometry3d pose;
-    if (const Status s = framePose(*model, *pw.ws, f, pose); !s) raiseStatus(s, "frame_pose");
+    const Status s =
+        q.is_none() ? framePose(*model, *pw.ws, pw.ws->kinematics.q, f, pose)
+                    : queryOrCompute(*model, pw, vectorArg("q", q, pw.q_buf), Eigen::VectorXd(),
+                                     [&](const VectorView& qv, const VectorView&) {
+                                       return framePose(*model, *pw.ws, qv, f, pose);
+                                     });
+    if (!s) raiseStatus(s, "frame_pose");
     return matrixCopy(pose.matrix());
       },
-      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"), "4×4 pose of the frame in the world at q");
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("frame"),
+      "4×4 pose of the frame in the world at q (q=None: at the state ws holds)");
   m.def(
       "frame_velocity",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle frame,
          const std::string& expressed) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const int f = frameArg(*model, frame);
-    const auto qv = vectorArg("q", q, pw.q_buf);
-    const auto qdv = vectorArg("qd", qd, pw.qd_buf);
     const Expressed e = expressedArg("expressed", expressed, true);
-    ++pw.generation;
     Vec6 v;
-    Status s = forwardKinematics(*model, *pw.ws, qv, qdv);
-    if (s) s = frameVelocity(*model, *pw.ws, f, e, v);
+    const Status s = queryOrCompute(*model, pw, vectorArg("q", q, pw.q_buf), vectorArg("qd", qd, pw.qd_buf),
+                                    [&](const VectorView& qv, const VectorView& qdv) {
+                                      return frameVelocity(*model, *pw.ws, qv, qdv, f, e, v);
+                                    });
     if (!s) raiseStatus(s, "frame_velocity");
     return vectorCopy(v);
       },
@@ -866,7 +883,7 @@ void bindDynamics(py::module_& m) {
     const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
     const auto qddv = optionalVector("qdd", qdd, pw.qdd_buf, pw.zeros);
     ++pw.generation;
-    if (const Status s = inverseDynamics(*model, task, qv, qdv, qddv, *pw.ws); !s) raiseStatus(s, "inverse_dynamics");
+    if (const Status s = inverseDynamics(*model, *pw.ws, qv, qdv, qddv, task); !s) raiseStatus(s, "inverse_dynamics");
     return vectorCopy(pw.ws->tau);
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("qdd") = py::none(),
@@ -878,7 +895,7 @@ void bindDynamics(py::module_& m) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const auto qv = vectorArg("q", q, pw.q_buf);
     ++pw.generation;
-    if (const Status s = jointSpaceInertia(*model, qv, *pw.ws); !s) raiseStatus(s, "joint_space_inertia");
+    if (const Status s = jointSpaceInertia(*model, *pw.ws, qv); !s) raiseStatus(s, "joint_space_inertia");
     return matrixCopy(pw.ws->H);
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), "CRBA: H(q), rotor inertias included, a new array");

@@ -46,14 +46,14 @@ TEST_CASE("hybrid dynamics with constraints on two frames and a wrench allocates
   Workspace ws(model, task);
   const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), qd = Eigen::VectorXd::Constant(7, 0.3),
                         tau = Eigen::VectorXd::Constant(7, 1.0);
-  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));  // warm
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));  // warm
   // No Catch2 assertion inside a counted region: the framework may allocate.
   bool all_ok = true;
   long count = allocationsDuring([&] {
     for (int k = 0; k < 10; ++k) {
       task.targets()[0] = 0.1 * k;
       task.wrench(w)[0] = k;
-      all_ok = solveHybridDynamics(model, task, q, qd, tau, ws).ok() && all_ok;
+      all_ok = solveHybridDynamics(model, ws, q, qd, tau, task).ok() && all_ok;
     }
   });
   CHECK(all_ok);
@@ -62,7 +62,7 @@ TEST_CASE("hybrid dynamics with constraints on two frames and a wrench allocates
   // An error status is reported without allocating, too.
   const Eigen::VectorXd short_q = Eigen::VectorXd::Zero(3);
   Status status;
-  count = allocationsDuring([&] { status = solveHybridDynamics(model, task, short_q, qd, tau, ws); });
+  count = allocationsDuring([&] { status = solveHybridDynamics(model, ws, short_q, qd, tau, task); });
   CHECK_FALSE(status.ok());
   CHECK(count == 0);
 }
@@ -74,10 +74,10 @@ TEST_CASE("a singular task (damped balance) allocates nothing") {
   task.addConstraint("panda_link7", ConstraintMatrix::Identity(6, 6), Expressed::Local);
   Workspace ws(model, task);
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7), qd = Eigen::VectorXd::Zero(7), tau = Eigen::VectorXd::Zero(7);
-  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));
   CHECK(ws.solution.balance.singular);
   bool ok = false;
-  CHECK(allocationsDuring([&] { ok = solveHybridDynamics(model, task, q, qd, tau, ws).ok(); }) == 0);
+  CHECK(allocationsDuring([&] { ok = solveHybridDynamics(model, ws, q, qd, tau, task).ok(); }) == 0);
   CHECK(ok);
 }
 
@@ -93,12 +93,12 @@ TEST_CASE("RNEA, CRBA, kinematics and Jacobians allocate nothing") {
   bool ok = false;
   double sink = 0.0;
   const long count = allocationsDuring([&] {
-    ok = inverseDynamics(model, task, q, qd, qd, ws).ok();
-    ok = jointSpaceInertia(model, q, ws).ok() && ok;
+    ok = inverseDynamics(model, ws, q, qd, qd, task).ok();
+    ok = jointSpaceInertia(model, ws, q).ok() && ok;
     ok = forwardKinematics(model, ws, q, qd).ok() && ok;
-    ok = framePose(model, ws, tool, pose).ok() && ok;
-    ok = frameVelocity(model, ws, tool, Expressed::Local, v_local).ok() && ok;
-    ok = frameVelocity(model, ws, tool, Expressed::World, v_world).ok() && ok;
+    ok = framePose(model, ws, q, tool, pose).ok() && ok;
+    ok = frameVelocity(model, ws, q, qd, tool, Expressed::Local, v_local).ok() && ok;
+    ok = frameVelocity(model, ws, q, qd, tool, Expressed::World, v_world).ok() && ok;
     sink = pose.translation().x() + v_local[0] + v_world[1];
     ok = frameJacobian(model, ws, q, tool, Expressed::World, J).ok() && ok;
   });
@@ -120,12 +120,12 @@ TEST_CASE("the friction solve allocates nothing (all joints stuck, indeterminate
   qd[3] = 0.4;  // one moving joint: kinetic friction
   FrictionOptions active, gradient;
   gradient.method = FrictionMethod::ProjectedGradient;
-  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws, active));  // warm
+  REQUIRE(solveWithFriction(model, ws, q, zero, zero, task, active));  // warm
   bool ok = true;
   const long count = allocationsDuring([&] {
-    ok = solveWithFriction(model, task, q, zero, zero, ws, active).ok() && ok;
-    ok = solveWithFriction(model, task, q, qd, zero, ws, active).ok() && ok;
-    ok = solveWithFriction(model, task, q, zero, zero, ws, gradient).ok() && ok;
+    ok = solveWithFriction(model, ws, q, zero, zero, task, active).ok() && ok;
+    ok = solveWithFriction(model, ws, q, qd, zero, task, active).ok() && ok;
+    ok = solveWithFriction(model, ws, q, zero, zero, task, gradient).ok() && ok;
   });
   CHECK(ok);
   CHECK(count == 0);
@@ -145,10 +145,10 @@ TEST_CASE("the friction solve allocates nothing when the maximisers form a hyper
   task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);
   Workspace ws(model, task);
   const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), zero = Eigen::VectorXd::Zero(7);
-  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws));  // warm
+  REQUIRE(solveWithFriction(model, ws, q, zero, zero, task));  // warm
   REQUIRE(ws.friction.indeterminate);                          // the choice among maximisers ran
   bool ok = false;
-  CHECK(allocationsDuring([&] { ok = solveWithFriction(model, task, q, zero, zero, ws).ok(); }) == 0);
+  CHECK(allocationsDuring([&] { ok = solveWithFriction(model, ws, q, zero, zero, task).ok(); }) == 0);
   CHECK(ok);
 }
 
@@ -160,11 +160,11 @@ TEST_CASE("the solver entry points are declared noexcept") {
   // (Through Ref arguments: converting a VectorXd to a Ref is not itself noexcept.)
   const Eigen::Ref<const Eigen::VectorXd> r(x);
   const FrictionOptions options;
-  static_assert(noexcept(solveHybridDynamics(model, task, r, r, r, ws)));
-  static_assert(noexcept(solveWithFriction(model, task, r, r, r, ws, options)));
-  static_assert(noexcept(inverseDynamics(model, task, r, r, r, ws)));
-  static_assert(noexcept(jointSpaceInertia(model, r, ws)));
-  CHECK(solveHybridDynamics(model, task, r, r, r, ws).ok());  // (and they run)
+  static_assert(noexcept(solveHybridDynamics(model, ws, r, r, r, task)));
+  static_assert(noexcept(solveWithFriction(model, ws, r, r, r, task, options)));
+  static_assert(noexcept(inverseDynamics(model, ws, r, r, r, task)));
+  static_assert(noexcept(jointSpaceInertia(model, ws, r)));
+  CHECK(solveHybridDynamics(model, ws, r, r, r, task).ok());  // (and they run)
 }
 
 TEST_CASE("the kinematics entry points are declared noexcept") {
@@ -176,16 +176,16 @@ TEST_CASE("the kinematics entry points are declared noexcept") {
   Vec6 out;
   // (qd given: the default argument builds a Ref, which is not noexcept itself.)
   static_assert(noexcept(forwardKinematics(model, ws, r, r)));
-  static_assert(noexcept(framePose(model, ws, 0, pose)));
-  static_assert(noexcept(frameVelocity(model, ws, 0, Expressed::Local, out)));
-  static_assert(noexcept(frameAcceleration(model, ws, 0, Expressed::World, out)));
+  static_assert(noexcept(framePose(model, ws, r, 0, pose)));
+  static_assert(noexcept(frameVelocity(model, ws, r, r, 0, Expressed::Local, out)));
+  static_assert(noexcept(frameAcceleration(model, ws, r, r, 0, Expressed::World, out)));
   // frameJacobian takes its output Ref by value, and copying a Ref is not
   // noexcept: assert the declaration itself (noexcept is part of the type).
   static_assert(
       std::is_same_v<decltype(frameJacobian), Status(const Model&, Workspace&, const Eigen::Ref<const Eigen::VectorXd>&,
                                                      int, Expressed, Eigen::Ref<Eigen::MatrixXd>) noexcept>);
   CHECK(forwardKinematics(model, ws, r, r).ok());  // (and they run)
-  CHECK(framePose(model, ws, 0, pose).ok());
+  CHECK(framePose(model, ws, r, 0, pose).ok());
   CHECK(pose.isApprox(Eigen::Isometry3d::Identity()));  // frame 0 is the base
 }
 
@@ -199,17 +199,17 @@ TEST_CASE("friction at a joint limit, with overrides, a margin and an infeasible
   FrictionOptions options;
   options.breakaway = Eigen::VectorXd::Constant(7, 0.5);
   options.margin = 0.5;
-  REQUIRE(solveWithFriction(model, task, q, zero, zero, ws, options));  // warm
+  REQUIRE(solveWithFriction(model, ws, q, zero, zero, task, options));  // warm
   bool ok = false;
-  CHECK(allocationsDuring([&] { ok = solveWithFriction(model, task, q, zero, zero, ws, options).ok(); }) == 0);
+  CHECK(allocationsDuring([&] { ok = solveWithFriction(model, ws, q, zero, zero, task, options).ok(); }) == 0);
   CHECK(ok);
 
   // The report's arm on its upper limit, asked to accelerate into it: Infeasible.
   zwang::testing::IntoUpperLimit into;
   Status status;
-  solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws);  // warm
+  solveWithFriction(into.arm, into.ws, into.q, into.zero, into.zero, into.task);  // warm
   CHECK(allocationsDuring(
-            [&] { status = solveWithFriction(into.arm, into.task, into.q, into.zero, into.zero, into.ws); }) == 0);
+            [&] { status = solveWithFriction(into.arm, into.ws, into.q, into.zero, into.zero, into.task); }) == 0);
   CHECK(status.code == StatusCode::Infeasible);
 }
 
@@ -218,17 +218,17 @@ TEST_CASE("frame accelerations and kinematics without velocities allocate nothin
   Task task(model);
   Workspace ws(model, task);
   const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), qd = Eigen::VectorXd::Constant(7, 0.3);
-  REQUIRE(solveHybridDynamics(model, task, q, qd, qd, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, qd, task));
   const int tool = model.frameIndex("tool0");
   Vec6 a_world, a_local;
   Eigen::Isometry3d pose;
   bool ok = false;
   double sink = 0.0;
   const long count = allocationsDuring([&] {
-    ok = frameAcceleration(model, ws, tool, Expressed::World, a_world).ok();
-    ok = frameAcceleration(model, ws, tool, Expressed::Local, a_local).ok() && ok;
+    ok = frameAcceleration(model, ws, q, qd, tool, Expressed::World, a_world).ok();
+    ok = frameAcceleration(model, ws, q, qd, tool, Expressed::Local, a_local).ok() && ok;
     ok = forwardKinematics(model, ws, q).ok() && ok;
-    ok = framePose(model, ws, tool, pose).ok() && ok;
+    ok = framePose(model, ws, q, tool, pose).ok() && ok;
     sink = a_world[2] + a_local[0] + pose.translation().z();
   });
   CHECK(ok);
@@ -260,37 +260,38 @@ TEST_CASE("every error return of every entry point allocates nothing and throws 
   StatusCode codes[32];
   int n = 0;
   const long count = allocationsDuring([&] {
-    codes[n++] = solveHybridDynamics(model, task, short3, ok7, ok7, ws).code;       // SizeMismatch
-    codes[n++] = solveHybridDynamics(model, task, ok7, nan7, ok7, ws).code;         // NonFinite
-    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, small).code;       // WorkspaceTooSmall
-    codes[n++] = solveHybridDynamics(model, task, ok7, ok7, ok7, foreign).code;     // ModelMismatch (workspace)
-    codes[n++] = solveHybridDynamics(model, foreign_task, ok7, ok7, ok7, ws).code;  // ModelMismatch (task)
-    codes[n++] = solveWithFriction(model, task, ok7, ok7, nan7, ws).code;           // NonFinite
+    codes[n++] = solveHybridDynamics(model, ws, short3, ok7, ok7, task).code;       // SizeMismatch
+    codes[n++] = solveHybridDynamics(model, ws, ok7, nan7, ok7, task).code;         // NonFinite
+    codes[n++] = solveHybridDynamics(model, small, ok7, ok7, ok7, task).code;       // WorkspaceTooSmall
+    codes[n++] = solveHybridDynamics(model, foreign, ok7, ok7, ok7, task).code;     // ModelMismatch (workspace)
+    codes[n++] = solveHybridDynamics(model, ws, ok7, ok7, ok7, foreign_task).code;  // ModelMismatch (task)
+    codes[n++] = solveWithFriction(model, ws, ok7, ok7, nan7, task).code;           // NonFinite
     for (std::size_t k = 0; k < bad_options.size(); ++k)                            // BadOption, each
-      option_codes[k] = solveWithFriction(model, task, ok7, ok7, ok7, ws, bad_options[k].options).code;
-    codes[n++] = inverseDynamics(model, task, ok7, short3, ok7, ws).code;           // SizeMismatch
-    codes[n++] = inverseDynamics(model, task, ok7, ok7, ok7, foreign).code;         // ModelMismatch
-    codes[n++] = jointSpaceInertia(model, nan7, ws).code;                           // NonFinite
-    codes[n++] = jointSpaceInertia(model, ok7, foreign).code;                       // ModelMismatch
-    codes[n++] = forwardKinematics(model, ws, short3).code;                         // SizeMismatch
-    codes[n++] = forwardKinematics(model, ws, ok7, nan7).code;                      // NonFinite
-    codes[n++] = forwardKinematics(model, foreign, ok7).code;                       // ModelMismatch
-    codes[n++] = frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong).code;  // SizeMismatch
-    codes[n++] = frameJacobian(model, ws, nan7, 1, Expressed::World, J).code;       // NonFinite
-    codes[n++] = frameJacobian(model, ws, ok7, frames, Expressed::World, J).code;   // ModelMismatch (frame)
-    codes[n++] = framePose(model, ws, -1, pose).code;                               // ModelMismatch (frame)
-    codes[n++] = framePose(model, ws, frames, pose).code;                           // ModelMismatch (frame)
-    codes[n++] = framePose(model, foreign, 1, pose).code;                           // ModelMismatch (workspace)
-    codes[n++] = frameVelocity(model, ws, -1, Expressed::Local, out).code;          // ModelMismatch (frame)
-    codes[n++] = frameVelocity(model, ws, frames, Expressed::World, out).code;      // ModelMismatch (frame)
-    codes[n++] = frameVelocity(model, foreign, 1, Expressed::Local, out).code;      // ModelMismatch (workspace)
-    codes[n++] = frameAcceleration(model, ws, -1, Expressed::World, out).code;      // ModelMismatch (frame)
-    codes[n++] = frameAcceleration(model, ws, frames, Expressed::Local, out).code;  // ModelMismatch (frame)
-    codes[n++] = frameAcceleration(model, foreign, 1, Expressed::World, out).code;  // ModelMismatch (workspace)
-    codes[n++] = solveHybridDynamics(model, resized, ok7, ok7, ok7, ws).code;       // SizeMismatch (targets)
-    codes[n++] = framePose(model, fresh, 1, pose).code;                             // NotComputed
-    codes[n++] = frameVelocity(model, fresh, 1, Expressed::Local, out).code;        // NotComputed
-    codes[n++] = frameAcceleration(model, fresh, 1, Expressed::World, out).code;    // NotComputed
+      option_codes[k] = solveWithFriction(model, ws, ok7, ok7, ok7, task, bad_options[k].options).code;
+    codes[n++] = inverseDynamics(model, ws, ok7, short3, ok7, task).code;                 // SizeMismatch
+    codes[n++] = inverseDynamics(model, foreign, ok7, ok7, ok7, task).code;               // ModelMismatch
+    codes[n++] = jointSpaceInertia(model, ws, nan7).code;                                 // NonFinite
+    codes[n++] = jointSpaceInertia(model, foreign, ok7).code;                             // ModelMismatch
+    codes[n++] = forwardKinematics(model, ws, short3).code;                               // SizeMismatch
+    codes[n++] = forwardKinematics(model, ws, ok7, nan7).code;                            // NonFinite
+    codes[n++] = forwardKinematics(model, foreign, ok7).code;                             // ModelMismatch
+    codes[n++] = frameJacobian(model, ws, ok7, 1, Expressed::World, J_wrong).code;        // SizeMismatch
+    codes[n++] = frameJacobian(model, ws, nan7, 1, Expressed::World, J).code;             // NonFinite
+    codes[n++] = frameJacobian(model, ws, ok7, frames, Expressed::World, J).code;         // ModelMismatch (frame)
+    codes[n++] = framePose(model, ws, ok7, -1, pose).code;                                // ModelMismatch (frame)
+    codes[n++] = framePose(model, ws, ok7, frames, pose).code;                            // ModelMismatch (frame)
+    codes[n++] = framePose(model, foreign, ok7, 1, pose).code;                            // ModelMismatch (workspace)
+    codes[n++] = frameVelocity(model, ws, ok7, ok7, -1, Expressed::Local, out).code;      // ModelMismatch (frame)
+    codes[n++] = frameVelocity(model, ws, ok7, ok7, frames, Expressed::World, out).code;  // ModelMismatch (frame)
+    codes[n++] = frameVelocity(model, foreign, ok7, ok7, 1, Expressed::Local, out).code;  // ModelMismatch (workspace)
+    codes[n++] = frameAcceleration(model, ws, ok7, ok7, -1, Expressed::World, out).code;  // ModelMismatch (frame)
+    codes[n++] = frameAcceleration(model, ws, ok7, ok7, frames, Expressed::Local, out).code;  // ModelMismatch (frame)
+    codes[n++] =
+        frameAcceleration(model, foreign, ok7, ok7, 1, Expressed::World, out).code;         // ModelMismatch (workspace)
+    codes[n++] = solveHybridDynamics(model, ws, ok7, ok7, ok7, resized).code;               // SizeMismatch (targets)
+    codes[n++] = framePose(model, fresh, ok7, 1, pose).code;                                // NotComputed
+    codes[n++] = frameVelocity(model, fresh, ok7, ok7, 1, Expressed::Local, out).code;      // NotComputed
+    codes[n++] = frameAcceleration(model, fresh, ok7, ok7, 1, Expressed::World, out).code;  // NotComputed
   });
   CHECK(count == 0);
   const StatusCode expected[] = {
@@ -325,7 +326,7 @@ TEST_CASE("a frame index out of range: every kinematics accessor returns a Statu
   Workspace ws(model, task);
   Eigen::MatrixXd J(6, 7);
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);
-  REQUIRE(solveHybridDynamics(model, task, q, q, q, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, q, q, task));
   const int frames = static_cast<int>(model.frames().size());
   REQUIRE(frames == 10);
   // Outputs hold a marker: an error leaves them unchanged.
@@ -338,9 +339,9 @@ TEST_CASE("a frame index out of range: every kinematics accessor returns a Statu
     int k = 0;
     for (const int bad : {-1, frames}) {
       results[k++] = frameJacobian(model, ws, q, bad, Expressed::World, J);
-      results[k++] = framePose(model, ws, bad, pose);
-      results[k++] = frameVelocity(model, ws, bad, Expressed::Local, v);
-      results[k++] = frameAcceleration(model, ws, bad, Expressed::World, a);
+      results[k++] = framePose(model, ws, q, bad, pose);
+      results[k++] = frameVelocity(model, ws, q, q, bad, Expressed::Local, v);
+      results[k++] = frameAcceleration(model, ws, q, q, bad, Expressed::World, a);
     }
   });
   CHECK(count == 0);
@@ -373,15 +374,15 @@ TEST_CASE("a tree with constraints on two branches and a relative constraint all
   Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(12, -0.5, 0.7), qd = Eigen::VectorXd::Constant(12, 0.3),
                   tau = Eigen::VectorXd::Constant(12, 1.0);
   for (int j = 0; j < 12; j += 3) qd[j] = 0.0;                // some joints stuck
-  REQUIRE(solveHybridDynamics(model, task, q, qd, tau, ws));  // warm
-  REQUIRE(solveWithFriction(model, task, q, qd, tau, ws));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));  // warm
+  REQUIRE(solveWithFriction(model, ws, q, qd, tau, task));
   bool all_ok = true;
   const long count = allocationsDuring([&] {
     for (int k = 0; k < 10; ++k) {
       task.targets()[0] = 0.1 * k;
-      all_ok = solveHybridDynamics(model, task, q, qd, tau, ws).ok() && all_ok;
-      all_ok = solveWithFriction(model, task, q, qd, tau, ws).ok() && all_ok;
-      all_ok = inverseDynamics(model, task, q, qd, tau, ws).ok() && all_ok;
+      all_ok = solveHybridDynamics(model, ws, q, qd, tau, task).ok() && all_ok;
+      all_ok = solveWithFriction(model, ws, q, qd, tau, task).ok() && all_ok;
+      all_ok = inverseDynamics(model, ws, q, qd, tau, task).ok() && all_ok;
     }
   });
   CHECK(all_ok);
@@ -496,12 +497,12 @@ FloatingCounts countFloatingSolves(FloatingCase& c) {
   const int frame = c.model.bodyFrame(c.model.bodyCount() - 1);
   Status statuses[6];
   const auto cycle = [&] {
-    statuses[0] = solveHybridDynamics(c.model, c.task, c.q, c.v, c.tau, ws);
-    statuses[1] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, gradient);
-    statuses[2] = inverseDynamics(c.model, c.task, c.q, c.v, c.tau, ws);
-    statuses[3] = jointSpaceInertia(c.model, c.q, ws);
+    statuses[0] = solveHybridDynamics(c.model, ws, c.q, c.v, c.tau, c.task);
+    statuses[1] = solveWithFriction(c.model, ws, c.q, c.v, c.tau, c.task, gradient);
+    statuses[2] = inverseDynamics(c.model, ws, c.q, c.v, c.tau, c.task);
+    statuses[3] = jointSpaceInertia(c.model, ws, c.q);
     statuses[4] = frameJacobian(c.model, ws, c.q, frame, Expressed::World, J);
-    statuses[5] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options);  // last: its result is read
+    statuses[5] = solveWithFriction(c.model, ws, c.q, c.v, c.tau, c.task, c.options);  // last: its result is read
   };
   cycle();  // warm
   FloatingCounts out;
@@ -545,9 +546,9 @@ TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the 
   c.q[iq + knee] = c.model.joint(knee).lower;  // stuck on its lower limit
   c.v[iv + knee] = 0.0;
   Workspace ws(c.model, c.task);
-  REQUIRE(solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options));  // warm
+  REQUIRE(solveWithFriction(c.model, ws, c.q, c.v, c.tau, c.task, c.options));  // warm
   bool ok = false;
-  CHECK(allocationsDuring([&] { ok = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options).ok(); }) == 0);
+  CHECK(allocationsDuring([&] { ok = solveWithFriction(c.model, ws, c.q, c.v, c.tau, c.task, c.options).ok(); }) == 0);
   CHECK(ok);
 
   // The knee held on its limit and asked to accelerate into it: Infeasible.
@@ -555,8 +556,8 @@ TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the 
   into.addJointConstraint(knee);
   into.targets()[0] = -1.0;
   Workspace ws_into(c.model, into);
-  Status status = solveWithFriction(c.model, into, c.q, c.v, c.tau, ws_into, c.options);  // warm
-  CHECK(allocationsDuring([&] { status = solveWithFriction(c.model, into, c.q, c.v, c.tau, ws_into, c.options); }) ==
+  Status status = solveWithFriction(c.model, ws_into, c.q, c.v, c.tau, into, c.options);  // warm
+  CHECK(allocationsDuring([&] { status = solveWithFriction(c.model, ws_into, c.q, c.v, c.tau, into, c.options); }) ==
         0);
   CHECK(status.code == StatusCode::Infeasible);
 
@@ -569,10 +570,10 @@ TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the 
   Workspace ws_fixed(fixed, c.task.constraintRows());
   StatusCode codes[4];
   const long count = allocationsDuring([&] {
-    codes[0] = solveHybridDynamics(c.model, c.task, off_unit, c.v, c.tau, ws).code;
-    codes[1] = solveWithFriction(c.model, c.task, off_unit, c.v, c.tau, ws, c.options).code;
-    codes[2] = solveHybridDynamics(c.model, c.task, joints_only, c.v, c.tau, ws).code;
-    codes[3] = solveHybridDynamics(c.model, c.task, c.q, c.v, c.tau, ws_fixed).code;
+    codes[0] = solveHybridDynamics(c.model, ws, off_unit, c.v, c.tau, c.task).code;
+    codes[1] = solveWithFriction(c.model, ws, off_unit, c.v, c.tau, c.task, c.options).code;
+    codes[2] = solveHybridDynamics(c.model, ws, joints_only, c.v, c.tau, c.task).code;
+    codes[3] = solveHybridDynamics(c.model, ws_fixed, c.q, c.v, c.tau, c.task).code;
   });
   CHECK(count == 0);
   CHECK(codes[0] == StatusCode::BadConfiguration);
@@ -598,8 +599,8 @@ TEST_CASE("floating bases: the standing humanoid, contacts sharing the load with
   half.margin = 0.5;
   Status statuses[2];
   const auto solves = [&] {
-    statuses[0] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, half);
-    statuses[1] = solveWithFriction(c.model, c.task, c.q, c.v, c.tau, ws, c.options);
+    statuses[0] = solveWithFriction(c.model, ws, c.q, c.v, c.tau, c.task, half);
+    statuses[1] = solveWithFriction(c.model, ws, c.q, c.v, c.tau, c.task, c.options);
   };
   solves();  // warm
   CHECK(allocationsDuring(solves) == 0);
@@ -611,7 +612,7 @@ TEST_CASE("floating bases: the standing humanoid, contacts sharing the load with
   // plain solve's τ_control (the standing scenario measures up to 1.9 N·m).
   const int n = c.model.dof();
   const Eigen::VectorXd felt = ws.solution.tau_control.tail(n) - ws.friction.mu;
-  REQUIRE(solveHybridDynamics(c.model, c.task, c.q, c.v, c.tau, ws));
+  REQUIRE(solveHybridDynamics(c.model, ws, c.q, c.v, c.tau, c.task));
   CHECK((felt - ws.solution.tau_control.tail(n)).cwiseAbs().maxCoeff() > 1e-3);
 }
 

@@ -126,7 +126,7 @@ TEST_CASE("Panda holds its tool still: the tool does not move; the tool and the 
   Eigen::VectorXd q(7);
   q << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
-  REQUIRE(zwang::solveWithFriction(model, task, q, zero, zero, ws).ok());
+  REQUIRE(zwang::solveWithFriction(model, ws, q, zero, zero, task).ok());
   auto same = [](const Json& j, const Eigen::VectorXd& v) {
     REQUIRE(j.size() == static_cast<std::size_t>(v.size()));
     for (Eigen::Index k = 0; k < v.size(); ++k)
@@ -207,9 +207,9 @@ TEST_CASE("Feed-forward torque, velocities, gravity, local wrench, world constra
   options.margin = p["friction"]["margin"].get<double>();
   options.joint_limits = p["friction"]["limits"].get<bool>();
   options.breakaway = Eigen::Map<const Eigen::VectorXd>(numbers(p["breakaway"]).data(), 7);
-  REQUIRE(zwang::solveWithFriction(m2, task2, Eigen::Map<const Eigen::VectorXd>(q.data(), 7),
+  REQUIRE(zwang::solveWithFriction(m2, ws, Eigen::Map<const Eigen::VectorXd>(q.data(), 7),
                                    Eigen::Map<const Eigen::VectorXd>(qd.data(), 7),
-                                   Eigen::Map<const Eigen::VectorXd>(tau.data(), 7), ws, options)
+                                   Eigen::Map<const Eigen::VectorXd>(tau.data(), 7), task2, options)
               .ok());
   for (int j = 0; j < 7; ++j) {
     const auto k = static_cast<std::size_t>(j);
@@ -225,7 +225,9 @@ TEST_CASE("Feed-forward torque, velocities, gravity, local wrench, world constra
   for (const auto& item : s["frames"].items()) frames.push_back(item.key());
   CHECK(frames == std::vector<std::string>{"tool0", "panda_link5"});
   zwang::Vec6 a;
-  REQUIRE(zwang::frameAcceleration(m2, ws, m2.frameIndex("panda_link5"), zwang::Expressed::World, a));
+  REQUIRE(zwang::frameAcceleration(m2, ws, Eigen::Map<const Eigen::VectorXd>(q.data(), 7),
+                                   Eigen::Map<const Eigen::VectorXd>(qd.data(), 7), m2.frameIndex("panda_link5"),
+                                   zwang::Expressed::World, a));
   for (int k = 0; k < 6; ++k)
     CHECK(s["frames"]["panda_link5"]["acceleration_world"][static_cast<std::size_t>(k)].get<double>() ==
           Approx(a[k]).margin(1e-12));
@@ -278,7 +280,7 @@ TEST_CASE("A tree: per-joint arrays in the model's order; the tool and the libra
   task.addConstraint("right_hand", directionsOf(p["constraints"][0]), zwang::Expressed::World);
   task.wrench(task.addWrench("left_hand", zwang::Expressed::World)) << 0, 0, -20, 0, 0, 0;
   zwang::Workspace ws(model, task);
-  REQUIRE(zwang::solveWithFriction(model, task, vectorOf(p["q"]), vectorOf(p["qd"]), Eigen::VectorXd::Zero(5), ws));
+  REQUIRE(zwang::solveWithFriction(model, ws, vectorOf(p["q"]), vectorOf(p["qd"]), Eigen::VectorXd::Zero(5), task));
   sameAs(s["qdd"], ws.solution.qdd);  // the tool prints every double exactly: equal, bit for bit
   sameAs(s["tau_control"], ws.solution.tau_control);
   sameAs(s["nu"], ws.solution.nu);
@@ -299,7 +301,7 @@ TEST_CASE("A relative constraint (\"relative_to\"): the tool and Task::addRelati
   task.addRelativeConstraint("left_hand", "right_hand", directionsOf(p["constraints"][0]));  // Expressed::Reference
   zwang::Workspace ws(model, task);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(5);
-  REQUIRE(zwang::solveHybridDynamics(model, task, vectorOf(p["q"]), zero, zero, ws));
+  REQUIRE(zwang::solveHybridDynamics(model, ws, vectorOf(p["q"]), zero, zero, task));
   sameAs(s["qdd"], ws.solution.qdd);
   sameAs(s["tau_constraint"], ws.solution.tau_constraint);
   sameAs(s["nu"], ws.solution.nu);
@@ -350,7 +352,7 @@ TEST_CASE("Mimic joints from the tool: \"follow_leaders\" fills the followers' q
   task.addRelativeConstraint("left_gripper", "right_gripper", directionsOf(p["constraints"][0]));
   task.wrench(task.addWrench("right_gripper", zwang::Expressed::World)) << 0, 0, -30, 0, 0, 0;
   zwang::Workspace ws(model, task);
-  REQUIRE(zwang::solveHybridDynamics(model, task, q, qd, Eigen::VectorXd::Zero(19), ws));
+  REQUIRE(zwang::solveHybridDynamics(model, ws, q, qd, Eigen::VectorXd::Zero(19), task));
   sameAs(s["qdd"], ws.solution.qdd);  // the tool prints every double exactly: equal, bit for bit
   sameAs(s["tau_control"], ws.solution.tau_control);
   for (const std::size_t follower : {9u, 18u})
@@ -478,7 +480,7 @@ TEST_CASE("A free base (solo12, \"base\" type free): it falls at g; the feet hel
   for (const Json& c : p["constraints"])
     task.addConstraint(c["frame"].get<std::string>(), directionsOf(c), zwang::Expressed::World);
   zwang::Workspace ws(f.model, task);
-  REQUIRE(zwang::solveHybridDynamics(f.model, task, f.q, f.qd, f.tau, ws));
+  REQUIRE(zwang::solveHybridDynamics(f.model, ws, f.q, f.qd, f.tau, task));
   sameAs(s["qdd"], ws.solution.qdd.tail(12));  // bit for bit
   sameAs(s["base"]["acceleration"], ws.solution.qdd.head(6));
   sameAs(s["base"]["acceleration_world"], ws.solution.base_acceleration_world);
@@ -514,7 +516,7 @@ TEST_CASE(
   zwang::Workspace ws(f.model, task);
   zwang::FrictionOptions friction;
   friction.breakaway = vectorOf(p["breakaway"]);
-  REQUIRE(zwang::solveWithFriction(f.model, task, f.q, f.qd, f.tau, ws, friction));
+  REQUIRE(zwang::solveWithFriction(f.model, ws, f.q, f.qd, f.tau, task, friction));
   sameAs(s["qdd"], ws.solution.qdd.tail(12));  // bit for bit
   sameAs(s["base"]["acceleration"], ws.solution.qdd.head(6));
   sameAs(s["tau_control"], ws.solution.tau_control.tail(12));
@@ -537,7 +539,7 @@ TEST_CASE("A planar root joint (planar_cart.urdf, \"base\" type planar): the too
   zwang::Task task(model);
   task.addConstraint("cart", directionsOf(p["constraints"][0]), zwang::Expressed::World);
   zwang::Workspace ws(model, task);
-  REQUIRE(zwang::solveWithFriction(model, task, f.q, f.qd, f.tau, ws));
+  REQUIRE(zwang::solveWithFriction(model, ws, f.q, f.qd, f.tau, task));
   sameAs(s["qdd"], ws.solution.qdd.tail(1));
   sameAs(s["base"]["acceleration"], ws.solution.qdd.head(3));
   sameAs(s["base"]["acceleration_world"], ws.solution.base_acceleration_world);
@@ -1269,7 +1271,7 @@ TEST_CASE("energy regenerates the committed CSV within 1e-12", "[energy]") {
     INFO(fresh[i].pose);
     const std::vector<double>& v = fresh[i].values;
     const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(v.data(), 7), zero = Eigen::VectorXd::Zero(7);
-    REQUIRE(zwang::inverseDynamics(model, free_task, q, zero, zero, ws));
+    REQUIRE(zwang::inverseDynamics(model, ws, q, zero, zero, free_task));
     const Eigen::VectorXd gravity = ws.tau;
     const double margins[3] = {0.0, 0.5, 1.0};
     for (int variant = 0; variant < 3; ++variant) {
@@ -1344,8 +1346,8 @@ TEST_CASE("energy: the dual arm holding a box regenerates the committed CSV with
     }
     Eigen::Isometry3d left, right;
     REQUIRE(zwang::forwardKinematics(model, ws, q));
-    REQUIRE(zwang::framePose(model, ws, model.frameIndex("left_tool0"), left));
-    REQUIRE(zwang::framePose(model, ws, model.frameIndex("right_tool0"), right));
+    REQUIRE(zwang::framePose(model, ws, q, model.frameIndex("left_tool0"), left));
+    REQUIRE(zwang::framePose(model, ws, q, model.frameIndex("right_tool0"), right));
     CHECK((left.translation() - right.translation()).norm() == Approx(0.3).margin(1e-9));
     // facing each other along the line between them, x axes down
     const Eigen::Vector3d across = (right.translation() - left.translation()).normalized();
@@ -1353,7 +1355,7 @@ TEST_CASE("energy: the dual arm holding a box regenerates the committed CSV with
     CHECK((right.linear().col(2) + across).norm() < 1e-9);
     CHECK((left.linear().col(0) - Eigen::Vector3d(0, 0, -1)).norm() < 1e-9);
     CHECK((right.linear().col(0) - Eigen::Vector3d(0, 0, -1)).norm() < 1e-9);
-    REQUIRE(zwang::inverseDynamics(model, box, q, zero, zero, ws));
+    REQUIRE(zwang::inverseDynamics(model, ws, q, zero, zero, box));
     const Eigen::VectorXd gravity = ws.tau;
     const double margins[3] = {0.0, 0.5, 1.0};
     for (int variant = 0; variant < 3; ++variant) {
@@ -1724,7 +1726,7 @@ TEST_CASE("solve: multi-DOF joints by name, the solution's dofs; the tool and th
   zwang::Task task(model);
   task.targets()[task.addJointConstraint(model.jointIndex("j2"))] = 0.5;
   zwang::Workspace ws(model, task);
-  REQUIRE(zwang::solveHybridDynamics(model, task, q, qd, tau, ws));
+  REQUIRE(zwang::solveHybridDynamics(model, ws, q, qd, tau, task));
   for (Eigen::Index k = 0; k < 11; ++k) {
     INFO("qdd[" << k << "]");
     CHECK(s["qdd"][static_cast<std::size_t>(k)].get<double>() == ws.solution.qdd[k]);  // the same solve, bit for bit

@@ -90,7 +90,7 @@ void checkStance(const zwang::Model& model, zwang::Workspace& ws, const Robot& r
   REQUIRE(zwang::forwardKinematics(model, ws, q));
   for (const std::string& foot : robot.feet) {
     Eigen::Isometry3d pose;
-    REQUIRE(zwang::framePose(model, ws, model.frameIndex(foot), pose));
+    REQUIRE(zwang::framePose(model, ws, q, model.frameIndex(foot), pose));
     INFO(foot);
     CHECK(std::abs(pose.translation().z()) < 1e-12);  // placed from the legs' kinematics: rounding only
     if (robot.contact_rows == 6) CHECK((pose.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12);
@@ -112,7 +112,7 @@ Eigen::VectorXd torquesWithGround(const zwang::Model& model, zwang::Workspace& w
     loaded.wrench(loaded.addWrench(robot.feet[f], zwang::Expressed::World)) = w;
   }
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  REQUIRE(zwang::inverseDynamics(model, loaded, q, zero, zero, ws));
+  REQUIRE(zwang::inverseDynamics(model, ws, q, zero, zero, loaded));
   return ws.tau;
 }
 
@@ -128,7 +128,7 @@ EffortMap effortMap(const zwang::Model& model, zwang::Workspace& ws, const Robot
   const Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> Gt(balanceTranspose(model, ws, robot, q));
   const zwang::Task gravity_only(model);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  REQUIRE(zwang::inverseDynamics(model, gravity_only, q, zero, zero, ws));
+  REQUIRE(zwang::inverseDynamics(model, ws, q, zero, zero, gravity_only));
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(model.nv(), n + 1);
   rhs.col(0) = ws.tau;
   rhs.bottomRightCorner(n, n).setIdentity();

@@ -65,8 +65,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Workspace ws(bound.model, *bound.task);
   const Status status =
       bound.with_friction
-          ? solveWithFriction(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws, bound.friction_options)
-          : solveHybridDynamics(bound.model, *bound.task, bound.q, bound.qd, bound.tau, ws);
+          ? solveWithFriction(bound.model, ws, bound.q, bound.qd, bound.tau, *bound.task, bound.friction_options)
+          : solveHybridDynamics(bound.model, ws, bound.q, bound.qd, bound.tau, *bound.task);
   if (status.ok() || status.code == StatusCode::Infeasible) {
     const char* where = bound.with_friction ? "solveWithFriction (JSON problem)" : "solveHybridDynamics (JSON problem)";
     fuzz::requireFinite(ws.solution.qdd, "qdd", where);

@@ -473,7 +473,7 @@ void assembleState(FuzzedDataProvider& in, const Model& model, const JointStateD
 void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                const Eigen::VectorXd& tau, FrictionOptions& options, Workspace& ws) {
   const bool finite_inputs = q.allFinite() && qd.allFinite() && tau.allFinite();
-  Status status = solveHybridDynamics(model, task, q, qd, tau, ws);
+  Status status = solveHybridDynamics(model, ws, q, qd, tau, task);
   if (!documented(status.code)) fuzz::failure("undocumented status", "solveHybridDynamics");
   if (finite_inputs && status.code == StatusCode::NonFinite)
     fuzz::failure("NonFinite for finite inputs", status.message);
@@ -485,7 +485,7 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
     options.method = method;
     const char* where = method == FrictionMethod::ActiveSet ? "solveWithFriction (active set)"
                                                             : "solveWithFriction (projected gradient)";
-    status = solveWithFriction(model, task, q, qd, tau, ws, options);
+    status = solveWithFriction(model, ws, q, qd, tau, task, options);
     if (!documented(status.code)) fuzz::failure("undocumented status", where);
     if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", where);
     checkQuaternionVerdict(model, q, status.code, where);
@@ -493,12 +493,12 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
   }
 
   if (finite_inputs) {
-    status = inverseDynamics(model, task, q, qd, tau, ws);
+    status = inverseDynamics(model, ws, q, qd, tau, task);
     if (status.ok())
       fuzz::requireFinite(ws.tau, "tau (RNEA)", "inverseDynamics");
     else if (!documented(status.code))
       fuzz::failure("undocumented status", "inverseDynamics");
-    status = jointSpaceInertia(model, q, ws);
+    status = jointSpaceInertia(model, ws, q);
     if (status.ok()) fuzz::requireFinite(ws.H, "H", "jointSpaceInertia");
     Eigen::MatrixXd J(6, model.nv());
     status = frameJacobian(model, ws, q, static_cast<int>(model.frames().size()) - 1, Expressed::World, J);
@@ -519,7 +519,7 @@ void checkNormalisation(const Model& model, const Task& task, Eigen::VectorXd q,
   if (normalised.ok() == zero)
     fuzz::failure("normalizeConfiguration: Ok exactly when the quaternion is non-zero", normalised.message);
   if (!normalised.ok()) return;
-  const Status status = solveHybridDynamics(model, task, q, qd, tau, ws);
+  const Status status = solveHybridDynamics(model, ws, q, qd, tau, task);
   if (status.code == StatusCode::BadConfiguration)
     fuzz::failure("BadConfiguration after normalizeConfiguration", status.message);
   if (status.ok()) checkSolution(ws, "solveHybridDynamics (normalised q)");

@@ -29,7 +29,7 @@ void loadAndSolve(const std::string& xml, const zwang::UrdfOptions& options) {
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.dof());
   Eigen::VectorXd q = zero, qd = zero;
   model.followLeaders(q, qd);  // a mimic joint's offset
-  const Status status = solveHybridDynamics(model, task, q, qd, zero, ws);
+  const Status status = solveHybridDynamics(model, ws, q, qd, zero, task);
   if (status.ok()) {
     fuzz::requireFinite(ws.solution.qdd, "qdd", "solveHybridDynamics on a loaded URDF");
     fuzz::requireFinite(ws.solution.tau_control, "tau_control", "solveHybridDynamics on a loaded URDF");

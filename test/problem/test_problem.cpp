@@ -130,11 +130,11 @@ TEST_CASE("The problem layer picks the solve: plain without friction options, el
   const Eigen::VectorXd tau = Eigen::VectorXd::Constant(1, 2.0);
   const zwang::FrictionOptions friction;
   zwang::Workspace layer(model, task), direct(model, task);
-  REQUIRE(problem::solve(model, task, q, qd, tau, layer, &friction));
-  REQUIRE(zwang::solveWithFriction(model, task, q, qd, tau, direct, friction));
+  REQUIRE(problem::solve(model, layer, q, qd, tau, task, &friction));
+  REQUIRE(zwang::solveWithFriction(model, direct, q, qd, tau, task, friction));
   CHECK(layer.solution.qdd == direct.solution.qdd);
   CHECK(layer.friction.mu == direct.friction.mu);
-  REQUIRE(problem::solve(model, task, q, qd, tau, layer, nullptr));
-  REQUIRE(zwang::solveHybridDynamics(model, task, q, qd, tau, direct));
+  REQUIRE(problem::solve(model, layer, q, qd, tau, task, nullptr));
+  REQUIRE(zwang::solveHybridDynamics(model, direct, q, qd, tau, task));
   CHECK(layer.solution.qdd == direct.solution.qdd);
 }

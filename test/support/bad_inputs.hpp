@@ -26,7 +26,7 @@ std::vector<BadFrictionOption> badFrictionOptions();
 
 // The report's 1-DOF arm resting on its upper limit, no gravity, with a task
 // that accelerates it into the limit (link1 angular z, b = 5 rad/s²):
-// solveWithFriction(arm, task, q, zero, zero, ws) returns Infeasible with
+// solveWithFriction(arm, ws, q, zero, zero, task) returns Infeasible with
 // `message`, and finite outputs. Built in place (the workspace refers to the
 // task's sizes): not copyable.
 struct IntoUpperLimit {

@@ -136,7 +136,7 @@ double frictionClosureError(const Model& model, const Task& task, const Eigen::V
   const Eigen::VectorXd qdd = solution.qdd;
   const Eigen::VectorXd drive = solution.tau_control + result.tau_friction;
   Workspace ws(model, free_task);
-  if (!solveHybridDynamics(model, free_task, q, qd, drive, ws)) return std::numeric_limits<double>::infinity();
+  if (!solveHybridDynamics(model, ws, q, qd, drive, free_task)) return std::numeric_limits<double>::infinity();
   return relativeError(ws.solution.qdd, qdd);
 }
 

@@ -182,6 +182,6 @@ RandomInverseDynamics::RandomInverseDynamics(std::mt19937_64& rng)
       ws(model, task),
       qdd(randomVector(rng, spec.dof(), 5.0)) {}
 
-Status RandomInverseDynamics::solve() { return inverseDynamics(model, task, in.q, in.qd, qdd, ws); }
+Status RandomInverseDynamics::solve() { return inverseDynamics(model, ws, in.q, in.qd, qdd, task); }
 
 }  // namespace zwang::testing

@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   task.gravity.setZero();
   zwang::Workspace ws(model, task);
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(1), tau = Eigen::VectorXd::Constant(1, 4.5);
-  const zwang::Status status = zwang::solveHybridDynamics(model, task, zero, zero, tau, ws);
+  const zwang::Status status = zwang::solveHybridDynamics(model, ws, zero, zero, tau, task);
   if (!status) {
     std::printf("solve failed: %s\n", status.message);
     return 1;

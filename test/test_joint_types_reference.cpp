@@ -487,3 +487,81 @@ TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the
       compared, draws, stuck_in_row_joint, e_qdd, e_g);
   CHECK(stuck_in_row_joint > 30);
 }
+
+TEST_CASE(
+    "joint types: forwardDynamics against the dense reference and inverseDynamics on trees with spherical "
+    "joints",
+    "[joint_types]") {
+  std::mt19937_64 rng(stressSeedOr(2026112701ULL));
+  Census census;
+  int compared = 0, draws = 0, with_wrenches = 0;
+  double e_qdd = 0, e_default = 0, e_round_trip = 0;
+  while (compared < 200) {
+    REQUIRE(++draws < 2000);
+    const ChainSpec spec = randomJointTypesTree(rng, 2, 16, 0.35);
+    const FloatingBase base = randomBase(rng);
+    RandomProblemOptions options;
+    options.max_constraint_rows = 0;
+    FloatingInput in = loadedInput(rng, spec, base, options);
+    in.constraints.clear();
+    const Model model = floatingModelFromSpec(spec, base);
+    const Task task = floatingTaskFromInput(model, in);
+    REQUIRE(task.constraintRows() == 0);
+    const FloatingResult dense = floatingDynamics(spec, base, in);
+    if (!wellPosed(dense)) continue;
+    Workspace ws(model, task);
+    const Status s = forwardDynamics(model, ws, in.q, in.v, in.tau, task);
+    INFO("draw " << draws << " (" << toString(base.kind) << " base, " << model.nv() << " DOFs): " << s.message);
+    REQUIRE(s);
+    ++compared;
+    census.count(spec, base);
+    with_wrenches += in.wrenches.empty() ? 0 : 1;
+    e_qdd = std::max(e_qdd, relativeError(ws.solution.qdd, dense.qdd));
+    // The accelerations held are this motion's, at this state.
+    Vec6 acceleration;
+    CHECK(frameAcceleration(model, ws, in.q, in.v, model.frameIndex(spec.links.back().name), Expressed::World,
+                            acceleration));
+    // RNEA at that q̈ gives τ back: forward and inverse dynamics are each other's inverse.
+    const Eigen::VectorXd qdd = ws.solution.qdd;
+    REQUIRE(inverseDynamics(model, ws, in.q, in.v, qdd, task));
+    e_round_trip = std::max(e_round_trip, relativeError(ws.tau, in.tau));
+    // Without a task: Task's default gravity and no wrenches.
+    FloatingInput plain = in;
+    plain.gravity = Eigen::Vector3d(0.0, 0.0, -9.81);
+    plain.wrenches.clear();
+    const FloatingResult dense_plain = floatingDynamics(spec, base, plain);
+    REQUIRE(forwardDynamics(model, ws, in.q, in.v, in.tau));
+    e_default = std::max(e_default, relativeError(ws.solution.qdd, dense_plain.qdd));
+  }
+  std::printf(
+      "forwardDynamics vs the dense reference: %d compared (%d draws, %d with wrenches; %d spherical joints, %d "
+      "planar, %d free)\n  max rel. error qdd %.2g, default task %.2g, inverseDynamics round trip %.2g\n",
+      compared, draws, with_wrenches, census.spherical, census.planar, census.free, e_qdd, e_default, e_round_trip);
+  CHECK(census.spherical_inner > 50);
+  CHECK(with_wrenches > 50);
+  // The same systems solved exactly by both, draws conditioned below 1e6: round-off only.
+  CHECK(e_qdd < 1e-9);
+  CHECK(e_default < 1e-9);
+  CHECK(e_round_trip < 1e-9);
+}
+
+TEST_CASE("forwardDynamics refuses a task with constraint rows, naming solveHybridDynamics", "[joint_types]") {
+  const ChainSpec spec = [] {
+    std::mt19937_64 rng(7);
+    return randomJointTypesTree(rng, 3, 6, 0.35);
+  }();
+  const Model model = floatingModelFromSpec(spec, FloatingBase{});
+  Task task(model);
+  task.addConstraint(static_cast<int>(model.frames().size()) - 1, ConstraintMatrix::Identity(6, 3));
+  Workspace ws(model, task);
+  Eigen::VectorXd q(model.nq());
+  REQUIRE(neutralConfiguration(model, q));
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  REQUIRE(solveHybridDynamics(model, ws, q, zero, zero, task));
+  const Status s = forwardDynamics(model, ws, q, zero, zero, task);
+  CHECK(s.code == StatusCode::BadOption);
+  CHECK(std::string(s.message) ==
+        "forwardDynamics: the task has 3 constraint rows; forwardDynamics is the unconstrained solve (gravity and "
+        "wrenches only): use solveHybridDynamics to meet them");
+  CHECK(ws.kinematics.stage == KinematicsStage::None);  // as any call that fails its input checks
+}

@@ -119,6 +119,8 @@ int reportExitCode(const ReportCommand& report, bool all_ok, const std::string& 
 
 // The commands; each returns the exit code.
 int commandSolve(int argc, char** argv);
+// `zwang forward-dynamics PROBLEM.json`: the same problem, solved without constraints or friction.
+int commandForwardDynamics(int argc, char** argv);
 int commandInfo(int argc, char** argv);
 int commandScenarios(int argc, char** argv);
 int commandEnergy(int argc, char** argv);

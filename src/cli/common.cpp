@@ -31,6 +31,18 @@ const char* usageText(const std::string& command) {
            "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage,\n"
            "3 infeasible task (the solution is still written, status.infeasible = true).\n"
            "The problem and solution schemas are in docs/cli.md.\n";
+  if (command == "forward-dynamics")
+    return "usage: zwang forward-dynamics PROBLEM.json [-o FILE] [--pretty]\n"
+           "\n"
+           "Forward dynamics of the unconstrained robot (the articulated-body algorithm): q̈\n"
+           "under the problem's q, qd, tau, gravity and wrenches, printed as solve prints a\n"
+           "solution. A problem with constraints or a \"friction\" section is refused: zwang\n"
+           "solve meets those.\n"
+           "\n"
+           "  -o, --output FILE  write the solution to FILE instead of stdout\n"
+           "  --pretty           indent the JSON for humans\n"
+           "\n"
+           "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage.\n";
   if (command == "info")
     return "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--base free|planar] [--strict]\n"
            "                  [--attach-beyond-tip] [--lock-mimic] [--json]\n"
@@ -87,6 +99,7 @@ const char* usageText(const std::string& command) {
          "\n"
          "commands:\n"
          "  solve PROBLEM.json [-o FILE] [--pretty]        solve a JSON problem, print the solution as JSON\n"
+         "  forward-dynamics PROBLEM.json [-o FILE]        q̈ of the unconstrained robot (no constraints, no friction)\n"
          "  info MODEL.urdf [--root L] [--tip L] [--json]  base, joints, frames and mass of a URDF tree or chain\n"
          "  scenarios [--out DIR] [--models DIR]           the report's chapter 6 and Fig. 5.5, with plots\n"
          "  energy [--out DIR] [--models DIR]              Panda, dual arm + box, humanoid and Solo 12 holding still:\n"

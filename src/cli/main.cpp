@@ -1,6 +1,7 @@
 // zwang: the command-line tool (docs/cli.md).
 //
 //   zwang solve PROBLEM.json [-o FILE] [--pretty]
+//   zwang forward-dynamics PROBLEM.json [-o FILE] [--pretty]
 //   zwang info MODEL.urdf [--root L] [--tip L] [--json]
 //   zwang scenarios [--out DIR] [--models DIR] [--no-plots]
 //   zwang energy [--out DIR] [--models DIR] [--no-plots]
@@ -31,6 +32,7 @@ int run(int argc, char** argv) {
     return kExitOk;
   }
   if (command == "solve") return commandSolve(argc, argv);
+  if (command == "forward-dynamics") return commandForwardDynamics(argc, argv);
   if (command == "info") return commandInfo(argc, argv);
   if (command == "scenarios") return commandScenarios(argc, argv);
   if (command == "energy") return commandEnergy(argc, argv);

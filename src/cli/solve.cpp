@@ -1,4 +1,4 @@
-// `zwang solve PROBLEM.json [-o FILE] [--pretty]`.
+// `zwang solve PROBLEM.json [-o FILE] [--pretty]` and `zwang forward-dynamics PROBLEM.json`.
 #include <cstdio>
 
 #include "cli.hpp"
@@ -18,29 +18,40 @@ void warnOutsideLimits(const std::string& file, const Model& model, const Eigen:
   });
 }
 
-}  // namespace
+// What each command solves the bound problem with.
+enum class Solver { Problem, ForwardDynamics };
 
-int commandSolve(int argc, char** argv) {
-  const Arguments args = parseArguments("solve", argc, argv, 2, {"--pretty"}, {"-o", "--output"});
+Status solveBound(Solver solver, const BoundProblem& bound, Workspace& ws) {
+  if (solver == Solver::ForwardDynamics)
+    return forwardDynamics(bound.model, ws, bound.q, bound.qd, bound.tau, *bound.task);
+  return problem::solve(bound.model, ws, bound.q, bound.qd, bound.tau, *bound.task,
+                        bound.with_friction ? &bound.friction_options : nullptr);
+}
+
+int runProblem(const char* command, Solver solver, int argc, char** argv) {
+  const Arguments args = parseArguments(command, argc, argv, 2, {"--pretty"}, {"-o", "--output"});
   if (args.help) {
-    std::fputs(usageText("solve"), stdout);
+    std::fputs(usageText(command), stdout);
     return kExitOk;
   }
   if (args.positional.size() != 1)
-    throw UsageError("solve", args.positional.empty() ? "no problem file given" : "more than one problem file given");
+    throw UsageError(command, args.positional.empty() ? "no problem file given" : "more than one problem file given");
   const std::string output = args.has("--output") ? args.value("--output") : args.value("-o");
 
   const Problem problem = readProblem(args.positional[0]);
   BoundProblem bound = bindProblem(problem);
+  if (solver == Solver::ForwardDynamics && bound.with_friction)
+    throw CliError(kExitError, problem.file + ": " + command +
+                                   ": the problem has a \"friction\" section; forward dynamics takes none (zwang solve "
+                                   "uses it)");
   printWarnings(bound.model);
   for (const ModelWarning& w : bound.task->warnings())  // the task's, e.g. contacts on a bolted-down base
     std::fprintf(stderr, "zwang: warning: %s: %s\n", problem.file.c_str(), printable(w.message, 4000).c_str());
   warnOutsideLimits(problem.file, bound.model, bound.q);
   Workspace ws(bound.model, *bound.task);
-  const Status status = problem::solve(bound.model, ws, bound.q, bound.qd, bound.tau, *bound.task,
-                                       bound.with_friction ? &bound.friction_options : nullptr);
+  const Status status = solveBound(solver, bound, ws);
   const bool infeasible = status.code == StatusCode::Infeasible;
-  if (!status && !infeasible) throw CliError(kExitError, problem.file + ": solve: " + status.message);
+  if (!status && !infeasible) throw CliError(kExitError, problem.file + ": " + command + ": " + status.message);
 
   const Json solution = solutionJson(bound.model, ws, bound.with_friction, status, bound.reported_frames);
   writeOutput(output, (args.has("--pretty") ? prettyDump(solution) : solution.dump()) + "\n");
@@ -52,6 +63,14 @@ int commandSolve(int argc, char** argv) {
     return kExitInfeasible;
   }
   return kExitOk;
+}
+
+}  // namespace
+
+int commandSolve(int argc, char** argv) { return runProblem("solve", Solver::Problem, argc, argv); }
+
+int commandForwardDynamics(int argc, char** argv) {
+  return runProblem("forward-dynamics", Solver::ForwardDynamics, argc, argv);
 }
 
 }  // namespace zwang::cli

@@ -826,12 +826,11 @@ void bindKinematics(py::module_& m) {
     PyWorkspace& pw = workspaceArg(model, ws_obj);
     const int f = frameArg(*model, frame);
     Eigen::Isometry3d pose;
-    const Status s =
-        q.is_none() ? framePose(*model, *pw.ws, pw.ws->kinematics.q, f, pose)
-                    : queryOrCompute(*model, pw, vectorArg("q", q, pw.q_buf), Eigen::VectorXd(),
-                                     [&](const VectorView& qv, const VectorView&) {
-                                       return framePose(*model, *pw.ws, qv, f, pose);
-                                     });
+    const Status s = q.is_none() ? framePose(*model, *pw.ws, pw.ws->kinematics.q, f, pose)
+                                 : queryOrCompute(*model, pw, vectorArg("q", q, pw.q_buf), Eigen::VectorXd(),
+                                                  [&](const VectorView& qv, const VectorView&) {
+      return framePose(*model, *pw.ws, qv, f, pose);
+                                   });
     if (!s) raiseStatus(s, "frame_pose");
     return matrixCopy(pose.matrix());
       },
@@ -847,8 +846,8 @@ void bindKinematics(py::module_& m) {
     Vec6 v;
     const Status s = queryOrCompute(*model, pw, vectorArg("q", q, pw.q_buf), vectorArg("qd", qd, pw.qd_buf),
                                     [&](const VectorView& qv, const VectorView& qdv) {
-                                      return frameVelocity(*model, *pw.ws, qv, qdv, f, e, v);
-                                    });
+      return frameVelocity(*model, *pw.ws, qv, qdv, f, e, v);
+    });
     if (!s) raiseStatus(s, "frame_velocity");
     return vectorCopy(v);
       },
@@ -871,8 +870,25 @@ void bindKinematics(py::module_& m) {
       "6×nv J with frame_velocity = J qd (nv = dof on a fixed base)");
 }
 
-// inverse_dynamics, joint_space_inertia.
+// forward_dynamics, inverse_dynamics, joint_space_inertia.
 void bindDynamics(py::module_& m) {
+  m.def(
+      "forward_dynamics",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
+         py::handle wrenches, py::handle gravity) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    Task& task = idTask(pw, wrenches, gravity);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
+    const auto tauv = optionalVector("tau", tau, pw.tau_buf, pw.zeros);
+    ++pw.generation;
+    if (const Status s = forwardDynamics(*model, *pw.ws, qv, qdv, tauv, task); !s) raiseStatus(s, "forward_dynamics");
+    return vectorCopy(pw.ws->solution.qdd);
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
+      py::kw_only(), py::arg("wrenches") = py::none(), py::arg("gravity") = py::none(),
+      "ABA: q̈ of the unconstrained robot under τ, gravity and wrenches (the inverse of inverse_dynamics; mimic\n"
+      "couplings kept), a new array. For constraints or friction: solve().");
   m.def(
       "inverse_dynamics",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle qdd,

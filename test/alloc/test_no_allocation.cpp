@@ -92,6 +92,7 @@ TEST_CASE("RNEA, CRBA, kinematics and Jacobians allocate nothing") {
   Vec6 v_local, v_world;
   bool ok = false;
   double sink = 0.0;
+  StatusCode stale = StatusCode::Ok;
   const long count = allocationsDuring([&] {
     ok = inverseDynamics(model, ws, q, qd, qd, task).ok();
     ok = jointSpaceInertia(model, ws, q).ok() && ok;
@@ -101,8 +102,14 @@ TEST_CASE("RNEA, CRBA, kinematics and Jacobians allocate nothing") {
     ok = frameVelocity(model, ws, q, qd, tool, Expressed::World, v_world).ok() && ok;
     sink = pose.translation().x() + v_local[0] + v_world[1];
     ok = frameJacobian(model, ws, q, tool, Expressed::World, J).ok() && ok;
+    ok = forwardDynamics(model, ws, q, qd, qd).ok() && ok;
+    ok = forwardDynamics(model, ws, q, qd, qd, task).ok() && ok;
+    ok = inverseDynamics(model, ws, q, qd, qd).ok() && ok;
+    ok = frameJacobian(model, ws, q, tool, Expressed::World, J).ok() && ok;  // the poses held at q: no sweep
+    stale = framePose(model, ws, qd, tool, pose).code;                       // another q: NotComputed
   });
   CHECK(ok);
+  CHECK(stale == StatusCode::NotComputed);
   CHECK(std::isfinite(sink));
   CHECK(count == 0);
 }
@@ -163,6 +170,9 @@ TEST_CASE("the solver entry points are declared noexcept") {
   static_assert(noexcept(solveHybridDynamics(model, ws, r, r, r, task)));
   static_assert(noexcept(solveWithFriction(model, ws, r, r, r, task, options)));
   static_assert(noexcept(inverseDynamics(model, ws, r, r, r, task)));
+  static_assert(noexcept(inverseDynamics(model, ws, r, r, r)));
+  static_assert(noexcept(forwardDynamics(model, ws, r, r, r, task)));
+  static_assert(noexcept(forwardDynamics(model, ws, r, r, r)));
   static_assert(noexcept(jointSpaceInertia(model, ws, r)));
   CHECK(solveHybridDynamics(model, ws, r, r, r, task).ok());  // (and they run)
 }

@@ -164,6 +164,31 @@ TEST_CASE("No friction section: the plain solver, no friction key", "[golden]") 
   CHECK(d["qdd"][0].get<double>() == Approx(-11.0 / 2.25).margin(1e-12));
 }
 
+TEST_CASE("forward-dynamics: the unconstrained solve of the same problem; constraints and friction refused",
+          "[golden]") {
+  // Without constraints or friction the problem's solve is forward dynamics: the same output, key for key.
+  for (const char* name : {"arm_plain.json", "solo_fall.json"}) {
+    INFO(name);
+    const Run r = run({"forward-dynamics", problem(name)});
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(parse(r.out) == solve(problem(name)));
+  }
+  CHECK(parse(run({"forward-dynamics", problem("arm_plain.json")}).out)["qdd"][0].get<double>() ==
+        Approx(-11.0 / 2.25).margin(1e-12));
+  const Run constrained = run({"forward-dynamics", problem("solo_feet.json")});
+  checkOneLineError(constrained, 1);
+  CHECK(contains(constrained.err,
+                 "solo_feet.json: forward-dynamics: forwardDynamics: the task has 12 constraint "
+                 "rows; forwardDynamics is the unconstrained solve (gravity and wrenches only): use "
+                 "solveHybridDynamics to meet them"));
+  const Run friction = run({"forward-dynamics", problem("arm_stick.json")});
+  checkOneLineError(friction, 1);
+  CHECK(contains(friction.err,
+                 "arm_stick.json: forward-dynamics: the problem has a \"friction\" section; forward "
+                 "dynamics takes none (zwang solve uses it)"));
+}
+
 TEST_CASE("Overrides: rotor_inertia and breakaway replace the model's values", "[golden]") {
   // I = 2.25 + 0.75 = 3, f = 2: the -5 N·m load slips, qdd = (-5 + 2) / 3 = -1
   const Json s = solve(problem("arm_overrides.json"));

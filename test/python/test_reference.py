@@ -110,6 +110,9 @@ def test_closure_property_on_panda(panda):
     # RNEA at that qdd gives tau_control back; the tool meets its set points.
     tau_id = zwang.inverse_dynamics(panda, ws, q, qd, res.qdd, wrenches=[w])
     np.testing.assert_allclose(tau_id, res.tau_control, rtol=0, atol=1e-9)
+    # forward_dynamics is that unconstrained solve, by its name.
+    qdd_fd = zwang.forward_dynamics(panda, ws, q, qd, res.tau_control, wrenches=[w])
+    np.testing.assert_allclose(qdd_fd, res.qdd, rtol=0, atol=1e-10)
     np.testing.assert_allclose(res.frame_acceleration("tool0", "world")[:3], [0.1, -0.2, 0.3], atol=1e-10)
 
 
@@ -130,6 +133,23 @@ def test_panda_hold_pose_friction_carries_the_load(panda):
     effort_half = np.sum(half.tau_control ** 2)
     assert np.all(np.abs(half.mu) <= 0.5 * panda.breakaway_friction + 1e-9)
     assert effort_half <= np.sum(plain.tau_control ** 2) + 1e-9
+
+
+def test_forward_dynamics_against_crba_and_rnea(panda):
+    """forward_dynamics: qdd = H^-1 (tau - C) with H from CRBA and C from RNEA at qdd = 0; gravity and
+    wrenches as inverse_dynamics takes them; constraints belong to solve()."""
+    ws = panda.workspace()
+    rng = np.random.default_rng(11)
+    for _ in range(20):
+        q, qd, tau = rng.uniform(-1, 1, 7), rng.uniform(-1, 1, 7), rng.uniform(-5, 5, 7)
+        gravity = rng.uniform(-10, 10, 3)
+        w = zwang.Wrench("panda_link4", rng.uniform(-2, 2, 6))
+        qdd = zwang.forward_dynamics(panda, ws, q, qd, tau, wrenches=[w], gravity=gravity)
+        H = zwang.joint_space_inertia(panda, ws, q)
+        C = zwang.inverse_dynamics(panda, ws, q, qd, wrenches=[w], gravity=gravity)
+        np.testing.assert_allclose(qdd, np.linalg.solve(H, tau - C), rtol=1e-9, atol=1e-9)
+    # Defaults: at rest, no torque, default gravity: the arm falls as the plain solve says.
+    np.testing.assert_array_equal(zwang.forward_dynamics(panda, ws, READY), zwang.solve(panda, ws, READY).qdd)
 
 
 def test_pendulum_rnea_crba_kinematics(panda):

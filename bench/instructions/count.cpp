@@ -3,7 +3,8 @@
 // case, named by it). Counts are the same on a busy machine as on a quiet
 // one, so two builds can be compared where timings are too noisy; they are
 // instructions, not time (a long dependency chain or a cache miss counts as
-// one). Uses only the public API, so the same file builds against any commit.
+// one). Uses only the public API, so the same file builds against any commit
+// (the calls below in either argument order: zwang/version.hpp came with 0.2's).
 // Built and run by bench/instructions/compare.sh, not by CMake.
 #include <valgrind/callgrind.h>
 
@@ -12,6 +13,14 @@
 #include <vector>
 
 #include "zwang/zwang.hpp"
+
+#if __has_include("zwang/version.hpp")
+#define ZWANG_ARGUMENTS(model, ws, q, qd, x, task) model, ws, q, qd, x, task
+#define ZWANG_CRBA_ARGUMENTS(model, ws, q) model, ws, q
+#else  // before 0.2: the task second, the workspace last
+#define ZWANG_ARGUMENTS(model, ws, q, qd, x, task) model, task, q, qd, x, ws
+#define ZWANG_CRBA_ARGUMENTS(model, ws, q) model, q, ws
+#endif
 
 namespace {
 
@@ -65,14 +74,14 @@ void countCase(const Case& c) {
       task.addConstraint(frame, A, Expressed::World);
   }
   Workspace ws(m, task);
-  count(c.name + "_hd", [&] { (void)solveHybridDynamics(m, ws, s.q, s.qd, s.tau, task); });
+  count(c.name + "_hd", [&] { (void)solveHybridDynamics(ZWANG_ARGUMENTS(m, ws, s.q, s.qd, s.tau, task)); });
   const Eigen::VectorXd at_rest = Eigen::VectorXd::Zero(m.nv());  // every joint with friction stuck
   const FrictionOptions options;
-  count(c.name + "_fric", [&] { (void)solveWithFriction(m, ws, s.q, at_rest, s.tau, task, options); });
+  count(c.name + "_fric", [&] { (void)solveWithFriction(ZWANG_ARGUMENTS(m, ws, s.q, at_rest, s.tau, task), options); });
   if (!c.rows.empty()) return;
   const Eigen::VectorXd qdd = Eigen::VectorXd::Constant(m.nv(), 0.3);
-  count(c.name + "_rnea", [&] { (void)inverseDynamics(m, ws, s.q, s.qd, qdd, task); });
-  count(c.name + "_crba", [&] { (void)jointSpaceInertia(m, ws, s.q); });
+  count(c.name + "_rnea", [&] { (void)inverseDynamics(ZWANG_ARGUMENTS(m, ws, s.q, s.qd, qdd, task)); });
+  count(c.name + "_crba", [&] { (void)jointSpaceInertia(ZWANG_CRBA_ARGUMENTS(m, ws, s.q)); });
 }
 
 }  // namespace

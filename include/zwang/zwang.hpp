@@ -11,6 +11,7 @@
 #include "zwang/status.hpp"
 #include "zwang/task.hpp"
 #include "zwang/urdf.hpp"
+#include "zwang/version.hpp"
 #include "zwang/workspace.hpp"
 
 /// \namespace zwang

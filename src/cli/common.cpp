@@ -12,103 +12,123 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <utility>
 
 #include "cli.hpp"
 #include "zwang/urdf.hpp"
 
 namespace zwang::cli {
 
+namespace {
+
+constexpr const char* kSolveUsage =
+    "usage: zwang solve PROBLEM.json [-o FILE] [--pretty]\n"
+    "\n"
+    "Solve the constrained hybrid dynamics problem in PROBLEM.json (with static\n"
+    "friction when it has a \"friction\" section) and print the solution as JSON.\n"
+    "\n"
+    "  -o, --output FILE  write the solution to FILE instead of stdout\n"
+    "  --pretty           indent the JSON for humans\n"
+    "\n"
+    "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage,\n"
+    "3 infeasible task (the solution is still written, status.infeasible = true).\n"
+    "The problem and solution schemas are in docs/cli.md.\n";
+
+constexpr const char* kForwardDynamicsUsage =
+    "usage: zwang forward-dynamics PROBLEM.json [-o FILE] [--pretty]\n"
+    "\n"
+    "Forward dynamics of the unconstrained robot (the articulated-body algorithm): q̈\n"
+    "under the problem's q, qd, tau, gravity and wrenches, printed as solve prints a\n"
+    "solution. A problem with constraints or a \"friction\" section is refused: zwang\n"
+    "solve meets those.\n"
+    "\n"
+    "  -o, --output FILE  write the solution to FILE instead of stdout\n"
+    "  --pretty           indent the JSON for humans\n"
+    "\n"
+    "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage.\n";
+
+constexpr const char* kInfoUsage =
+    "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--base free|planar] [--strict]\n"
+    "                  [--attach-beyond-tip] [--lock-mimic] [--json]\n"
+    "\n"
+    "Print the model loaded from MODEL.urdf: the base (fixed, free or planar; nq, nv),\n"
+    "joints (parent joint, type, axis, limits, friction, viscous, rotor inertia, effort\n"
+    "limit), frames, moving and base mass, and the model's warnings (also on stderr as\n"
+    "\"zwang: warning: ...\").\n"
+    "\n"
+    "  --root LINK           the model starts at LINK (default: the URDF's root link)\n"
+    "  --tip LINK            the chain from the root to LINK (default: the whole tree\n"
+    "                        below the root)\n"
+    "  --base free|planar    give the root link a floating base: a free-flyer, or x, y, yaw\n"
+    "                        in the world's x-y plane (default fixed; a URDF whose root\n"
+    "                        joint is floating or planar floats without it)\n"
+    "  --strict              refuse doubtful data (every warning becomes an error)\n"
+    "  --attach-beyond-tip   weld links behind moving joints below the tip to the tip\n"
+    "                        body as a payload (those joints locked at 0)\n"
+    "  --lock-mimic          weld the mimic joints (at their position when the leader\n"
+    "                        is at 0) instead of refusing the model\n"
+    "  --json                print JSON instead of a table\n";
+
+constexpr const char* kScenariosUsage =
+    "usage: zwang scenarios [--out DIR] [--models DIR] [--no-plots]\n"
+    "\n"
+    "Reproduce the report's chapter 6 (scenarios 1 and 2) and Fig. 5.5 with the\n"
+    "1-DOF arm: print the friction-aware results next to the report's numbers and\n"
+    "write DIR/<name>.csv (g, qdd, tau over 201 friction values) and, with gnuplot,\n"
+    "DIR/<name>_g.png, _qdd.png, _tau.png.\n"
+    "\n"
+    "  --out DIR     output directory (default: ./scenarios; created if missing)\n"
+    "  --models DIR  where one_dof_arm.urdf is (default: the source tree's models/)\n"
+    "  --no-plots    write the CSVs only (no gnuplot script, no PNG)\n"
+    "\n"
+    "Exit code 1 when a result disagrees with the report's.\n";
+
+constexpr const char* kEnergyUsage =
+    "usage: zwang energy [--out DIR] [--models DIR] [--no-plots]\n"
+    "\n"
+    "The Panda holding still against gravity in six poses, the dual arm\n"
+    "(dual_panda.urdf) holding a 3 kg box between its hands in five postures, then\n"
+    "simple_humanoid.urdf and solo12.urdf on a free base standing on the ground: the\n"
+    "motor torques of the plain solver and of the friction-aware solver (margins\n"
+    "0.5 and 1), with the URDF's breakaway friction (chosen values for the standing\n"
+    "robots). Prints the tables and writes DIR/panda_energy.csv,\n"
+    "DIR/dual_energy.csv, DIR/standing_energy.csv and, with gnuplot, their PNG bar\n"
+    "charts (DIR/*_energy.png, DIR/*_joints.png).\n"
+    "\n"
+    "  --out DIR     output directory (default: ./energy; created if missing)\n"
+    "  --models DIR  where panda.urdf, dual_panda.urdf, simple_humanoid.urdf and solo12.urdf\n"
+    "                are (default: the source tree's models/)\n"
+    "  --no-plots    write the CSVs only (no gnuplot scripts, no PNG)\n"
+    "\n"
+    "Exit code 1 when a result disagrees with the closed form or a check.\n";
+
+constexpr const char* kCommandsUsage =
+    "usage: zwang <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  solve PROBLEM.json [-o FILE] [--pretty]        solve a JSON problem, print the solution as JSON\n"
+    "  forward-dynamics PROBLEM.json [-o FILE]        q̈ of the unconstrained robot (no constraints, no friction)\n"
+    "  info MODEL.urdf [--root L] [--tip L] [--json]  base, joints, frames and mass of a URDF tree or chain\n"
+    "  scenarios [--out DIR] [--models DIR]           the report's chapter 6 and Fig. 5.5, with plots\n"
+    "  energy [--out DIR] [--models DIR]              Panda, dual arm + box, humanoid and Solo 12 holding still:\n"
+    "                                                 effort with/without friction\n"
+    "\n"
+    "  zwang <command> --help   a command's options\n"
+    "  zwang --version          the version\n"
+    "\n"
+    "Exit codes: 0 ok, 1 error, 2 usage, 3 infeasible task. See docs/cli.md.\n";
+
+}  // namespace
+
 const char* usageText(const std::string& command) {
-  if (command == "solve")
-    return "usage: zwang solve PROBLEM.json [-o FILE] [--pretty]\n"
-           "\n"
-           "Solve the constrained hybrid dynamics problem in PROBLEM.json (with static\n"
-           "friction when it has a \"friction\" section) and print the solution as JSON.\n"
-           "\n"
-           "  -o, --output FILE  write the solution to FILE instead of stdout\n"
-           "  --pretty           indent the JSON for humans\n"
-           "\n"
-           "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage,\n"
-           "3 infeasible task (the solution is still written, status.infeasible = true).\n"
-           "The problem and solution schemas are in docs/cli.md.\n";
-  if (command == "forward-dynamics")
-    return "usage: zwang forward-dynamics PROBLEM.json [-o FILE] [--pretty]\n"
-           "\n"
-           "Forward dynamics of the unconstrained robot (the articulated-body algorithm): q̈\n"
-           "under the problem's q, qd, tau, gravity and wrenches, printed as solve prints a\n"
-           "solution. A problem with constraints or a \"friction\" section is refused: zwang\n"
-           "solve meets those.\n"
-           "\n"
-           "  -o, --output FILE  write the solution to FILE instead of stdout\n"
-           "  --pretty           indent the JSON for humans\n"
-           "\n"
-           "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage.\n";
-  if (command == "info")
-    return "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--base free|planar] [--strict]\n"
-           "                  [--attach-beyond-tip] [--lock-mimic] [--json]\n"
-           "\n"
-           "Print the model loaded from MODEL.urdf: the base (fixed, free or planar; nq, nv),\n"
-           "joints (parent joint, type, axis, limits, friction, viscous, rotor inertia, effort\n"
-           "limit), frames, moving and base mass, and the model's warnings (also on stderr as\n"
-           "\"zwang: warning: ...\").\n"
-           "\n"
-           "  --root LINK           the model starts at LINK (default: the URDF's root link)\n"
-           "  --tip LINK            the chain from the root to LINK (default: the whole tree\n"
-           "                        below the root)\n"
-           "  --base free|planar    give the root link a floating base: a free-flyer, or x, y, yaw\n"
-           "                        in the world's x-y plane (default fixed; a URDF whose root\n"
-           "                        joint is floating or planar floats without it)\n"
-           "  --strict              refuse doubtful data (every warning becomes an error)\n"
-           "  --attach-beyond-tip   weld links behind moving joints below the tip to the tip\n"
-           "                        body as a payload (those joints locked at 0)\n"
-           "  --lock-mimic          weld the mimic joints (at their position when the leader\n"
-           "                        is at 0) instead of refusing the model\n"
-           "  --json                print JSON instead of a table\n";
-  if (command == "scenarios")
-    return "usage: zwang scenarios [--out DIR] [--models DIR] [--no-plots]\n"
-           "\n"
-           "Reproduce the report's chapter 6 (scenarios 1 and 2) and Fig. 5.5 with the\n"
-           "1-DOF arm: print the friction-aware results next to the report's numbers and\n"
-           "write DIR/<name>.csv (g, qdd, tau over 201 friction values) and, with gnuplot,\n"
-           "DIR/<name>_g.png, _qdd.png, _tau.png.\n"
-           "\n"
-           "  --out DIR     output directory (default: ./scenarios; created if missing)\n"
-           "  --models DIR  where one_dof_arm.urdf is (default: the source tree's models/)\n"
-           "  --no-plots    write the CSVs only (no gnuplot script, no PNG)\n"
-           "\n"
-           "Exit code 1 when a result disagrees with the report's.\n";
-  if (command == "energy")
-    return "usage: zwang energy [--out DIR] [--models DIR] [--no-plots]\n"
-           "\n"
-           "The Panda holding still against gravity in six poses, the dual arm\n"
-           "(dual_panda.urdf) holding a 3 kg box between its hands in five postures, then\n"
-           "simple_humanoid.urdf and solo12.urdf on a free base standing on the ground: the\n"
-           "motor torques of the plain solver and of the friction-aware solver (margins\n"
-           "0.5 and 1), with the URDF's breakaway friction (chosen values for the standing\n"
-           "robots). Prints the tables and writes DIR/panda_energy.csv,\n"
-           "DIR/dual_energy.csv, DIR/standing_energy.csv and, with gnuplot, their PNG bar\n"
-           "charts (DIR/*_energy.png, DIR/*_joints.png).\n"
-           "\n"
-           "  --out DIR     output directory (default: ./energy; created if missing)\n"
-           "  --models DIR  where panda.urdf, dual_panda.urdf, simple_humanoid.urdf and solo12.urdf\n"
-           "                are (default: the source tree's models/)\n"
-           "  --no-plots    write the CSVs only (no gnuplot scripts, no PNG)\n"
-           "\n"
-           "Exit code 1 when a result disagrees with the closed form or a check.\n";
-  return "usage: zwang <command> [options]\n"
-         "\n"
-         "commands:\n"
-         "  solve PROBLEM.json [-o FILE] [--pretty]        solve a JSON problem, print the solution as JSON\n"
-         "  forward-dynamics PROBLEM.json [-o FILE]        q̈ of the unconstrained robot (no constraints, no friction)\n"
-         "  info MODEL.urdf [--root L] [--tip L] [--json]  base, joints, frames and mass of a URDF tree or chain\n"
-         "  scenarios [--out DIR] [--models DIR]           the report's chapter 6 and Fig. 5.5, with plots\n"
-         "  energy [--out DIR] [--models DIR]              Panda, dual arm + box, humanoid and Solo 12 holding still:\n"
-         "                                                 effort with/without friction\n"
-         "\n"
-         "  zwang <command> --help   a command's options\n"
-         "  zwang --version          the version\n"
-         "\n"
-         "Exit codes: 0 ok, 1 error, 2 usage, 3 infeasible task. See docs/cli.md.\n";
+  const std::pair<const char*, const char*> usages[] = {{"solve", kSolveUsage},
+                                                        {"forward-dynamics", kForwardDynamicsUsage},
+                                                        {"info", kInfoUsage},
+                                                        {"scenarios", kScenariosUsage},
+                                                        {"energy", kEnergyUsage}};
+  for (const auto& [name, text] : usages)
+    if (command == name) return text;
+  return kCommandsUsage;
 }
 
 bool Arguments::has(const std::string& name) const {

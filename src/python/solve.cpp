@@ -819,7 +819,8 @@ void bindKinematics(py::module_& m) {
     if (!s) raiseStatus(s, "forward_kinematics");
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
-      "Poses (and velocities with qd) of every body into ws; then frame_pose/frame_velocity with q=None.");
+      "Poses (and velocities with qd) of every body into ws; then frame_pose(q=None), or any query at this state\n"
+      "without recomputing.");
   m.def(
       "frame_pose",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle frame) {

@@ -469,6 +469,23 @@ void assembleState(FuzzedDataProvider& in, const Model& model, const JointStateD
   }
 }
 
+// After a solve at (q, qd): the frame queries at that state read finite values; at another q they are NotComputed.
+void checkHeldState(const Model& model, const Workspace& ws, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  const int frame = static_cast<int>(model.frames().size()) - 1;
+  Eigen::Isometry3d pose;
+  Vec6 velocity, acceleration;
+  if (!framePose(model, ws, q, frame, pose).ok() ||
+      !frameVelocity(model, ws, q, qd, frame, Expressed::World, velocity).ok() ||
+      !frameAcceleration(model, ws, q, qd, frame, Expressed::Local, acceleration).ok())
+    fuzz::failure("a query at the solve's state", "not Ok");
+  fuzz::requireFinite(pose.matrix(), "pose", "framePose");
+  fuzz::requireFinite(acceleration, "acceleration", "frameAcceleration");
+  Eigen::VectorXd other = q;
+  other[0] = q[0] == 0.0 ? 1.0 : -q[0];  // differs from q[0] whatever its size
+  if (framePose(model, ws, other, frame, pose).code != StatusCode::NotComputed)
+    fuzz::failure("a query at another q", "not NotComputed");
+}
+
 // The solves, each status documented, every output of a successful one finite.
 void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                const Eigen::VectorXd& tau, FrictionOptions& options, Workspace& ws) {
@@ -480,6 +497,16 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
   if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "solveHybridDynamics");
   checkQuaternionVerdict(model, q, status.code, "solveHybridDynamics");
   if (status.ok()) checkSolution(ws, "solveHybridDynamics");
+  if (status.ok()) checkHeldState(model, ws, q, qd);
+
+  // forwardDynamics: the task's rows refused, the rest as the plain solve.
+  status = forwardDynamics(model, ws, q, qd, tau, task);
+  if ((task.constraintRows() > 0) != (status.code == StatusCode::BadOption))
+    fuzz::failure("forwardDynamics: BadOption exactly for a task with rows", status.message);
+  status = forwardDynamics(model, ws, q, qd, tau);
+  if (!documented(status.code)) fuzz::failure("undocumented status", "forwardDynamics");
+  if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "forwardDynamics");
+  if (status.ok()) checkSolution(ws, "forwardDynamics");
 
   for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
     options.method = method;

@@ -250,8 +250,9 @@ namespace {
 // Lines 19–21 for DOF body i, one constraint column of its subtree at a time:
 // (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle; without kBalance,
 // jointBalanceUpdate adds a joint's DOFs at once) and
-// A_parent = P^A A_i (line 19).
-template <bool kBalance>
+// A_parent = P^A A_i (line 19). Without kBias, Ẍ_bias,i = 0 (a multi-DOF
+// joint's bodies before its last) and line 20 skips Aᵀ Ẍ_bias.
+template <bool kBalance, bool kBias>
 inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace& ws) {
   ConstraintMatrix& A = ws.Ahat;
   const Vec6& S = ws.S[at(i)];
@@ -267,8 +268,8 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
   }
   for (int col = first; col < k; ++col) {
     const double sA_D = sA[col] * inverse_D;
-    ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
-    double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
+    ws.U[col] += kBias ? A.col(col).dot(c) + sA[col] * u_D : sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
+    double* L_col = &ws.L(0, col);                                           // line 21 (sign: see top), lower triangle
     if (kBalance)
       for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
     A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
@@ -405,9 +406,11 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     }
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
     if (first == i) {
-      constraintColumnsStep<true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
+      constraintColumnsStep<true, true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
     } else {
-      for (int k = i; k >= first; --k) constraintColumnsStep<false>(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
+      constraintColumnsStep<false, true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
+      for (int k = i - 1; k >= first; --k)
+        constraintColumnsStep<false, false>(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
       jointBalanceUpdate(task, first, i, ws);
     }
     passToParent(model, first, i, IA, pA, ws);

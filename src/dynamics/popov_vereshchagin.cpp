@@ -294,12 +294,20 @@ void jointBalanceUpdate(const Task& task, int first, int dofs, Workspace& ws) {
   for (int col = c0; col < c1; ++col) {
     double w[6];  // SᵀA_k / D_k of this column
     for (int k = 0; k < n; ++k) w[k] = sA[k][col] * ws.inverse_D[at(first + k)];
-    double* L_col = &ws.L(0, col);
-    for (int r = col; r < c1; ++r) {
-      double sum = 0.0;
-      for (int k = 0; k < n; ++k) sum += sA[k][r] * w[k];
-      L_col[r] += sum;
-    }
+    const Eigen::Index len = c1 - col;
+    Eigen::Map<Eigen::VectorXd> L_col(&ws.L(col, col), len);
+    auto term = [&](int k) { return Eigen::Map<const Eigen::VectorXd>(sA[k] + col, len) * w[k]; };
+    // One expression: one vectorised pass over the column, the sum in k order.
+    if (kDofs == 6)
+      L_col += term(0) + term(1) + term(2) + term(3) + term(4) + term(5);
+    else if (kDofs == 3)
+      L_col += term(0) + term(1) + term(2);
+    else
+      for (Eigen::Index r = 0; r < len; ++r) {
+        double sum = 0.0;
+        for (int k = 0; k < n; ++k) sum += sA[k][col + r] * w[k];
+        L_col[r] += sum;
+      }
   }
 }
 

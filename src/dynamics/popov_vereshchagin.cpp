@@ -859,7 +859,8 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
     Vec6 carried = Vec6::Zero();
     for (int i = N; i >= 1; --i) {
       const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
-      carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+      if (k > k_beyond)  // most bodies carry none: no product of zero width
+        carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
       tau_c[i - 1] = ws.S[at(i)].dot(carried);
     }
     return;
@@ -867,7 +868,11 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   std::vector<Vec6>& carried = ws.constraint_wrench;
   for (int i = 1; i <= N; ++i) {  // body i's own columns: those on bodies ≥ i but not ≥ i + 1
     const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
-    carried[at(i)].noalias() = ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+    if (k == k_beyond)  // most bodies carry none: no product of zero width
+      carried[at(i)].setZero();
+    else
+      carried[at(i)].noalias() =
+          ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
   }
   for (int i = N; i >= 1; --i) {
     tau_c[i - 1] = ws.S[at(i)].dot(carried[at(i)]);

@@ -679,8 +679,9 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
     auto dU = s.dU.col(c).segment(rows_first, rows);
     Vec6 du = Vec6::Zero();
     if (own >= n) {
-      du.noalias() = -W * dF;
-      for (int r = 0; r < rows; ++r) dU[r] -= Yt.col(r).dot(dF);
+      const Vec6 F = dF;  // in registers: a store to dU could alias dF's memory, so each row would reload it
+      du.noalias() = -W * F;
+      for (int r = 0; r < rows; ++r) dU[r] -= Yt.col(r).dot(F);
     } else {  // δF^a is zero where the column enters
       du[own] = 1.0;
       for (int k = own - 1; k >= 0; --k)

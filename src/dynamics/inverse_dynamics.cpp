@@ -92,18 +92,33 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
   ws.kinematics.stage = KinematicsStage::Poses;  // the velocities are left at rest, not the state's
   ws.kinematics.model = &model;
 
-  // Inward: composite inertias, and row i of H from F_i = I^c_i S_i.
-  for (int i = 1; i <= N; ++i) ws.Ic[at(i)] = ws.I[at(i)].matrix();
-  // H_ij ≠ 0 only for the DOFs j supporting i (its ancestors); the rest stays
-  // zero: the tree's sparsity, zero blocks between branches.
-  ws.H.setZero();
-  for (int i = N; i >= 1; --i) {
-    const int p = model.parent(i);
-    if (p > 0) ws.Ic[at(p)] += ws.Ic[at(i)];  // base coordinates: composite inertias add
-    const Vec6 F = ws.Ic[at(i)] * ws.S[at(i)];
-    const int row = i - 1;
-    ws.H(row, row) = ws.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
-    for (int j = p; j >= 1; j = model.parent(j)) ws.H(row, j - 1) = ws.H(j - 1, row) = ws.S[at(j)].dot(F);
+  // Inward, joint by joint: composite inertias, and row k of H from F_k =
+  // I^c S_k. A multi-DOF joint's intermediate bodies carry no mass and have
+  // one child, so all its DOFs see its last body's I^c: only that one is
+  // formed and handed to the parent (the world, body 0, takes nothing).
+  for (int i = 1; i <= N; ++i)
+    if (i == N || model.jointStart(i + 1) == i + 1) ws.Ic[at(i)] = ws.I[at(i)].matrix();
+  for (int last = N; last >= 1;) {
+    const int first = model.jointStart(last), p = model.parent(first);
+    const Mat6& Ic = ws.Ic[at(last)];
+    if (p > 0) ws.Ic[at(p)] += Ic;  // base coordinates: composite inertias add
+    for (int i = last; i >= first; --i) {
+      const Vec6 F = Ic * ws.S[at(i)];
+      const int row = i - 1;
+      ws.H(row, row) = ws.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
+      // H_kj ≠ 0 only for the DOFs j supporting k (its ancestors); the rest of
+      // row k below the diagonal is the zeros of the branches between them
+      // (none on a chain): each entry written once, with no pass over all of H.
+      for (int j = i - 1, a = model.parent(i); j >= 1; --j) {
+        double h = 0.0;
+        if (j == a) {
+          h = ws.S[at(j)].dot(F);
+          a = model.parent(a);
+        }
+        ws.H(row, j - 1) = ws.H(j - 1, row) = h;
+      }
+    }
+    last = first - 1;
   }
 }
 

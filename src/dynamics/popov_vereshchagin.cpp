@@ -251,8 +251,9 @@ namespace {
 // Lines 19–21 for DOF body i, one constraint column of its subtree at a time:
 // (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle; without kBalance,
 // jointBalanceUpdate adds a joint's DOFs at once) and
-// A_parent = P^A A_i (line 19).
-template <bool kBalance>
+// A_parent = P^A A_i (line 19). Without kBias, Ẍ_bias,i = 0 (a multi-DOF
+// joint's bodies before its last) and line 20 skips Aᵀ Ẍ_bias.
+template <bool kBalance, bool kBias>
 inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace& ws) {
   ConstraintMatrix& A = ws.Ahat;
   const Vec6& S = ws.S[at(i)];
@@ -268,8 +269,8 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
   }
   for (int col = first; col < k; ++col) {
     const double sA_D = sA[col] * inverse_D;
-    ws.U[col] += A.col(col).dot(c) + sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
-    double* L_col = &ws.L(0, col);                   // line 21 (sign: see top), lower triangle
+    ws.U[col] += kBias ? A.col(col).dot(c) + sA[col] * u_D : sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
+    double* L_col = &ws.L(0, col);                                           // line 21 (sign: see top), lower triangle
     if (kBalance)
       for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
     A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
@@ -294,12 +295,20 @@ void jointBalanceUpdate(const Task& task, int first, int dofs, Workspace& ws) {
   for (int col = c0; col < c1; ++col) {
     double w[6];  // SᵀA_k / D_k of this column
     for (int k = 0; k < n; ++k) w[k] = sA[k][col] * ws.inverse_D[at(first + k)];
-    double* L_col = &ws.L(0, col);
-    for (int r = col; r < c1; ++r) {
-      double sum = 0.0;
-      for (int k = 0; k < n; ++k) sum += sA[k][r] * w[k];
-      L_col[r] += sum;
-    }
+    const Eigen::Index len = c1 - col;
+    Eigen::Map<Eigen::VectorXd> L_col(&ws.L(col, col), len);
+    auto term = [&](int k) { return Eigen::Map<const Eigen::VectorXd>(sA[k] + col, len) * w[k]; };
+    // One expression: one vectorised pass over the column, the sum in k order.
+    if (kDofs == 6)
+      L_col += term(0) + term(1) + term(2) + term(3) + term(4) + term(5);
+    else if (kDofs == 3)
+      L_col += term(0) + term(1) + term(2);
+    else
+      for (Eigen::Index r = 0; r < len; ++r) {
+        double sum = 0.0;
+        for (int k = 0; k < n; ++k) sum += sA[k][col + r] * w[k];
+        L_col[r] += sum;
+      }
   }
 }
 
@@ -406,9 +415,11 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     }
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
     if (first == i) {
-      constraintColumnsStep<true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
+      constraintColumnsStep<true, true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
     } else {
-      for (int k = i; k >= first; --k) constraintColumnsStep<false>(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
+      constraintColumnsStep<false, true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
+      for (int k = i - 1; k >= first; --k)
+        constraintColumnsStep<false, false>(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
       jointBalanceUpdate(task, first, i, ws);
     }
     passToParent(model, first, i, IA, pA, ws);
@@ -669,8 +680,9 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
     auto dU = s.dU.col(c).segment(rows_first, rows);
     Vec6 du = Vec6::Zero();
     if (own >= n) {
-      du.noalias() = -W * dF;
-      for (int r = 0; r < rows; ++r) dU[r] -= Yt.col(r).dot(dF);
+      const Vec6 F = dF;  // in registers: a store to dU could alias dF's memory, so each row would reload it
+      du.noalias() = -W * F;
+      for (int r = 0; r < rows; ++r) dU[r] -= Yt.col(r).dot(F);
     } else {  // δF^a is zero where the column enters
       du[own] = 1.0;
       for (int k = own - 1; k >= 0; --k)
@@ -849,7 +861,8 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
     Vec6 carried = Vec6::Zero();
     for (int i = N; i >= 1; --i) {
       const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
-      carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+      if (k > k_beyond)  // most bodies carry none: no product of zero width
+        carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
       tau_c[i - 1] = ws.S[at(i)].dot(carried);
     }
     return;
@@ -857,7 +870,11 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   std::vector<Vec6>& carried = ws.constraint_wrench;
   for (int i = 1; i <= N; ++i) {  // body i's own columns: those on bodies ≥ i but not ≥ i + 1
     const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
-    carried[at(i)].noalias() = ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+    if (k == k_beyond)  // most bodies carry none: no product of zero width
+      carried[at(i)].setZero();
+    else
+      carried[at(i)].noalias() =
+          ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
   }
   for (int i = N; i >= 1; --i) {
     tau_c[i - 1] = ws.S[at(i)].dot(carried[at(i)]);

@@ -210,7 +210,7 @@ Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const Fric
   Vec6 terms = Vec6::Zero(), joint_motion = Vec6::Zero();
   for (int l = model.parent(body); l > 0; l = model.parent(l)) {
     joint_motion += ws.S[static_cast<std::size_t>(l)] * fs.dqdd(l - 1, a);
-    if (model.dofs()[static_cast<std::size_t>(l - 1)].index_in_joint > 0) continue;
+    if (model.jointStart(l) != l) continue;  // the compact array, not the 120-byte Dof
     terms += joint_motion.cwiseAbs();
     joint_motion.setZero();
   }

@@ -20,18 +20,22 @@ const char* toString(JointState state);
 
 /// What solveWithFriction reports besides the motion (Workspace::friction).
 struct FrictionResult {
-  Eigen::VectorXd mu;             ///< μ*, per joint (0 for moving joints)
-  std::vector<JointState> state;  ///< per joint
-  Eigen::VectorXd tau_friction;  ///< torque friction and limits put on each joint (−μ, or −f_c sign q̇ − b q̇)
-  Eigen::MatrixXd dqdd_dmu;      ///< n × n: column j = ∂q̈/∂μ_j = −K e_j for a stuck joint j, 0 otherwise
-  std::vector<int> stuck;        ///< Θ₀: the stuck joints, ascending
-  double gauss_dual = 0.0;       ///< g(μ*) = Z(q̈*) + μ*ᵀ W q̈*
-  int iterations = 0;            ///< of the maximiser
-  bool converged = true;         ///< the maximiser met its KKT tolerance within max_iterations
-  double kkt_residual = 0.0;     ///< max violation of the optimality conditions [rad/s² or m/s²]
-  bool indeterminate = false;    ///< μ* is not unique; the effort-minimising one was chosen
-  bool limit_impact = false;     ///< a joint on a limit moves into it (needs an impulse; not modelled)
-  int impact_joint = -1;         ///< the joint of limit_impact, −1 when there is none
+  /// μ*, per DOF below the root (Model::dof() entries, a multi-DOF joint's
+  /// one per DOF: a box each; 0 for moving DOFs).
+  Eigen::VectorXd mu;
+  std::vector<JointState> state;  ///< per DOF, as mu
+  Eigen::VectorXd tau_friction;  ///< per DOF, as mu: what friction and limits put on it (−μ, or −f_c sign q̇ − b q̇)
+  /// nv × dof(): column j = ∂q̈/∂μ_j = −K e_j for a stuck DOF j, 0 otherwise
+  /// (rows: every entry of q̈, a floating base's first).
+  Eigen::MatrixXd dqdd_dmu;
+  std::vector<int> stuck;      ///< Θ₀: the stuck DOFs (indices into mu), ascending
+  double gauss_dual = 0.0;     ///< g(μ*) = Z(q̈*) + μ*ᵀ W q̈*
+  int iterations = 0;          ///< of the maximiser
+  bool converged = true;       ///< the maximiser met its KKT tolerance within max_iterations
+  double kkt_residual = 0.0;   ///< max violation of the optimality conditions [rad/s² or m/s²]
+  bool indeterminate = false;  ///< μ* is not unique; the effort-minimising one was chosen
+  bool limit_impact = false;   ///< a joint on a limit moves into it (needs an impulse; not modelled)
+  int impact_joint = -1;       ///< the joint of limit_impact, −1 when there is none
 };
 
 }  // namespace zwang

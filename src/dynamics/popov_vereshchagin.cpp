@@ -151,8 +151,8 @@ namespace {
 // on a's body and −A on r's, and b − f·β_lin − n·(ω_a × ω_r) is the set point
 // (kept on a's side; r's side has 0, the balance adds the two). Gravity
 // shifts both bodies' sweep accelerations alike and cancels.
-void relativeConstraintInBodyForm(const Model& model, const Task& task, const Task::ConstraintGroup& g, int col,
-                                  Workspace& ws) {
+void relativeConstraintInBodyForm(const Model& model, const Task& task, const TaskSolverOrder::ConstraintGroup& g,
+                                  int col, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const Transform Xa = framePlacementInBase(model, ws, g.frame);
   const Transform Xr = framePlacementInBase(model, ws, g.reference);
@@ -183,7 +183,7 @@ void relativeConstraintInBodyForm(const Model& model, const Task& task, const Ta
 // the column is +F on the joint's body and −F on its parent, and F·Ẍ_bias
 // goes to the set point (on the body's side, with the row's b). A different F
 // with F·S = 1 would differ by a force the joint itself transmits: same motion, same ν.
-void jointPieceInBodyForm(const Model& model, const Task& task, const Task::ConstraintGroup& g, int col,
+void jointPieceInBodyForm(const Model& model, const Task& task, const TaskSolverOrder::ConstraintGroup& g, int col,
                           Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int body = bodyOfDof(g.dof);  // the body the DOF moves (g.body is this side's: it or its parent)
@@ -206,9 +206,9 @@ void jointPieceInBodyForm(const Model& model, const Task& task, const Task::Cons
 //   A_w = [f; n + p × f],  A_wᵀ Ẍ = b − f·(ω × v_p) − f·g.
 void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
-  const std::vector<int>& user_row = task.solverRowToUserRow();
+  const std::vector<int>& user_row = solverOrder(task).solverRowToUserRow();
   int col = 0;
-  for (const Task::ConstraintGroup& g : task.groups()) {
+  for (const TaskSolverOrder::ConstraintGroup& g : solverOrder(task).groups()) {
     if (g.dof >= 0) {
       jointPieceInBodyForm(model, task, g, col++, ws);
       continue;
@@ -262,7 +262,7 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
   const Vec6& IAS = sw.IAS[at(i)];
   const Vec6& c = sw.c[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
-  const int first = task.firstColumn(i), k = task.activeColumns(i);
+  const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).activeColumns(i);
   double* sA = sw.SA.col(i).data();
   const double SS_D = S.squaredNorm() * inverse_D;
   for (int col = first; col < k; ++col) {
@@ -288,11 +288,11 @@ template <int kDofs>
 void jointBalanceUpdate(const Task& task, int first, int dofs, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int n = kDofs > 0 ? kDofs : dofs;
-  const int c0 = task.firstColumn(first), c1 = task.activeColumns(first);
+  const int c0 = solverOrder(task).firstColumn(first), c1 = solverOrder(task).activeColumns(first);
   const double* sA[6];
   for (int k = 0; k < n; ++k) {
     double* sA_k = sw.SA.col(first + k).data();
-    for (int r = task.activeColumns(first + k); r < c1; ++r) sA_k[r] = 0.0;
+    for (int r = solverOrder(task).activeColumns(first + k); r < c1; ++r) sA_k[r] = 0.0;
     sA[k] = sA_k;
   }
   for (int col = c0; col < c1; ++col) {
@@ -434,7 +434,7 @@ namespace {
 void condensedBalance(const Task& task, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int columns = task.solverColumns(), m = task.balanceRows();
-  const std::vector<int>& row = task.balanceRowOfColumn();
+  const std::vector<int>& row = solverOrder(task).balanceRowOfColumn();
   sw.L_rows.topLeftCorner(m, m).setZero();
   sw.L_scale_rows.head(m).setZero();
   sw.rhs.head(m).setZero();
@@ -454,7 +454,7 @@ void condensedBalance(const Task& task, Workspace& ws) {
 // ν of each solver column from ν of its balance row (both sides carry the row's ν).
 void expandToColumns(const Task& task, const Eigen::Ref<const Eigen::MatrixXd>& rows,
                      Eigen::Ref<Eigen::MatrixXd> columns) {
-  const std::vector<int>& row = task.balanceRowOfColumn();
+  const std::vector<int>& row = solverOrder(task).balanceRowOfColumn();
   for (int col = 0; col < task.solverColumns(); ++col) columns.row(col) = rows.row(row[at(col)]);
 }
 
@@ -463,7 +463,7 @@ void expandToColumns(const Task& task, const Eigen::Ref<const Eigen::MatrixXd>& 
 void balance(const Task& task, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.balanceRows();
-  const bool condensed = task.hasRelative();
+  const bool condensed = solverOrder(task).hasRelative();
   if (condensed) condensedBalance(task, ws);
   Eigen::MatrixXd& L = condensed ? sw.L_rows : sw.L;
   const Eigen::VectorXd& L_scale = condensed ? sw.L_scale_rows : sw.L_scale;
@@ -510,7 +510,7 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   for (int i = 1; i <= model.nv(); ++i) {
     const int p = model.parent(i);
     const Vec6 a_parent = p == i - 1 ? a_previous : sw.a[at(p)];
-    const int first = task.firstColumn(i), k = task.activeColumns(i) - first;
+    const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).activeColumns(i) - first;
     const double constraint = sw.SA.col(i).segment(first, k).dot(sw.nu.segment(first, k));        // Sᵀ A_i ν
     qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];  // line 28
     a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];                 // line 29
@@ -577,7 +577,7 @@ void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eig
     Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
     const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
     for (Eigen::Index c = from; c < to; ++c) dq[c - c0] = s.du(i, c);
-    const int first = task.firstColumn(i), ki = task.activeColumns(i);
+    const int first = solverOrder(task).firstColumn(i), ki = solverOrder(task).activeColumns(i);
     for (int r = first; r < ki; ++r) dq += sw.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
     const double* parent = da + model.parent(i) * da_stride;
     const Vec6& IAS = sw.IAS[at(i)];
@@ -625,7 +625,7 @@ void oneDofColumns(const Model& model, const Task& task, const Workspace& ws, co
   const Vec6& IAS = sw.IAS[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
   const bool to_world = model.parent(i) == 0;  // the world takes δF^a and does nothing with it
-  const int first = task.firstColumn(i), end = task.activeColumns(i);
+  const int first = solverOrder(task).firstColumn(i), end = solverOrder(task).activeColumns(i);
   const Eigen::Index begin = s.run_begin[i], run_end = s.run_end[i];
   const Eigen::Index own = begin < run_end && bodyOfDof(dofs[at(static_cast<int>(begin))]) == i ? begin : -1;
   double* const du = s.du.data() + i;  // row i
@@ -666,9 +666,10 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
   // The joint's constraint rows: its subtree's [rows_first, rows_first +
   // rows), DOF body k taking those before rows_end[k] (a joint row on one of
   // the joint's DOFs sits on that DOF's body, and only the bodies before see it).
-  const int rows_first = task.firstColumn(first), rows = task.activeColumns(first) - rows_first;
+  const int rows_first = solverOrder(task).firstColumn(first),
+            rows = solverOrder(task).activeColumns(first) - rows_first;
   int rows_end[6];
-  for (int k = 0; k < n; ++k) rows_end[k] = task.activeColumns(first + k) - rows_first;
+  for (int k = 0; k < n; ++k) rows_end[k] = solverOrder(task).activeColumns(first + k) - rows_first;
   // Line 20 for a column from below, all DOFs at once: δU₀ −= Y δF^a with
   // Y = Σ_k SᵀA_k W_k / D_k (kept transposed: a row's 6 entries side by side).
   auto Yt = s.joint_rows.leftCols(rows);
@@ -734,13 +735,13 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
   // outward pass's lanes, a block of columns at a time; else here, all at once.
-  const bool solve_in_lanes = !task.hasRelative() && !sw.balance_factorisation.by_eigen;
-  dU *= -1.0;                // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
-  if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
+  const bool solve_in_lanes = !solverOrder(task).hasRelative() && !sw.balance_factorisation.by_eigen;
+  dU *= -1.0;                             // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+  if (solverOrder(task).hasRelative()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
     auto dU_rows = sw.dU_rows.topLeftCorner(rows, k);
     dU_rows.setZero();
-    for (int col = 0; col < m; ++col) dU_rows.row(task.balanceRowOfColumn()[at(col)]) += dU.row(col);
+    for (int col = 0; col < m; ++col) dU_rows.row(solverOrder(task).balanceRowOfColumn()[at(col)]) += dU.row(col);
     auto dnu_rows = sw.dnu_rows.topLeftCorner(rows, k);
     balanceApplyColumns(sw.balance_factorisation, dU_rows, dnu_rows, sw.balance_factorisation.work.head(rows));
     expandToColumns(task, dnu_rows, dnu.topRows(m));
@@ -803,11 +804,11 @@ void taskResidual(const Task& task, Workspace& ws) {
   // picked components 1e-12).
   const int m = task.balanceRows();
   BalanceReport& report = ws.solution.balance;
-  if (!task.hasRelative()) {  // one column per row
+  if (!solverOrder(task).hasRelative()) {  // one column per row
     double sum2 = 0.0;
     bool met = true;
     int col = 0;
-    for (const Task::ConstraintGroup& g : task.groups()) {
+    for (const TaskSolverOrder::ConstraintGroup& g : solverOrder(task).groups()) {
       const Vec6& a = sw.a[at(g.body)];
       for (int k = 0; k < g.rows; ++k, ++col) {
         const auto A = sw.A_body.col(col);
@@ -826,9 +827,9 @@ void taskResidual(const Task& task, Workspace& ws) {
   auto size = sw.row_size.head(m);
   error.setZero();
   size.setZero();
-  const std::vector<int>& row = task.balanceRowOfColumn();
+  const std::vector<int>& row = solverOrder(task).balanceRowOfColumn();
   int col = 0;
-  for (const Task::ConstraintGroup& g : task.groups()) {
+  for (const TaskSolverOrder::ConstraintGroup& g : solverOrder(task).groups()) {
     const Vec6& a = sw.a[at(g.body)];
     for (int k = 0; k < g.rows; ++k, ++col) {
       const auto A = sw.A_body.col(col);
@@ -853,7 +854,7 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   if (task.hasContacts()) {
     sw.nu_motors.head(columns) = nu_all.head(columns);
     for (int col = 0; col < columns; ++col)
-      if (task.contactColumns()[at(col)]) sw.nu_motors[col] = 0.0;
+      if (solverOrder(task).contactColumns()[at(col)]) sw.nu_motors[col] = 0.0;
   }
   const VectorRef nu_solver = task.hasContacts() ? VectorRef(sw.nu_motors.head(columns)) : nu_all;
   // The wrenches A ν of each body's own constraints, summed inward and
@@ -868,7 +869,7 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   if (model.isChain()) {  // one running sum from the tip inward
     Vec6 carried = Vec6::Zero();
     for (int i = N; i >= 1; --i) {
-      const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
+      const int k_beyond = solverOrder(task).activeColumns(i + 1), k = solverOrder(task).activeColumns(i);
       carried.noalias() += sw.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
       tau_c[i - 1] = sw.S[at(i)].dot(carried);
     }
@@ -876,7 +877,7 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   }
   std::vector<Vec6>& carried = sw.constraint_wrench;
   for (int i = 1; i <= N; ++i) {  // body i's own columns: those on bodies ≥ i but not ≥ i + 1
-    const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
+    const int k_beyond = solverOrder(task).activeColumns(i + 1), k = solverOrder(task).activeColumns(i);
     carried[at(i)].noalias() = sw.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
   }
   for (int i = N; i >= 1; --i) {
@@ -919,7 +920,7 @@ void publishNu(const Task& task, Workspace& ws) {
   // Both columns of a relative row carry the row's ν: either may write it.
   // Mimic rows (after the user's) are the mechanism's, not the task's.
   for (int col = 0; col < task.solverColumns(); ++col) {
-    const int row = task.solverRowToUserRow()[at(col)];
+    const int row = solverOrder(task).solverRowToUserRow()[at(col)];
     if (row < m) ws.solution.nu[row] = sw.nu[col];
   }
 }

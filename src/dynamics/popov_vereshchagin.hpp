@@ -11,6 +11,7 @@
 #include "dynamics/workspace_scratch.hpp"
 
 #include "dynamics/checks.hpp"
+#include "dynamics/task_solver_order.hpp"
 
 namespace zwang::internal {
 

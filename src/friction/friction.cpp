@@ -226,7 +226,7 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
     const auto a = static_cast<Eigen::Index>(b);
     const int i = bodyOfDof(dofOfEntry(model, stuck[b]));
     const auto at_i = static_cast<std::size_t>(i);
-    const int first = task.firstColumn(i), count = task.activeColumns(i) - first;
+    const int first = solverOrder(task).firstColumn(i), count = solverOrder(task).activeColumns(i) - first;
     const auto SA = sw.SA.col(i).segment(first, count).cwiseAbs();
     const Vec6 IAS = sw.IAS[at_i].cwiseAbs();
     fs.curvature_terms[a] = (1.0 + IAS.dot(parentAccelerationTerms(model, ws, fs, a, i)) +
@@ -330,7 +330,8 @@ EffortChange effortAlongFlatDirections(const Model& model, const Task& task, con
   if (!task.hasContacts()) return EffortChange::Own;
   const int m = task.solverColumns(), n = model.dof();
   bool motor_rows = false;
-  for (int col = 0; col < m && !motor_rows; ++col) motor_rows = !task.contactColumns()[static_cast<std::size_t>(col)];
+  for (int col = 0; col < m && !motor_rows; ++col)
+    motor_rows = !solverOrder(task).contactColumns()[static_cast<std::size_t>(col)];
   if (!motor_rows) return EffortChange::Fixed;  // τ_c ≡ 0: τ_control = τ whatever μ
   MaximiserChoiceScratch& s = fs.choice;
   const auto N = s.null_basis.topLeftCorner(ns, nullity);

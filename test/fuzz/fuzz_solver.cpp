@@ -33,6 +33,8 @@
 #include "fuzz_common.hpp"
 #include "zwang/zwang.hpp"
 
+#include "dynamics/task_solver_order.hpp"  // the task's groups, to mutate their matrices
+
 #include "dynamics/workspace_scratch.hpp"  // the sweep's accelerations, checked finite too
 
 namespace {
@@ -298,7 +300,7 @@ TaskDraw drawTask(FuzzedDataProvider& in, const Model& chain, int frames) {
         group.reference >= 0 && group.reference != group.frame ? RowGroup::Kind::Relative : RowGroup::Kind::Frame;
     addGroup(group, task);
     draw.groups.push_back(group);
-    previous = &task.groups().back().A;
+    previous = &solverOrder(task).groups().back().A;
   }
   draw.targets.resize(task.constraintRows());
   for (Eigen::Index r = 0; r < draw.targets.size(); ++r) draw.targets[r] = signedLog(in, 1e-3, 1e3);

@@ -1,24 +1,13 @@
 #include "zwang/workspace.hpp"
 
+#include "dynamics/workspace_scratch.hpp"
 #include "friction/friction_scratch.hpp"
 
 namespace zwang {
 
-Workspace::Workspace(const Model& model, int max_constraint_rows)
-    : dof_(model.dof()),
-      capacity_(max_constraint_rows < 0 ? 0 : max_constraint_rows),
-      mimic_rows_(static_cast<int>(model.mimicJoints().size())) {
+WorkspaceScratch::WorkspaceScratch(const Model& model, int columns, int m) {
   const auto bodies = static_cast<std::size_t>(model.bodyCount());
-  const int n = dof_, m = balanceCapacity();
-  const int nv = model.nv();
-  solution.qdd.setZero(nv);
-  solution.nu.setZero(0);
-  solution.tau_constraint.setZero(nv);
-  solution.tau_control.setZero(nv);
-  kinematics.q.setZero(model.nq());
-  kinematics.qd.setZero(nv);
-  default_task_ = std::make_unique<Task>(model);
-
+  const int n = model.dof();
   Xworld.assign(bodies, Transform{});
   S.assign(bodies, Vec6::Zero());
   I.assign(bodies, RigidInertia{});
@@ -31,7 +20,6 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   D.assign(bodies, 0.0);
   inverse_D.assign(bodies, 0.0);
   u.assign(bodies, 0.0);
-  const int columns = columnCapacity();
   SA.setZero(columns, static_cast<Eigen::Index>(bodies));
   Ahat.setZero(6, columns);
   U.setZero(columns);
@@ -60,6 +48,23 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   f.assign(bodies, Vec6::Zero());
   constraint_wrench.assign(bodies, Vec6::Zero());
   Ic.assign(bodies, Mat6::Zero());
+  friction_scratch = std::make_unique<internal::FrictionScratch>(n, model.nv(), static_cast<int>(bodies), columns);
+}
+
+WorkspaceScratch::~WorkspaceScratch() = default;
+
+Workspace::Workspace(const Model& model, int max_constraint_rows)
+    : dof_(model.dof()),
+      capacity_(max_constraint_rows < 0 ? 0 : max_constraint_rows),
+      mimic_rows_(static_cast<int>(model.mimicJoints().size())) {
+  const int n = dof_;
+  const int nv = model.nv();
+  solution.qdd.setZero(nv);
+  solution.nu.setZero(0);
+  solution.tau_constraint.setZero(nv);
+  solution.tau_control.setZero(nv);
+  kinematics.q.setZero(model.nq());
+  kinematics.qd.setZero(nv);
   H.setZero(nv, nv);
   tau.setZero(nv);
 
@@ -68,7 +73,8 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
   friction.tau_friction.setZero(n);
   friction.dqdd_dmu.setZero(nv, n);
   friction.stuck.reserve(static_cast<std::size_t>(n));
-  friction_scratch_ = std::make_unique<internal::FrictionScratch>(n, nv, static_cast<int>(bodies), columns);
+  scratch_ = std::make_unique<WorkspaceScratch>(model, columnCapacity(), balanceCapacity());
+  default_task_ = std::make_unique<Task>(model);
 }
 
 Workspace::~Workspace() = default;

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The library's layers (docs/architecture.md): an internal header may be
-included only from its own folder or from a layer above it. Exits 1 naming
-every include that points the wrong way."""
+included only from its own folder or from a layer above it, and a public
+header names no internal header or namespace. Exits 1 naming every include
+that points the wrong way."""
 import pathlib
 import re
 import sys
@@ -15,7 +16,7 @@ allowed = {
     "dynamics": {"linalg", "dynamics"},
     "friction": {"linalg", "qp", "dynamics", "friction"},
     # The front ends' problem layer: above the library (which never includes it), below the front ends.
-    "problem": {"problem"},
+    "problem": {"problem", "model"},  # model/urdf_option_names.hpp: the front ends' spelling of the URDF options
     "cli": {"problem"},
     "python": {"problem"},
 }
@@ -27,10 +28,14 @@ for folder, may in allowed.items():
             m = include.search(line)
             if m and m.group(1) != "zwang" and m.group(1) not in may:
                 bad.append(f"{path.relative_to(root)}:{number}: {folder} includes {m.group(1)}/ ({line.strip()})")
-for path in sorted((root / "include").rglob("*.hpp")):  # public headers: no internal header at all
+# Public headers hold the public API only: no internal header, and no internal namespace.
+internal_name = re.compile(r"\b(internal|detail)::|namespace\s+(internal|detail)\b")
+for path in sorted((root / "include").rglob("*.hpp")):
     for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
         m = include.search(line)
         if m and m.group(1) != "zwang":
             bad.append(f"{path.relative_to(root)}:{number}: a public header includes {m.group(1)}/")
+        if internal_name.search(line):
+            bad.append(f"{path.relative_to(root)}:{number}: a public header names an internal namespace")
 print("\n".join(bad) if bad else f"layers: every include points one way ({', '.join(allowed)})")
 sys.exit(1 if bad else 0)

@@ -18,12 +18,15 @@
 #include "support/random_problem.hpp"
 #include "zwang/zwang.hpp"
 
+#include "model/split_mix64.hpp"  // the generator randomConfiguration draws from
+
 #ifdef ZWANG_CONFIGURATION_COUNT_ALLOCATIONS
 #include "counting_malloc.hpp"
 #endif
 
 using namespace zwang;
 using namespace zwang::testing;
+using zwang::internal::splitMix64;
 
 namespace {
 

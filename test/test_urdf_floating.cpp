@@ -13,8 +13,12 @@
 
 #include "zwang/zwang.hpp"
 
+#include "model/split_mix64.hpp"        // the generator randomConfiguration draws from
+#include "model/urdf_option_names.hpp"  // the front ends' names of the options
+
 using namespace zwang;
 using Catch::Matchers::Contains;
+using zwang::internal::splitMix64;
 
 namespace {
 
@@ -292,7 +296,8 @@ TEST_CASE("floating joints off the root; errors: a base on a floating file, a pl
   REQUIRE_THROWS_WITH(loadUrdfString(floating, withBase(BaseType::Planar)),
                       Contains("already has a floating root joint 'root_joint'"));
   // … unless the caller accepts the file's own base of the same type.
-  UrdfOptions match = withBase(BaseType::Free);
+  // With a front end's names for the options (their loader, found by argument-dependent lookup).
+  zwang::internal::NamedUrdfOptions match{withBase(BaseType::Free), {}};
   match.base_may_match_file = true;
   CHECK(loadUrdfString(floating, match).baseType() == BaseType::Free);
   match.base = BaseType::Planar;

@@ -19,6 +19,8 @@
 #include "support/urdf_writer.hpp"
 #include "zwang/zwang.hpp"
 
+#include "model/urdf_option_names.hpp"  // the front ends' names of the options
+
 using Catch::Contains;
 using namespace zwang;
 using namespace zwang::testing;
@@ -498,7 +500,8 @@ TEST_CASE("mimic joints: nothing left to move, or no finite position to lock at"
                       Catch::Equals("<string>: joint 'm2' (q = 1·q_nope + 0) mimics joint 'nope', which the URDF "
                                     "does not have: set UrdfOptions::mimic = MimicJoints::Lock to weld it at q = 0 "
                                     "(its position when 'nope' is at rest)"));
-  UrdfOptions cli;  // the names the CLI and Python give the lock option
+  // The names the CLI and Python give the lock option (their loader, found by argument-dependent lookup).
+  zwang::internal::NamedUrdfOptions cli;
   cli.names.lock_mimic = "--lock-mimic";
   REQUIRE_THROWS_WITH(loadUrdfString(missing, cli), Contains("which the URDF does not have: set --lock-mimic to weld"));
   cli.names.lock_mimic = "lock_mimic=True";

@@ -81,11 +81,6 @@ Status difference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q
 /// they cannot both hold). q_out has nq() entries.
 Status neutralConfiguration(const Model& model, Eigen::Ref<Eigen::VectorXd> q_out) noexcept;
 
-/// One step of the generator randomConfiguration draws from: SplitMix64
-/// (state += 0x9E3779B97F4A7C15, then two xor-shift-multiply rounds), a uniform
-/// 64-bit number from any state, the same on every platform.
-std::uint64_t splitMix64(std::uint64_t& state) noexcept;
-
 /// A random configuration drawn from `state` (advanced; the same state gives
 /// the same q on every platform), joint by joint in allJoints() order:
 ///   Free      : x, y, z uniform in [−1, 1] m, then a uniform random unit
@@ -101,8 +96,9 @@ std::uint64_t splitMix64(std::uint64_t& state) noexcept;
 ///               2h). So continuous joints and joints without limits draw from
 ///               [−π, π] (prismatic: [−1, 1] m). Mimic joints draw nothing: they
 ///               are set from their leaders.
-/// Each draw is u = (splitMix64(state) >> 11)·2⁻⁵³ ∈ [0, 1), mapped to
-/// (1 − u)·lo + u·hi. q_out has nq() entries.
+/// Each draw is u = (x >> 11)·2⁻⁵³ ∈ [0, 1), mapped to (1 − u)·lo + u·hi,
+/// with x the next number of SplitMix64 (state += 0x9E3779B97F4A7C15, then two
+/// xor-shift-multiply rounds): the same on every platform. q_out has nq() entries.
 Status randomConfiguration(const Model& model, std::uint64_t& state, Eigen::Ref<Eigen::VectorXd> q_out) noexcept;
 
 /// Normalise every quaternion of q (free and spherical joints, a free base's

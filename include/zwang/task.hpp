@@ -149,6 +149,27 @@ class Task {
   const std::vector<ModelWarning>& warnings() const { return warnings_; }
 
   // --- read by the solver -------------------------------------------------
+  /// One wrench, as the solver reads it.
+  struct AppliedWrench {
+    int frame;                  ///< frame index
+    Expressed expressed;        ///< axes of value
+    Vec6 value = Vec6::Zero();  ///< [f; n] at the frame origin
+  };
+  /// Number of solver columns: one per row, two for a row of a relative
+  /// constraint (one on each side).
+  int solverColumns() const { return static_cast<int>(solver_row_.size()); }
+  /// True when some constraint is a contact (addContact).
+  bool hasContacts() const { return has_contacts_; }
+  /// The wrenches, in the order of addWrench.
+  const std::vector<AppliedWrench>& wrenches() const { return wrenches_; }
+  /// Joint count of the model the task was made for (checked by every solve).
+  int modelDof() const { return dof_; }
+  /// Frame count of the model the task was made for (checked by every solve).
+  int modelFrames() const { return frames_; }
+
+ private:
+  // --- the solver's view (src/dynamics/task_solver_order.hpp) ------------
+  friend class TaskSolverOrder;
   /// The constraints on one frame, as the solver reads them. A relative
   /// constraint appears twice: on the constrained frame's body, and (with
   /// `reference_side`) on the reference frame's body, where its force is −A ν.
@@ -170,20 +191,11 @@ class Task {
     bool mimic_row = false;    ///< a piece of a mimic row (its first_row counts the mimic rows)
     bool contact = false;      ///< the environment supplies its force (addContact)
   };
-  /// One wrench, as the solver reads it.
-  struct AppliedWrench {
-    int frame;                  ///< frame index
-    Expressed expressed;        ///< axes of value
-    Vec6 value = Vec6::Zero();  ///< [f; n] at the frame origin
-  };
   /// Groups sorted by body, last body first ("solver order"): since the
   /// bodies are in depth-first order, the columns acting on a body's subtree
   /// are then a contiguous block (columnRange), and for a chain the columns
   /// acting on bodies i..N a leading block.
   const std::vector<ConstraintGroup>& groups() const { return groups_; }
-  /// Number of solver columns: one per row, two for a row of a relative
-  /// constraint (one on each side).
-  int solverColumns() const { return static_cast<int>(solver_row_.size()); }
   /// The row of each solver column: a user row (< constraintRows()) or a mimic row.
   const std::vector<int>& solverRowToUserRow() const { return solver_row_; }
   /// Number of solver columns acting on bodies b, b+1, … (a leading block).
@@ -197,18 +209,9 @@ class Task {
   bool hasRelative() const { return has_relative_; }
   /// The balance row of each solver column (the identity without relative constraints).
   const std::vector<int>& balanceRowOfColumn() const { return balance_row_; }
-  /// True when some constraint is a contact (addContact).
-  bool hasContacts() const { return has_contacts_; }
   /// Per solver column: 1 when its force is a contact's (the environment's), else 0.
   const std::vector<char>& contactColumns() const { return contact_column_; }
-  /// The wrenches, in the order of addWrench.
-  const std::vector<AppliedWrench>& wrenches() const { return wrenches_; }
-  /// Joint count of the model the task was made for (checked by every solve).
-  int modelDof() const { return dof_; }
-  /// Frame count of the model the task was made for (checked by every solve).
-  int modelFrames() const { return frames_; }
 
- private:
   int dof_;
   int frames_;
   std::vector<std::string> frame_names_;  // copied, so the Task does not dangle

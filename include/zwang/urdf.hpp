@@ -114,16 +114,6 @@ struct UrdfOptions {
   /// true, the file's joint is used when its type is the one `base` asks for,
   /// ModelError otherwise. For callers that always name the base (the CLI's "base").
   bool base_may_match_file = false;
-  /// How the caller spells these options, for the hints in messages (the CLI
-  /// says "--tip", Python "tip=").
-  struct Names {
-    std::string tip = "UrdfOptions::tip";                               ///< the name of the tip option
-    std::string rotor_inertia = "UrdfOptions::rotor_inertia";           ///< the name of the rotor_inertia option
-    std::string attach_beyond_tip = "UrdfOptions::attach_beyond_tip";   ///< the name of the attach_beyond_tip option
-    std::string lock_mimic = "UrdfOptions::mimic = MimicJoints::Lock";  ///< how to ask for MimicJoints::Lock
-    std::string refuse_mimic = "UrdfOptions::mimic = MimicJoints::Refuse";  ///< how MimicJoints::Refuse was asked for
-    std::string base = "UrdfOptions::base";                                 ///< the name of the base option
-  } names;                                                                  ///< see Names
 };
 
 /// Throw ModelError with a message naming the file (or "<string>"), the link or

@@ -246,10 +246,10 @@ int commandInfo(int argc, char** argv) {
       throw UsageError("info", std::string("--base: ") + e.what());
     }
   }
-  const UrdfOptions options = problem::urdfOptions(request);
+  const internal::NamedUrdfOptions options = problem::urdfOptions(request);
   Model model;
   try {
-    model = loadUrdfFile(path, options);
+    model = internal::loadUrdfFile(path, options);
   } catch (const ModelError& e) {
     throw CliError(kExitError, e.what());
   }

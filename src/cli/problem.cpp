@@ -302,19 +302,19 @@ void placeJointValues(const JsonReader& in, const Model& model, const JointValue
 }
 
 // The URDF options of the problem's keys, named as the problem names them in the loader's messages.
-UrdfOptions urdfOptions(const Problem& p) {
+internal::NamedUrdfOptions urdfOptions(const Problem& p) {
   problem::ModelRequest request{p.root, p.tip, p.strict, p.attach_beyond_tip, p.lock_mimic, p.base.type, {}};
   request.names = {"\"tip\"", "\"rotor_inertia\"", "\"attach_beyond_tip\"", "\"lock_mimic\": true"};
   request.names.base = "base.type";
-  UrdfOptions urdf = problem::urdfOptions(request);  // a fixed base when there is no "base"
-  urdf.base_may_match_file = true;                   // "base" also names a floating root joint of the file
+  internal::NamedUrdfOptions urdf = problem::urdfOptions(request);  // a fixed base when there is no "base"
+  urdf.base_may_match_file = true;  // "base" also names a floating root joint of the file
   return urdf;
 }
 
 Model loadModel(const JsonReader& in, const Problem& p) {
   Model model;
   try {
-    model = loadUrdfFile(p.model_path, urdfOptions(p));
+    model = internal::loadUrdfFile(p.model_path, urdfOptions(p));
   } catch (const ModelError& e) {
     // A relative "model" the loader could not open: say what it was resolved to and why.
     std::error_code ec;

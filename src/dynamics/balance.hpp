@@ -8,6 +8,23 @@
 
 namespace zwang::internal {
 
+// The factorisation of the last balance, kept so that further right-hand sides
+// (the friction extension's unit torques) reuse it (src/dynamics/balance.cpp).
+struct BalanceFactorisation {
+  bool by_eigen = false;          // false: 𝓛 = C Cᵀ (certified regular); true: eigenpairs of 𝓛̃
+  Eigen::MatrixXd factor;         // C (lower), or the eigenvectors V of 𝓛̃ (by_eigen)
+  Eigen::VectorXd eigenvalues;    // σ̃_k (by_eigen)
+  Eigen::VectorXd gain;           // what each eigen-direction is multiplied by: 1/σ̃, damped, or 0
+  Eigen::VectorXd equilibration;  // E_ii = 1/√𝓛_ii (1 on a row nothing moves)
+  // Orthonormal basis of the directions E v_k with σ̃_k below singular_threshold
+  // (the first `near_null_count` columns), and the weight of each in the
+  // Euclidean projection: 1 at exact rank loss, falling to 0 at the threshold.
+  Eigen::MatrixXd near_null_basis;
+  Eigen::VectorXd near_null_weight;  // the weight of each of those directions (see near_null_basis)
+  int near_null_count = 0;           // columns of near_null_basis in use
+  Eigen::VectorXd work;              // scratch of balanceApply (V's coordinates)
+};
+
 // Solves 𝓛 ν = r for the symmetric positive semi-definite m×m matrix `L`
 // (only its lower triangle is read; it is overwritten), m = L.rows(). Two ways,
 // recorded in `f` so that balanceApply can reuse them:

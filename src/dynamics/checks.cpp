@@ -16,7 +16,8 @@ Status velocitySizeMismatch(const Model& model, const char* name, Eigen::Index s
 }
 
 Status workspaceMismatch(const Model& model, const Workspace& ws) {
-  const bool bodies_fit = static_cast<int>(ws.S.size()) == model.bodyCount();
+  const WorkspaceScratch& sw = scratchOf(ws);
+  const bool bodies_fit = static_cast<int>(sw.S.size()) == model.bodyCount();
   // One of the two of the right size: the workspace fits, the other was resized since.
   if (bodies_fit && ws.tau.size() == model.nv())
     return Status::error(StatusCode::SizeMismatch,

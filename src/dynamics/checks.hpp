@@ -9,6 +9,8 @@
 #include "zwang/status.hpp"
 #include "zwang/workspace.hpp"
 
+#include "dynamics/workspace_scratch.hpp"
+
 namespace zwang::internal {
 
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
@@ -54,8 +56,9 @@ inline Status checkVelocityVector(const Model& model, const char* name, const Ve
 // and τ are nv × nv and nv) must be refused before anything is written:
 // Workspace::dof() alone cannot tell a fixed arm from the same arm floating.
 inline bool workspaceFitsModel(const Model& model, const Workspace& ws) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   return ws.tau.size() == model.nv() && ws.H.rows() == model.nv() && ws.H.cols() == model.nv() &&
-         static_cast<int>(ws.S.size()) == model.bodyCount();
+         static_cast<int>(sw.S.size()) == model.bodyCount();
 }
 // The ModelMismatch status for a workspace that does not fit (names both nv),
 // or SizeMismatch for a workspace that fits whose H or τ a user resized.

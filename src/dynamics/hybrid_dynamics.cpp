@@ -9,6 +9,7 @@ namespace zwang {
 Status solveHybridDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                            const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
                            const Task& task) noexcept {
+  WorkspaceScratch& sw = scratchOf(ws);
   using namespace internal;
   ws.kinematics.stage = KinematicsStage::None;  // until the sweeps below compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
@@ -22,7 +23,7 @@ Status solveHybridDynamics(const Model& model, Workspace& ws, const Eigen::Ref<c
   out.base_acceleration_world = baseClassicalAcceleration(model, ws);
   taskResidual(task, ws);  // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
-  constraintTorques(model, task, ws, ws.nu.head(task.solverColumns()), out.tau_constraint);
+  constraintTorques(model, task, ws, sw.nu.head(task.solverColumns()), out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   out.gauss = gaussFunction(model, task, out.qdd, tau, ws);
   return {};

@@ -16,6 +16,7 @@ ZWANG_FLATTEN void recursiveNewtonEuler(const Model& model, const Task& task,
                                         const Eigen::Ref<const Eigen::VectorXd>& q_all,
                                         const Eigen::Ref<const Eigen::VectorXd>& qd_all,
                                         const Eigen::Ref<const Eigen::VectorXd>& qdd, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int N = model.nv();
   Eigen::VectorXd& tau = ws.tau;
   const std::vector<Dof>& dofs = model.dofs();
@@ -25,35 +26,35 @@ ZWANG_FLATTEN void recursiveNewtonEuler(const Model& model, const Task& task,
   // (src/dynamics/sweeps.hpp): no transforms between bodies. Gravity is the
   // world's acceleration [−g; 0].
   internal::outwardKinematics(model, q_all, qd_all, ws, true);
-  ws.a_world = ws.a[0] = internal::gravityAcceleration(task.gravity);
+  sw.a_world = sw.a[0] = internal::gravityAcceleration(task.gravity);
   // A body whose parent is the body before it (every body of a chain, most of
   // a tree's) takes the parent's value from a register, not from the store
   // just made: a load that waits on that store costs more than the sum.
-  Vec6 a_previous = ws.a[0];
+  Vec6 a_previous = sw.a[0];
   for (int i = 1; i <= N; ++i) {
     const int p = model.parent(i);
-    const Vec6 a = (p == i - 1 ? a_previous : ws.a[at(p)]) + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];
-    ws.a[at(i)] = a;
+    const Vec6 a = (p == i - 1 ? a_previous : sw.a[at(p)]) + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];
+    sw.a[at(i)] = a;
     a_previous = a;
   }
   ws.kinematics.stage = KinematicsStage::Accelerations;
   ws.kinematics.model = &model;
   internal::applyExternalWrenches(model, task, ws);
-  for (int i = 1; i <= N; ++i) ws.f[at(i)] = ws.I[at(i)] * ws.a[at(i)] + ws.Fbias[at(i)];
+  for (int i = 1; i <= N; ++i) sw.f[at(i)] = sw.I[at(i)] * sw.a[at(i)] + sw.Fbias[at(i)];
 
   // Inward: the child just done passes its force to body i − 1 in a register
-  // when that is its parent; other parents collect in ws.f. The world (body
+  // when that is its parent; other parents collect in sw.f. The world (body
   // 0) takes what reaches it: the ground carries it.
   Vec6 to_previous = Vec6::Zero();
   for (int i = N; i >= 1; --i) {
-    const Vec6 f = ws.f[at(i)] + to_previous;
-    tau[i - 1] = ws.S[at(i)].dot(f) + dofs[at(i - 1)].rotor_inertia * qdd[i - 1];
+    const Vec6 f = sw.f[at(i)] + to_previous;
+    tau[i - 1] = sw.S[at(i)].dot(f) + dofs[at(i - 1)].rotor_inertia * qdd[i - 1];
     const int p = model.parent(i);
     to_previous.setZero();
     if (p == i - 1)
       to_previous = f;
     else if (p > 0)
-      ws.f[at(p)] += f;
+      sw.f[at(p)] += f;
   }
 }
 
@@ -83,6 +84,7 @@ Status inverseDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const
 namespace {
 
 void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int N = model.nv();
   const std::vector<Dof>& dofs = model.dofs();
   auto at = [](int i) { return static_cast<std::size_t>(i); };
@@ -97,22 +99,22 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
   // one child, so all its DOFs see its last body's I^c: only that one is
   // formed and handed to the parent (the world, body 0, takes nothing).
   for (int i = 1; i <= N; ++i)
-    if (i == N || model.jointStart(i + 1) == i + 1) ws.Ic[at(i)] = ws.I[at(i)].matrix();
+    if (i == N || model.jointStart(i + 1) == i + 1) sw.Ic[at(i)] = sw.I[at(i)].matrix();
   for (int last = N; last >= 1;) {
     const int first = model.jointStart(last), p = model.parent(first);
-    const Mat6& Ic = ws.Ic[at(last)];
-    if (p > 0) ws.Ic[at(p)] += Ic;  // base coordinates: composite inertias add
+    const Mat6& Ic = sw.Ic[at(last)];
+    if (p > 0) sw.Ic[at(p)] += Ic;  // base coordinates: composite inertias add
     for (int i = last; i >= first; --i) {
-      const Vec6 F = Ic * ws.S[at(i)];
+      const Vec6 F = Ic * sw.S[at(i)];
       const int row = i - 1;
-      ws.H(row, row) = ws.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
+      ws.H(row, row) = sw.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
       // H_kj ≠ 0 only for the DOFs j supporting k (its ancestors); the rest of
       // row k below the diagonal is the zeros of the branches between them
       // (none on a chain): each entry written once, with no pass over all of H.
       for (int j = i - 1, a = model.parent(i); j >= 1; --j) {
         double h = 0.0;
         if (j == a) {
-          h = ws.S[at(j)].dot(F);
+          h = sw.S[at(j)].dot(F);
           a = model.parent(a);
         }
         ws.H(row, j - 1) = ws.H(j - 1, row) = h;

@@ -21,22 +21,23 @@ template <bool kInertia, bool kVelocity>
 ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint,
                                           const Eigen::Ref<const Eigen::VectorXd>& q,
                                           const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int i = joint.v_index + 1;
   const auto b = static_cast<std::size_t>(i);
   const auto p = static_cast<std::size_t>(model.parent(i));
-  const Transform& X = ws.Xworld[b] = joint.transform(q[joint.q_index]) * ws.Xworld[p];  // line 4: ⁱX₀
-  Vec6& S = ws.S[b];
+  const Transform& X = sw.Xworld[b] = joint.transform(q[joint.q_index]) * sw.Xworld[p];  // line 4: ⁱX₀
+  Vec6& S = sw.S[b];
   motionSubspace(joint.isRevolute(), X.E.transpose() * joint.axis, X.r, S);  // the axis in the world
-  if (kInertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
+  if (kInertia) sw.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
   if (kVelocity) {
     const Vec6 vJ = S * qd[i - 1];
-    const Vec6 v = ws.v[b] = ws.v[p] + vJ;                            // line 5
-    ws.c[b] = spatial::crossMotion(v, vJ);                            // line 6: Ṡ_i q̇_i = Ẋ_i × S_i q̇_i
-    if (kInertia) ws.Fbias[b] = spatial::crossForce(v, ws.I[b] * v);  // line 7, without F_ext
+    const Vec6 v = sw.v[b] = sw.v[p] + vJ;                            // line 5
+    sw.c[b] = spatial::crossMotion(v, vJ);                            // line 6: Ṡ_i q̇_i = Ẋ_i × S_i q̇_i
+    if (kInertia) sw.Fbias[b] = spatial::crossForce(v, sw.I[b] * v);  // line 7, without F_ext
   } else {
-    ws.v[b].setZero();
-    ws.c[b].setZero();
-    ws.Fbias[b].setZero();
+    sw.v[b].setZero();
+    sw.c[b].setZero();
+    sw.Fbias[b].setZero();
   }
 }
 
@@ -46,45 +47,46 @@ ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint
 template <bool kInertia, bool kVelocity>
 void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
                         const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const std::vector<Dof>& dofs = model.dofs();
   const int first = joint.v_index + 1, last = joint.v_index + joint.nv();
   const auto p = static_cast<std::size_t>(model.parent(first));
-  const Transform X = joint.transform(q.data() + joint.q_index) * ws.Xworld[p];  // line 4: ⁱX₀
+  const Transform X = joint.transform(q.data() + joint.q_index) * sw.Xworld[p];  // line 4: ⁱX₀
   // The joint frame's axes in the world, for DOFs whose axis is fixed there
   // (a planar joint's x and y); the others' axes turn with the child.
   bool any_in_joint_frame = false;
   for (int i = first; i <= last; ++i) any_in_joint_frame |= dofs[static_cast<std::size_t>(i - 1)].in_joint_frame;
   const Mat3 Et_joint_frame =
-      any_in_joint_frame ? Mat3(ws.Xworld[p].E.transpose() * joint.placement.E.transpose()) : Mat3::Zero();
+      any_in_joint_frame ? Mat3(sw.Xworld[p].E.transpose() * joint.placement.E.transpose()) : Mat3::Zero();
   const Mat3 Et_child = X.E.transpose();
-  Vec6 v = ws.v[p];
+  Vec6 v = sw.v[p];
   Vec6 vJ_child = Vec6::Zero(), vJ_joint_frame = Vec6::Zero();  // S q̇ by the frame its axes are fixed in
   for (int i = first; i <= last; ++i) {
     const auto b = static_cast<std::size_t>(i);
     const Dof& dof = dofs[b - 1];
-    ws.Xworld[b] = X;
-    Vec6& S = ws.S[b];
+    sw.Xworld[b] = X;
+    Vec6& S = sw.S[b];
     motionSubspace(dof.rotation, (dof.in_joint_frame ? Et_joint_frame : Et_child) * dof.axis, X.r, S);
-    ws.c[b].setZero();
-    ws.Fbias[b].setZero();
-    if (kInertia && i < last) ws.I[b] = RigidInertia{};
+    sw.c[b].setZero();
+    sw.Fbias[b].setZero();
+    if (kInertia && i < last) sw.I[b] = RigidInertia{};
     if (kVelocity) {
       const Vec6 vJ = S * qd[i - 1];
-      ws.v[b] = v += vJ;  // line 5
+      sw.v[b] = v += vJ;  // line 5
       (dof.in_joint_frame ? vJ_joint_frame : vJ_child) += vJ;
     } else {
-      ws.v[b].setZero();
+      sw.v[b].setZero();
     }
   }
   const auto b = static_cast<std::size_t>(last);
-  if (kInertia) ws.I[b] = spatial::inverseTransformInertia(X, model.inertia(last));
+  if (kInertia) sw.I[b] = spatial::inverseTransformInertia(X, model.inertia(last));
   // Line 6 on the joint's last body: Ẍ_bias = Ṡ q̇, where an axis fixed in a
   // body moving with Ẋ turns as Ṡ = Ẋ × S (the child's for most, the
   // parent's for a planar joint's x and y); line 7 there.
   if (kVelocity) {
-    ws.c[b] = spatial::crossMotion(v, vJ_child);
-    if (any_in_joint_frame) ws.c[b] += spatial::crossMotion(ws.v[p], vJ_joint_frame);
-    if (kInertia) ws.Fbias[b] = spatial::crossForce(v, ws.I[b] * v);
+    sw.c[b] = spatial::crossMotion(v, vJ_child);
+    if (any_in_joint_frame) sw.c[b] += spatial::crossMotion(sw.v[p], vJ_joint_frame);
+    if (kInertia) sw.Fbias[b] = spatial::crossForce(v, sw.I[b] * v);
   }
 }
 
@@ -117,10 +119,11 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
 }
 
 void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   for (const Task::AppliedWrench& w : task.wrenches()) {
     const int body = model.frame(w.frame).body;
     if (body == 0) continue;  // a wrench on the world (a fixed base) moves nothing
-    ws.Fbias[static_cast<std::size_t>(body)] -= wrenchInBase(model, ws, w.frame, w.expressed, w.value);
+    sw.Fbias[static_cast<std::size_t>(body)] -= wrenchInBase(model, ws, w.frame, w.expressed, w.value);
   }
 }
 
@@ -234,10 +237,11 @@ Vec6 velocityAtPoint(const Vec6& m, const Vec3& p) {
 // that move it: those on the path from its body to the world.
 void jacobianColumns(const Model& model, const Workspace& ws, int frame, Expressed expressed,
                      Eigen::Ref<Eigen::MatrixXd>& J) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   J.setZero();
   for (int i = model.frame(frame).body; i >= 1; i = model.parent(i))
-    J.col(i - 1) = express(X, expressed, velocityAtPoint(ws.S[static_cast<std::size_t>(i)], X.r));
+    J.col(i - 1) = express(X, expressed, velocityAtPoint(sw.S[static_cast<std::size_t>(i)], X.r));
 }
 
 }  // namespace
@@ -268,21 +272,23 @@ Status framePose(const Model& model, const Workspace& ws, const Eigen::Ref<const
 Status frameVelocity(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                      const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, Expressed expressed,
                      Vec6& velocity) noexcept {
+  const WorkspaceScratch& sw = scratchOf(ws);
   if (Status s = checkQuery(model, ws, q, qd, frame, KinematicsStage::Velocities, "frameVelocity"); !s) return s;
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   // Ẋ of the frame's body (a floating base's motion included), seen at the frame origin.
-  velocity = express(X, expressed, velocityAtPoint(ws.v[static_cast<std::size_t>(model.frame(frame).body)], X.r));
+  velocity = express(X, expressed, velocityAtPoint(sw.v[static_cast<std::size_t>(model.frame(frame).body)], X.r));
   return {};
 }
 
 Status frameAcceleration(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept {
+  const WorkspaceScratch& sw = scratchOf(ws);
   if (Status s = checkQuery(model, ws, q, qd, frame, KinematicsStage::Accelerations, "frameAcceleration"); !s) return s;
-  // ws.a holds the sweep's accelerations, true + [−g; 0] (= ws.a_world).
+  // sw.a holds the sweep's accelerations, true + [−g; 0] (= sw.a_world).
   const Transform X = internal::framePlacementInBase(model, ws, frame);
   const auto b = static_cast<std::size_t>(model.frame(frame).body);
-  acceleration = express(X, expressed, internal::classicalAtPoint(ws.a[b] - ws.a_world, ws.v[b], X.r));
+  acceleration = express(X, expressed, internal::classicalAtPoint(sw.a[b] - sw.a_world, sw.v[b], X.r));
   return {};
 }
 

@@ -151,12 +151,13 @@ namespace {
 // on a's body and −A on r's, and b − f·β_lin − n·(ω_a × ω_r) is the set point
 // (kept on a's side; r's side has 0, the balance adds the two). Gravity
 // shifts both bodies' sweep accelerations alike and cancels.
-void relativeConstraintInBodyForm(const Model& model, const Task& task, const Task::ConstraintGroup& g, int col,
-                                  Workspace& ws) {
+void relativeConstraintInBodyForm(const Model& model, const Task& task, const TaskSolverOrder::ConstraintGroup& g,
+                                  int col, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const Transform Xa = framePlacementInBase(model, ws, g.frame);
   const Transform Xr = framePlacementInBase(model, ws, g.reference);
-  const Vec6& va = ws.v[at(model.frame(g.frame).body)];
-  const Vec6& vr = ws.v[at(model.frame(g.reference).body)];
+  const Vec6& va = sw.v[at(model.frame(g.frame).body)];
+  const Vec6& vr = sw.v[at(model.frame(g.reference).body)];
   const Vec3 wa = va.tail<3>(), wr = vr.tail<3>();
   const Vec3 pa_dot = va.head<3>() + wa.cross(Xa.r), pr_dot = vr.head<3>() + wr.cross(Xr.r);
   const Vec3 d = Xa.r - Xr.r;
@@ -168,9 +169,9 @@ void relativeConstraintInBodyForm(const Model& model, const Task& task, const Ta
   const double sign = g.reference_side ? -1.0 : 1.0;
   for (int k = 0; k < g.rows; ++k) {
     const Vec3 f = R * g.A.col(k).head<3>(), n = R * g.A.col(k).tail<3>();
-    ws.A_body.col(col + k) << sign * f, sign * (n + Xa.r.cross(f));
+    sw.A_body.col(col + k) << sign * f, sign * (n + Xa.r.cross(f));
     const double b = task.targets()[g.first_row + k];
-    ws.b_body[col + k] = g.reference_side ? 0.0 : b - f.dot(beta_lin) - n.dot(beta_ang);
+    sw.b_body[col + k] = g.reference_side ? 0.0 : b - f.dot(beta_lin) - n.dot(beta_ang);
   }
 }
 
@@ -182,19 +183,20 @@ void relativeConstraintInBodyForm(const Model& model, const Task& task, const Ta
 // the column is +F on the joint's body and −F on its parent, and F·Ẍ_bias
 // goes to the set point (on the body's side, with the row's b). A different F
 // with F·S = 1 would differ by a force the joint itself transmits: same motion, same ν.
-void jointPieceInBodyForm(const Model& model, const Task& task, const Task::ConstraintGroup& g, int col,
+void jointPieceInBodyForm(const Model& model, const Task& task, const TaskSolverOrder::ConstraintGroup& g, int col,
                           Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int body = bodyOfDof(g.dof);  // the body the DOF moves (g.body is this side's: it or its parent)
-  const Vec6& S = ws.S[at(body)];
+  const Vec6& S = sw.S[at(body)];
   Vec6 F;
   if (model.dofs()[at(g.dof)].rotation)
     F << Vec3::Zero(), S.tail<3>();
   else
-    F << S.head<3>(), ws.Xworld[at(body)].r.cross(S.head<3>());
-  ws.A_body.col(col) = ((g.reference_side ? -1.0 : 1.0) * g.coefficient) * F;
+    F << S.head<3>(), sw.Xworld[at(body)].r.cross(S.head<3>());
+  sw.A_body.col(col) = ((g.reference_side ? -1.0 : 1.0) * g.coefficient) * F;
   // A joint row's set point q̈_j = b (a mimic row's is 0) joins F·Ẍ_bias on the body's side.
   const double b = g.mimic_row ? 0.0 : task.targets()[g.first_row];
-  ws.b_body[col] = g.reference_side ? 0.0 : b + g.coefficient * F.dot(ws.c[at(body)]);
+  sw.b_body[col] = g.reference_side ? 0.0 : b + g.coefficient * F.dot(sw.c[at(body)]);
 }
 
 // The task's constraints as unit forces on their bodies in base coordinates,
@@ -203,9 +205,10 @@ void jointPieceInBodyForm(const Model& model, const Task& task, const Task::Cons
 // acceleration is"; the sweep works with spatial accelerations shifted by [−g; 0]):
 //   A_w = [f; n + p × f],  A_wᵀ Ẍ = b − f·(ω × v_p) − f·g.
 void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) {
-  const std::vector<int>& user_row = task.solverRowToUserRow();
+  WorkspaceScratch& sw = scratchOf(ws);
+  const std::vector<int>& user_row = solverOrder(task).solverRowToUserRow();
   int col = 0;
-  for (const Task::ConstraintGroup& g : task.groups()) {
+  for (const TaskSolverOrder::ConstraintGroup& g : solverOrder(task).groups()) {
     if (g.dof >= 0) {
       jointPieceInBodyForm(model, task, g, col++, ws);
       continue;
@@ -216,7 +219,7 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
       continue;
     }
     const Transform X = framePlacementInBase(model, ws, g.frame);  // ᶠX₀
-    const Vec6& v = ws.v[at(g.body)];
+    const Vec6& v = sw.v[at(g.body)];
     const Vec3 w = v.tail<3>();
     const Vec3 classical_shift = w.cross(v.head<3>() + w.cross(X.r));  // ω × v_p
     const Mat3 R = X.E.transpose();
@@ -226,9 +229,9 @@ void constraintsInBodyForm(const Model& model, const Task& task, Workspace& ws) 
         f = R * f;
         n = R * n;
       }
-      ws.A_body.col(col) << f, n + X.r.cross(f);
+      sw.A_body.col(col) << f, n + X.r.cross(f);
       const double b = task.targets()[user_row[at(col)]];
-      ws.b_body[col] = b - f.dot(classical_shift) - f.dot(task.gravity);
+      sw.b_body[col] = b - f.dot(classical_shift) - f.dot(task.gravity);
     }
   }
 }
@@ -255,22 +258,23 @@ namespace {
 // joint's bodies before its last) and line 20 skips Aᵀ Ẍ_bias.
 template <bool kBalance, bool kBias>
 inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace& ws) {
-  ConstraintMatrix& A = ws.Ahat;
-  const Vec6& S = ws.S[at(i)];
-  const Vec6& IAS = ws.IAS[at(i)];
-  const Vec6& c = ws.c[at(i)];
-  const double inverse_D = ws.inverse_D[at(i)];
-  const int first = task.firstColumn(i), k = task.activeColumns(i);
-  double* sA = ws.SA.col(i).data();
+  WorkspaceScratch& sw = scratchOf(ws);
+  ConstraintMatrix& A = sw.Ahat;
+  const Vec6& S = sw.S[at(i)];
+  const Vec6& IAS = sw.IAS[at(i)];
+  const Vec6& c = sw.c[at(i)];
+  const double inverse_D = sw.inverse_D[at(i)];
+  const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).activeColumns(i);
+  double* sA = sw.SA.col(i).data();
   const double SS_D = S.squaredNorm() * inverse_D;
   for (int col = first; col < k; ++col) {
     sA[col] = S.dot(A.col(col));                         // (Sᵀ A_i)ᵀ
-    ws.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
+    sw.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
   }
   for (int col = first; col < k; ++col) {
     const double sA_D = sA[col] * inverse_D;
-    ws.U[col] += kBias ? A.col(col).dot(c) + sA[col] * u_D : sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
-    double* L_col = &ws.L(0, col);                                           // line 21 (sign: see top), lower triangle
+    sw.U[col] += kBias ? A.col(col).dot(c) + sA[col] * u_D : sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
+    double* L_col = &sw.L(0, col);                                           // line 21 (sign: see top), lower triangle
     if (kBalance)
       for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
     A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
@@ -284,19 +288,20 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
 // DOFs sits on that DOF's body): its SᵀA is zero beyond. kDofs 0: n at run time.
 template <int kDofs>
 void jointBalanceUpdate(const Task& task, int first, int dofs, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int n = kDofs > 0 ? kDofs : dofs;
-  const int c0 = task.firstColumn(first), c1 = task.activeColumns(first);
+  const int c0 = solverOrder(task).firstColumn(first), c1 = solverOrder(task).activeColumns(first);
   const double* sA[6];
   for (int k = 0; k < n; ++k) {
-    double* sA_k = ws.SA.col(first + k).data();
-    for (int r = task.activeColumns(first + k); r < c1; ++r) sA_k[r] = 0.0;
+    double* sA_k = sw.SA.col(first + k).data();
+    for (int r = solverOrder(task).activeColumns(first + k); r < c1; ++r) sA_k[r] = 0.0;
     sA[k] = sA_k;
   }
   for (int col = c0; col < c1; ++col) {
     double w[6];  // SᵀA_k / D_k of this column
-    for (int k = 0; k < n; ++k) w[k] = sA[k][col] * ws.inverse_D[at(first + k)];
+    for (int k = 0; k < n; ++k) w[k] = sA[k][col] * sw.inverse_D[at(first + k)];
     const Eigen::Index len = c1 - col;
-    Eigen::Map<Eigen::VectorXd> L_col(&ws.L(col, col), len);
+    Eigen::Map<Eigen::VectorXd> L_col(&sw.L(col, col), len);
     auto term = [&](int k) { return Eigen::Map<const Eigen::VectorXd>(sA[k] + col, len) * w[k]; };
     // One expression: one vectorised pass over the column, the sum in k order.
     if (kDofs == 6)
@@ -325,12 +330,13 @@ void jointBalanceUpdate(const Task& task, int first, int last, Workspace& ws) {
 
 // Line 13's D and 1/D of DOF body i from its I^A S, or Degenerate.
 inline Status pivot(const Dof& dof, int i, Workspace& ws) {
-  const double D = dof.rotor_inertia + ws.S[at(i)].dot(ws.IAS[at(i)]);  // line 13
-  ws.D[at(i)] = D;
+  WorkspaceScratch& sw = scratchOf(ws);
+  const double D = dof.rotor_inertia + sw.S[at(i)].dot(sw.IAS[at(i)]);  // line 13
+  sw.D[at(i)] = D;
   if (!(D > 1e-300))
     return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)", dof.name.c_str(),
                          D);
-  ws.inverse_D[at(i)] = 1.0 / D;  // one division per DOF; the rest multiply
+  sw.inverse_D[at(i)] = 1.0 / D;  // one division per DOF; the rest multiply
   return {};
 }
 
@@ -339,24 +345,25 @@ inline Status pivot(const Dof& dof, int i, Workspace& ws) {
 // child to arrive (the last in depth-first order: its subtree ends where p's
 // does) starts p's sums from I_p and F_bias,p.
 inline void passToParent(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int p = model.parent(first);
   if (p == 0) return;  // the world takes nothing
-  Mat6& IA_parent = ws.IA[at(p)];
-  Vec6& FA_parent = ws.FA[at(p)];
-  const Vec6& IAS = ws.IAS[at(last)];
-  const Vec6 IAS_D = IAS * ws.inverse_D[at(last)];
+  Mat6& IA_parent = sw.IA[at(p)];
+  Vec6& FA_parent = sw.FA[at(p)];
+  const Vec6& IAS = sw.IAS[at(last)];
+  const Vec6 IAS_D = IAS * sw.inverse_D[at(last)];
   if (model.subtreeEnd(last) == model.subtreeEnd(p)) {
     IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
-    ws.I[at(p)].addTo(IA_parent);
-    FA_parent = ws.Fbias[at(p)] + pA + IAS_D * ws.u[at(last)];
+    sw.I[at(p)].addTo(IA_parent);
+    FA_parent = sw.Fbias[at(p)] + pA + IAS_D * sw.u[at(last)];
   } else {
     IA_parent.noalias() += IA - IAS.lazyProduct(IAS_D.transpose());
-    FA_parent += pA + IAS_D * ws.u[at(last)];
+    FA_parent += pA + IAS_D * sw.u[at(last)];
   }
   for (int k = first; k < last; ++k) {  // a multi-DOF joint's other DOFs
-    const Vec6 IAS_k_D = ws.IAS[at(k)] * ws.inverse_D[at(k)];
-    IA_parent.noalias() -= ws.IAS[at(k)].lazyProduct(IAS_k_D.transpose());
-    FA_parent += IAS_k_D * ws.u[at(k)];
+    const Vec6 IAS_k_D = sw.IAS[at(k)] * sw.inverse_D[at(k)];
+    IA_parent.noalias() -= sw.IAS[at(k)].lazyProduct(IAS_k_D.transpose());
+    FA_parent += IAS_k_D * sw.u[at(k)];
   }
 }
 
@@ -368,19 +375,20 @@ inline void passToParent(const Model& model, int first, int last, const Mat6& IA
 // but each pivot waits on a 6-vector update, not on a 6 × 6 downdate of I^A.
 inline Status jointPivots(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA, const VectorRef& tau,
                           Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const std::vector<Dof>& dofs = model.dofs();
   for (int k = first; k <= last; ++k) {
-    ws.IAS[at(k)].noalias() = IA * ws.S[at(k)];  // the columns of I^A S: independent
-    ws.u[at(k)] = tau[k - 1] - ws.S[at(k)].dot(pA);
+    sw.IAS[at(k)].noalias() = IA * sw.S[at(k)];  // the columns of I^A S: independent
+    sw.u[at(k)] = tau[k - 1] - sw.S[at(k)].dot(pA);
   }
   for (int m = last; m >= first; --m) {
     if (Status s = pivot(dofs[at(m - 1)], m, ws); !s) return s;
-    const Vec6& IAS_m = ws.IAS[at(m)];
-    const double inverse_D = ws.inverse_D[at(m)], u_m = ws.u[at(m)];
+    const Vec6& IAS_m = sw.IAS[at(m)];
+    const double inverse_D = sw.inverse_D[at(m)], u_m = sw.u[at(m)];
     for (int k = first; k < m; ++k) {
-      const double g = ws.S[at(k)].dot(IAS_m) * inverse_D;
-      ws.IAS[at(k)] -= IAS_m * g;
-      ws.u[at(k)] -= g * u_m;
+      const double g = sw.S[at(k)].dot(IAS_m) * inverse_D;
+      sw.IAS[at(k)] -= IAS_m * g;
+      sw.u[at(k)] -= g * u_m;
     }
   }
   return {};
@@ -389,37 +397,38 @@ inline Status jointPivots(const Model& model, int first, int last, const Mat6& I
 }  // namespace
 
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int N = model.nv();
   const std::vector<Dof>& dofs = model.dofs();
   const int m = task.solverColumns();
-  ws.U.head(m).setZero();  // U_N = 0
-  ws.L_scale.head(m).setZero();
-  ws.L.topLeftCorner(m, m).setZero();           // 𝓛_N = 0 (only the lower triangle is kept)
-  ws.Ahat.leftCols(m) = ws.A_body.leftCols(m);  // A_i, each column updated in place on its way to the base
+  sw.U.head(m).setZero();  // U_N = 0
+  sw.L_scale.head(m).setZero();
+  sw.L.topLeftCorner(m, m).setZero();           // 𝓛_N = 0 (only the lower triangle is kept)
+  sw.Ahat.leftCols(m) = sw.A_body.leftCols(m);  // A_i, each column updated in place on its way to the base
   // Joint by joint from the leaves; body i is a joint's last DOF body.
   for (int i = N; i >= 1;) {
     const int first = model.jointStart(i);
     if (model.subtreeEnd(i) == i + 1) {  // a leaf: lines 8–9, I^A = I, F^A = F_bias
-      ws.IA[at(i)] = ws.I[at(i)].matrix();
-      ws.FA[at(i)] = ws.Fbias[at(i)];
+      sw.IA[at(i)] = sw.I[at(i)].matrix();
+      sw.FA[at(i)] = sw.Fbias[at(i)];
     }
-    const Mat6& IA = ws.IA[at(i)];
-    Vec6 pA = ws.FA[at(i)];
-    pA.noalias() += IA * ws.c[at(i)];  // F^A + I^A Ẍ_bias
+    const Mat6& IA = sw.IA[at(i)];
+    Vec6 pA = sw.FA[at(i)];
+    pA.noalias() += IA * sw.c[at(i)];  // F^A + I^A Ẍ_bias
     if (first == i) {                  // one DOF: lines 13–15 as the report has them
-      ws.IAS[at(i)].noalias() = IA * ws.S[at(i)];
+      sw.IAS[at(i)].noalias() = IA * sw.S[at(i)];
       if (Status s = pivot(dofs[at(i - 1)], i, ws); !s) return s;
-      ws.u[at(i)] = tau[i - 1] - ws.S[at(i)].dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
+      sw.u[at(i)] = tau[i - 1] - sw.S[at(i)].dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
     } else if (Status s = jointPivots(model, first, i, IA, pA, tau, ws); !s) {
       return s;
     }
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
     if (first == i) {
-      constraintColumnsStep<true, true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
+      constraintColumnsStep<true, true>(task, i, sw.u[at(i)] * sw.inverse_D[at(i)], ws);
     } else {
-      constraintColumnsStep<false, true>(task, i, ws.u[at(i)] * ws.inverse_D[at(i)], ws);
+      constraintColumnsStep<false, true>(task, i, sw.u[at(i)] * sw.inverse_D[at(i)], ws);
       for (int k = i - 1; k >= first; --k)
-        constraintColumnsStep<false, false>(task, k, ws.u[at(k)] * ws.inverse_D[at(k)], ws);
+        constraintColumnsStep<false, false>(task, k, sw.u[at(k)] * sw.inverse_D[at(k)], ws);
       jointBalanceUpdate(task, first, i, ws);
     }
     passToParent(model, first, i, IA, pA, ws);
@@ -432,23 +441,24 @@ namespace {
 
 // With relative constraints, each balance row is the sum of its solver
 // columns (the two sides): 𝓛_rows = Mᵀ 𝓛 M, and likewise U, L_scale, b and
-// A₀ᵀẌ₀, with M the 0/1 map of columns to rows. Into ws.L_rows (lower
-// triangle), ws.L_scale_rows and ws.rhs.
+// A₀ᵀẌ₀, with M the 0/1 map of columns to rows. Into sw.L_rows (lower
+// triangle), sw.L_scale_rows and sw.rhs.
 void condensedBalance(const Task& task, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int columns = task.solverColumns(), m = task.balanceRows();
-  const std::vector<int>& row = task.balanceRowOfColumn();
-  ws.L_rows.topLeftCorner(m, m).setZero();
-  ws.L_scale_rows.head(m).setZero();
-  ws.rhs.head(m).setZero();
+  const std::vector<int>& row = solverOrder(task).balanceRowOfColumn();
+  sw.L_rows.topLeftCorner(m, m).setZero();
+  sw.L_scale_rows.head(m).setZero();
+  sw.rhs.head(m).setZero();
   const Vec6 a0 = gravityAcceleration(task.gravity);
   for (int q = 0; q < columns; ++q) {
     const int rq = row[at(q)];
-    ws.L_scale_rows[rq] += ws.L_scale[q];
-    ws.rhs[rq] += ws.b_body[q] - ws.U[q] - ws.Ahat.col(q).dot(a0);
+    sw.L_scale_rows[rq] += sw.L_scale[q];
+    sw.rhs[rq] += sw.b_body[q] - sw.U[q] - sw.Ahat.col(q).dot(a0);
     for (int p = q; p < columns; ++p) {  // 𝓛(p, q), p ≥ q, stands for (p, q) and (q, p)
       const int rp = row[at(p)];
-      const double value = ws.L(p, q) * (p != q && rp == rq ? 2.0 : 1.0);
-      ws.L_rows(std::max(rp, rq), std::min(rp, rq)) += value;
+      const double value = sw.L(p, q) * (p != q && rp == rq ? 2.0 : 1.0);
+      sw.L_rows(std::max(rp, rq), std::min(rp, rq)) += value;
     }
   }
 }
@@ -456,18 +466,19 @@ void condensedBalance(const Task& task, Workspace& ws) {
 // ν of each solver column from ν of its balance row (both sides carry the row's ν).
 void expandToColumns(const Task& task, const Eigen::Ref<const Eigen::MatrixXd>& rows,
                      Eigen::Ref<Eigen::MatrixXd> columns) {
-  const std::vector<int>& row = task.balanceRowOfColumn();
+  const std::vector<int>& row = solverOrder(task).balanceRowOfColumn();
   for (int col = 0; col < task.solverColumns(); ++col) columns.row(col) = rows.row(row[at(col)]);
 }
 
 }  // namespace
 
 void balance(const Task& task, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.balanceRows();
-  const bool condensed = task.hasRelative();
+  const bool condensed = solverOrder(task).hasRelative();
   if (condensed) condensedBalance(task, ws);
-  Eigen::MatrixXd& L = condensed ? ws.L_rows : ws.L;
-  const Eigen::VectorXd& L_scale = condensed ? ws.L_scale_rows : ws.L_scale;
+  Eigen::MatrixXd& L = condensed ? sw.L_rows : sw.L;
+  const Eigen::VectorXd& L_scale = condensed ? sw.L_scale_rows : sw.L_scale;
   // A row no joint can move (its row of G is zero: a constraint on the base,
   // or a direction through every joint axis) has 𝓛_rr = Σ (Sᵀa)²/D = 0 up to
   // the rounding of the Sᵀa products, ~ε²·L_scale. Make it exactly zero, so
@@ -485,13 +496,13 @@ void balance(const Task& task, Workspace& ws) {
       for (int row = r; row < m; ++row) L(row, r) = 0.0;
     }
   if (!condensed) {
-    ws.rhs.head(m) = ws.b_body.head(m) - ws.U.head(m);                                                // line 25 …
-    ws.rhs.head(m).noalias() -= ws.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
+    sw.rhs.head(m) = sw.b_body.head(m) - sw.U.head(m);                                                // line 25 …
+    sw.rhs.head(m).noalias() -= sw.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
   }
-  Eigen::VectorXd& nu = condensed ? ws.nu_rows : ws.nu;
+  Eigen::VectorXd& nu = condensed ? sw.nu_rows : sw.nu;
   BalanceReport& report = ws.solution.balance;
-  report = solveBalance(L.topLeftCorner(m, m), ws.rhs.head(m), nu.head(m), ws.balance_factorisation, task.balance);
-  if (condensed) expandToColumns(task, ws.nu_rows.head(m), ws.nu);
+  report = solveBalance(L.topLeftCorner(m, m), sw.rhs.head(m), nu.head(m), sw.balance_factorisation, task.balance);
+  if (condensed) expandToColumns(task, sw.nu_rows.head(m), sw.nu);
   // The report counts the task's rows. The mimic rows are independent of each
   // other whatever the task (each alone moves its own mimic joint; a leader is
   // never a mimic joint), so every direction the balance lost lies in the
@@ -502,30 +513,33 @@ void balance(const Task& task, Workspace& ws) {
 }
 
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
-  ws.a_world = ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  WorkspaceScratch& sw = scratchOf(ws);
+  sw.a_world = sw.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
   // Each body's q̈ waits on its parent's Ẍ: that chain sets the time. So the
   // parent's Ẍ comes from a register when it is the body before (a chain, a
   // joint's DOFs), and line 28 multiplies by the 1/D the inward sweep formed.
-  Vec6 a_previous = ws.a[0];
+  Vec6 a_previous = sw.a[0];
   for (int i = 1; i <= model.nv(); ++i) {
     const int p = model.parent(i);
-    const Vec6 a_parent = p == i - 1 ? a_previous : ws.a[at(p)];
-    const int first = task.firstColumn(i), k = task.activeColumns(i) - first;
-    const double constraint = ws.SA.col(i).segment(first, k).dot(ws.nu.segment(first, k));        // Sᵀ A_i ν
-    qdd[i - 1] = (ws.u[at(i)] - ws.IAS[at(i)].dot(a_parent) + constraint) * ws.inverse_D[at(i)];  // line 28
-    a_previous = ws.a[at(i)] = a_parent + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];                 // line 29
+    const Vec6 a_parent = p == i - 1 ? a_previous : sw.a[at(p)];
+    const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).activeColumns(i) - first;
+    const double constraint = sw.SA.col(i).segment(first, k).dot(sw.nu.segment(first, k));        // Sᵀ A_i ν
+    qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];  // line 28
+    a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];                 // line 29
   }
 }
 
 void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd) {
-  ws.a_world = ws.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  WorkspaceScratch& sw = scratchOf(ws);
+  sw.a_world = sw.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
   for (int i = 1; i <= model.nv(); ++i)
-    ws.a[at(i)] = ws.a[at(model.parent(i))] + ws.S[at(i)] * qdd[i - 1] + ws.c[at(i)];  // line 29
+    sw.a[at(i)] = sw.a[at(model.parent(i))] + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];  // line 29
 }
 
 Vec6 baseClassicalAcceleration(const Model& model, const Workspace& ws) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   const auto b = at(model.baseBody());  // the world's, zero, on a fixed base
-  return classicalAtPoint(ws.a[b] - ws.a_world, ws.v[b], ws.Xworld[b].r);
+  return classicalAtPoint(sw.a[b] - sw.a_world, sw.v[b], sw.Xworld[b].r);
 }
 
 namespace {
@@ -557,12 +571,13 @@ void balanceSolveLanes(const Eigen::MatrixXd& C, int m, double* lanes, Eigen::In
 template <int W>
 void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, bool solve_balance,
                   UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
   const int N = model.nv(), m = task.solverColumns();
   auto dnu_lanes = s.dnu_lanes.topLeftCorner(W, m);  // SᵀA δν: whole lanes per row
   if (solve_balance) {
     dnu_lanes = s.dU.block(0, c0, m, W).transpose();  // −δU₀
-    balanceSolveLanes<W>(ws.balance_factorisation.factor, m, dnu_lanes.data(), s.dnu_lanes.outerStride());
+    balanceSolveLanes<W>(sw.balance_factorisation.factor, m, dnu_lanes.data(), s.dnu_lanes.outerStride());
     dnu.middleCols(c0, W) = dnu_lanes.transpose();
   } else {
     dnu_lanes = dnu.middleCols(c0, W).transpose();
@@ -574,14 +589,14 @@ void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eig
     Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
     const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
     for (Eigen::Index c = from; c < to; ++c) dq[c - c0] = s.du(i, c);
-    const int first = task.firstColumn(i), ki = task.activeColumns(i);
-    for (int r = first; r < ki; ++r) dq += ws.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
+    const int first = solverOrder(task).firstColumn(i), ki = solverOrder(task).activeColumns(i);
+    for (int r = first; r < ki; ++r) dq += sw.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
     const double* parent = da + model.parent(i) * da_stride;
-    const Vec6& IAS = ws.IAS[at(i)];
+    const Vec6& IAS = sw.IAS[at(i)];
     for (int e = 0; e < 6; ++e) dq -= IAS[e] * Eigen::Map<const Lanes>(parent + e * W);
-    dq *= ws.inverse_D[at(i)];
+    dq *= sw.inverse_D[at(i)];
     dqdd.template block<1, W>(i - 1, c0) = dq.transpose();
-    const Vec6& S = ws.S[at(i)];
+    const Vec6& S = sw.S[at(i)];
     double* child = da + i * da_stride;
     for (int e = 0; e < 6; ++e) Eigen::Map<Lanes>(child + e * W) = Eigen::Map<const Lanes>(parent + e * W) + S[e] * dq;
   }
@@ -609,18 +624,20 @@ void columnRuns(const Model& model, const std::vector<int>& dofs, UnitTorqueScra
 // [first, end) of i's subtree (dU_c: the column's δU₀).
 ZWANG_ALWAYS_INLINE void constraintColumnsDelta(const Workspace& ws, int i, int first, int end, double du_D,
                                                 double* dU_c) {
-  for (int r = first; r < end; ++r) dU_c[r] += ws.SA(r, i) * du_D;
+  const WorkspaceScratch& sw = scratchOf(ws);
+  for (int r = first; r < end; ++r) dU_c[r] += sw.SA(r, i) * du_D;
 }
 
 // Lines 13–20 of a one-DOF joint (body i) on its run of columns: δu_i = [i is
 // the column's DOF] − Sᵀ δF^a, then δU₀ and δF^a for the parent.
 void oneDofColumns(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& dofs, int i,
                    UnitTorqueScratch& s) {
-  const Vec6& S = ws.S[at(i)];
-  const Vec6& IAS = ws.IAS[at(i)];
-  const double inverse_D = ws.inverse_D[at(i)];
+  const WorkspaceScratch& sw = scratchOf(ws);
+  const Vec6& S = sw.S[at(i)];
+  const Vec6& IAS = sw.IAS[at(i)];
+  const double inverse_D = sw.inverse_D[at(i)];
   const bool to_world = model.parent(i) == 0;  // the world takes δF^a and does nothing with it
-  const int first = task.firstColumn(i), end = task.activeColumns(i);
+  const int first = solverOrder(task).firstColumn(i), end = solverOrder(task).activeColumns(i);
   const Eigen::Index begin = s.run_begin[i], run_end = s.run_end[i];
   const Eigen::Index own = begin < run_end && bodyOfDof(dofs[at(static_cast<int>(begin))]) == i ? begin : -1;
   double* const du = s.du.data() + i;  // row i
@@ -645,12 +662,13 @@ void oneDofColumns(const Model& model, const Task& task, const Workspace& ws, co
 // Σ_k I^A_k S_k δu_k / D_k more (lines 17–18).
 void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& dofs, int first,
                      int last, UnitTorqueScratch& s) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   const int n = last - first + 1;
   double g[6][6];  // g[k][l] for 0 ≤ k < l < n
   Mat6 W = Mat6::Zero(), IAS_D = Mat6::Zero();
   for (int k = n - 1; k >= 0; --k) {
-    const Vec6& S_k = ws.S[at(first + k)];
-    IAS_D.col(k) = ws.IAS[at(first + k)] * ws.inverse_D[at(first + k)];
+    const Vec6& S_k = sw.S[at(first + k)];
+    IAS_D.col(k) = sw.IAS[at(first + k)] * sw.inverse_D[at(first + k)];
     W.row(k) = S_k.transpose();
     for (int l = k + 1; l < n; ++l) {
       g[k][l] = S_k.dot(IAS_D.col(l));
@@ -660,16 +678,17 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
   // The joint's constraint rows: its subtree's [rows_first, rows_first +
   // rows), DOF body k taking those before rows_end[k] (a joint row on one of
   // the joint's DOFs sits on that DOF's body, and only the bodies before see it).
-  const int rows_first = task.firstColumn(first), rows = task.activeColumns(first) - rows_first;
+  const int rows_first = solverOrder(task).firstColumn(first),
+            rows = solverOrder(task).activeColumns(first) - rows_first;
   int rows_end[6];
-  for (int k = 0; k < n; ++k) rows_end[k] = task.activeColumns(first + k) - rows_first;
+  for (int k = 0; k < n; ++k) rows_end[k] = solverOrder(task).activeColumns(first + k) - rows_first;
   // Line 20 for a column from below, all DOFs at once: δU₀ −= Y δF^a with
   // Y = Σ_k SᵀA_k W_k / D_k (kept transposed: a row's 6 entries side by side).
   auto Yt = s.joint_rows.leftCols(rows);
   Yt.setZero();
   for (int k = 0; k < n; ++k) {
-    const auto SA_k = ws.SA.col(first + k).segment(rows_first, rows);
-    const Vec6 W_k_D = W.row(k).transpose() * ws.inverse_D[at(first + k)];
+    const auto SA_k = sw.SA.col(first + k).segment(rows_first, rows);
+    const Vec6 W_k_D = W.row(k).transpose() * sw.inverse_D[at(first + k)];
     for (int r = 0; r < rows_end[k]; ++r) Yt.col(r) += W_k_D * SA_k[r];
   }
   const bool to_world = model.parent(first) == 0;
@@ -689,7 +708,7 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
         for (int l = k + 1; l <= own; ++l) du[k] -= g[k][l] * du[l];
       for (int k = 0; k <= own; ++k)
         dU.head(rows_end[k]) +=
-            ws.SA.col(first + k).segment(rows_first, rows_end[k]) * (du[k] * ws.inverse_D[at(first + k)]);
+            sw.SA.col(first + k).segment(rows_first, rows_end[k]) * (du[k] * sw.inverse_D[at(first + k)]);
     }
     // All n entries (those above the column's own DOF are zero and never read):
     // fixed sizes, not a call to memcpy per column.
@@ -707,6 +726,7 @@ void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, 
 
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& dofs,
                        UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
+  WorkspaceScratch& sw = scratchOf(ws);
   // Only the τ-dependent terms change: u, F^a (line 17) and U (line 20); the
   // inertia terms I^A, D, P^A, A_i and 𝓛 are shared with the main pass.
   // Column c is zero except on the path from its DOF's body to the world, so
@@ -728,18 +748,18 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
   // outward pass's lanes, a block of columns at a time; else here, all at once.
-  const bool solve_in_lanes = !task.hasRelative() && !ws.balance_factorisation.by_eigen;
-  dU *= -1.0;                // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
-  if (task.hasRelative()) {  // on the balance's rows: each the sum of its columns
+  const bool solve_in_lanes = !solverOrder(task).hasRelative() && !sw.balance_factorisation.by_eigen;
+  dU *= -1.0;                             // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+  if (solverOrder(task).hasRelative()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
-    auto dU_rows = ws.dU_rows.topLeftCorner(rows, k);
+    auto dU_rows = sw.dU_rows.topLeftCorner(rows, k);
     dU_rows.setZero();
-    for (int col = 0; col < m; ++col) dU_rows.row(task.balanceRowOfColumn()[at(col)]) += dU.row(col);
-    auto dnu_rows = ws.dnu_rows.topLeftCorner(rows, k);
-    balanceApplyColumns(ws.balance_factorisation, dU_rows, dnu_rows, ws.balance_factorisation.work.head(rows));
+    for (int col = 0; col < m; ++col) dU_rows.row(solverOrder(task).balanceRowOfColumn()[at(col)]) += dU.row(col);
+    auto dnu_rows = sw.dnu_rows.topLeftCorner(rows, k);
+    balanceApplyColumns(sw.balance_factorisation, dU_rows, dnu_rows, sw.balance_factorisation.work.head(rows));
     expandToColumns(task, dnu_rows, dnu.topRows(m));
   } else if (!solve_in_lanes) {
-    balanceApplyColumns(ws.balance_factorisation, dU, dnu.topRows(m), ws.balance_factorisation.work.head(m));
+    balanceApplyColumns(sw.balance_factorisation, dU, dnu.topRows(m), sw.balance_factorisation.work.head(m));
   }
   // Lines 28–29 for the differences: the widest blocks of columns first, so
   // that few lanes idle (29 stuck joints: 8 + 8 + 8 + 4 + 1).
@@ -781,6 +801,7 @@ double termSize(const Column& A, const Vec6& a) {
 }  // namespace
 
 void taskResidual(const Task& task, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   // Aᵀ Ẍ − b row by row on the final accelerations. In sweep form both sides
   // carry the same gravity and velocity shifts (constraintsInBodyForm), so the
   // difference is the row's error in its own units. A row counts as met when
@@ -796,16 +817,16 @@ void taskResidual(const Task& task, Workspace& ws) {
   // picked components 1e-12).
   const int m = task.balanceRows();
   BalanceReport& report = ws.solution.balance;
-  if (!task.hasRelative()) {  // one column per row
+  if (!solverOrder(task).hasRelative()) {  // one column per row
     double sum2 = 0.0;
     bool met = true;
     int col = 0;
-    for (const Task::ConstraintGroup& g : task.groups()) {
-      const Vec6& a = ws.a[at(g.body)];
+    for (const TaskSolverOrder::ConstraintGroup& g : solverOrder(task).groups()) {
+      const Vec6& a = sw.a[at(g.body)];
       for (int k = 0; k < g.rows; ++k, ++col) {
-        const auto A = ws.A_body.col(col);
-        const double error = A.dot(a) - ws.b_body[col];
-        const double size = termSize(A, a) + std::abs(ws.b_body[col]) + std::abs(ws.rhs[col]);
+        const auto A = sw.A_body.col(col);
+        const double error = A.dot(a) - sw.b_body[col];
+        const double size = termSize(A, a) + std::abs(sw.b_body[col]) + std::abs(sw.rhs[col]);
         sum2 += error * error;
         met = met && std::abs(error) <= task.balance.residual_tolerance * size;
       }
@@ -815,39 +836,40 @@ void taskResidual(const Task& task, Workspace& ws) {
     return;
   }
   // A relative row sums its two columns' terms (the balance's rows).
-  auto error = ws.row_error.head(m);
-  auto size = ws.row_size.head(m);
+  auto error = sw.row_error.head(m);
+  auto size = sw.row_size.head(m);
   error.setZero();
   size.setZero();
-  const std::vector<int>& row = task.balanceRowOfColumn();
+  const std::vector<int>& row = solverOrder(task).balanceRowOfColumn();
   int col = 0;
-  for (const Task::ConstraintGroup& g : task.groups()) {
-    const Vec6& a = ws.a[at(g.body)];
+  for (const TaskSolverOrder::ConstraintGroup& g : solverOrder(task).groups()) {
+    const Vec6& a = sw.a[at(g.body)];
     for (int k = 0; k < g.rows; ++k, ++col) {
-      const auto A = ws.A_body.col(col);
+      const auto A = sw.A_body.col(col);
       const int r = row[at(col)];
-      error[r] += A.dot(a) - ws.b_body[col];
-      size[r] += termSize(A, a) + std::abs(ws.b_body[col]);
+      error[r] += A.dot(a) - sw.b_body[col];
+      size[r] += termSize(A, a) + std::abs(sw.b_body[col]);
     }
   }
   bool met = true;
   for (int r = 0; r < m; ++r)
-    met = met && std::abs(error[r]) <= task.balance.residual_tolerance * (size[r] + std::abs(ws.rhs[r]));
+    met = met && std::abs(error[r]) <= task.balance.residual_tolerance * (size[r] + std::abs(sw.rhs[r]));
   report.residual = m > 0 ? error.norm() : 0.0;
   report.consistent = met;
 }
 
 void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_all,
                        Eigen::Ref<Eigen::VectorXd> tau_c) {
+  WorkspaceScratch& sw = scratchOf(ws);
   // The motors give every constraint force but the contacts' (the
   // environment's): those columns count with ν = 0 here.
   const int columns = task.solverColumns();
   if (task.hasContacts()) {
-    ws.nu_motors.head(columns) = nu_all.head(columns);
+    sw.nu_motors.head(columns) = nu_all.head(columns);
     for (int col = 0; col < columns; ++col)
-      if (task.contactColumns()[at(col)]) ws.nu_motors[col] = 0.0;
+      if (solverOrder(task).contactColumns()[at(col)]) sw.nu_motors[col] = 0.0;
   }
-  const VectorRef nu_solver = task.hasContacts() ? VectorRef(ws.nu_motors.head(columns)) : nu_all;
+  const VectorRef nu_solver = task.hasContacts() ? VectorRef(sw.nu_motors.head(columns)) : nu_all;
   // The wrenches A ν of each body's own constraints, summed inward and
   // projected on each joint: the physical torque (docs/solver.md, "Constraint torques: why not eq. 4.4").
   // On a tree each body carries its own wrenches and its children's: the
@@ -860,30 +882,31 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   if (model.isChain()) {  // one running sum from the tip inward
     Vec6 carried = Vec6::Zero();
     for (int i = N; i >= 1; --i) {
-      const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
+      const int k_beyond = solverOrder(task).activeColumns(i + 1), k = solverOrder(task).activeColumns(i);
       if (k > k_beyond)  // most bodies carry none: no product of zero width
-        carried.noalias() += ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
-      tau_c[i - 1] = ws.S[at(i)].dot(carried);
+        carried.noalias() += sw.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+      tau_c[i - 1] = sw.S[at(i)].dot(carried);
     }
     return;
   }
-  std::vector<Vec6>& carried = ws.constraint_wrench;
+  std::vector<Vec6>& carried = sw.constraint_wrench;
   for (int i = 1; i <= N; ++i) {  // body i's own columns: those on bodies ≥ i but not ≥ i + 1
-    const int k_beyond = task.activeColumns(i + 1), k = task.activeColumns(i);
+    const int k_beyond = solverOrder(task).activeColumns(i + 1), k = solverOrder(task).activeColumns(i);
     if (k == k_beyond)  // most bodies carry none: no product of zero width
       carried[at(i)].setZero();
     else
       carried[at(i)].noalias() =
-          ws.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+          sw.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
   }
   for (int i = N; i >= 1; --i) {
-    tau_c[i - 1] = ws.S[at(i)].dot(carried[at(i)]);
+    tau_c[i - 1] = sw.S[at(i)].dot(carried[at(i)]);
     if (model.parent(i) > 0) carried[at(model.parent(i))] += carried[at(i)];  // the world takes the rest
   }
 }
 
 double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
                      const Workspace& ws) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   // Z with true accelerations and gravity as a force (the physical Gauss
   // function; the gravity-shifted sweep's version differs by a constant):
   // Σ_i ½ aᵢᵀIᵢaᵢ + (F_bias,i − I_i[g; 0])ᵀaᵢ + Σ_j ½ d_j q̈_j² − τ_j q̈_j,
@@ -893,13 +916,13 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
   const std::vector<Dof>& dofs = model.dofs();
   double Z = 0.0;
   for (int i = 1; i <= model.nv(); ++i) {
-    const RigidInertia& I = ws.I[at(i)];
-    const Vec6& a_sweep = ws.a[at(i)];
+    const RigidInertia& I = sw.I[at(i)];
+    const Vec6& a_sweep = sw.a[at(i)];
     const Vec3 a_lin = a_sweep.head<3>() + g;  // true acceleration: sweep − [−g; 0]
     const Vec3 alpha = a_sweep.tail<3>();
     const Vec3 y_lin = 0.5 * a_lin - g;
     const Vec3 y_ang = 0.5 * alpha;
-    const Vec6& F = ws.Fbias[at(i)];
+    const Vec6& F = sw.Fbias[at(i)];
     Z += a_lin.dot(I.mass * y_lin - I.h.cross(y_ang) + F.head<3>()) +
          alpha.dot(I.h.cross(y_lin) + I.Ibar * y_ang + F.tail<3>());
     const double qdd_i = qdd[i - 1];
@@ -909,13 +932,14 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
 }
 
 void publishNu(const Task& task, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.constraintRows();
   if (ws.solution.nu.size() != m) ws.solution.nu.resize(m);  // only when the task's size changed
   // Both columns of a relative row carry the row's ν: either may write it.
   // Mimic rows (after the user's) are the mechanism's, not the task's.
   for (int col = 0; col < task.solverColumns(); ++col) {
-    const int row = task.solverRowToUserRow()[at(col)];
-    if (row < m) ws.solution.nu[row] = ws.nu[col];
+    const int row = solverOrder(task).solverRowToUserRow()[at(col)];
+    if (row < m) ws.solution.nu[row] = sw.nu[col];
   }
 }
 

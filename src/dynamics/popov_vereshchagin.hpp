@@ -8,7 +8,10 @@
 #include "zwang/status.hpp"
 #include "zwang/workspace.hpp"
 
+#include "dynamics/workspace_scratch.hpp"
+
 #include "dynamics/checks.hpp"
+#include "dynamics/task_solver_order.hpp"
 
 namespace zwang::internal {
 
@@ -18,7 +21,9 @@ using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 // The body DOF k (entry k of v) moves (body 0 is the world), and that DOF's
 // articulated inertia D (line 13: its pivot of the joint's D) after the inward sweep.
 inline int bodyOfDof(int dof) { return dof + 1; }
-inline double dofInertia(const Workspace& ws, int dof) { return ws.D[static_cast<std::size_t>(bodyOfDof(dof))]; }
+inline double dofInertia(const Workspace& ws, int dof) {
+  return scratchOf(ws).D[static_cast<std::size_t>(bodyOfDof(dof))];
+}
 
 // Input checks shared by every solve (the balance options included).
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
@@ -32,15 +37,15 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 // Fails (Degenerate) when a joint has no inertia to move.
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws);
 
-// Line 25: ν = 𝓛⁺(b − A₀ᵀẌ₀ − U₀) into ws.nu (solver order), factoring 𝓛
-// (kept in ws.balance_factorisation for unitTorqueColumns) and filling
+// Line 25: ν = 𝓛⁺(b − A₀ᵀẌ₀ − U₀) into sw.nu (solver order), factoring 𝓛
+// (kept in sw.balance_factorisation for unitTorqueColumns) and filling
 // ws.solution.balance (all but the residual: see taskResidual).
 void balance(const Task& task, Workspace& ws);
 
-// Lines 26–30: q̈ (into `qdd`) and Ẍ (into ws.a) from ws.nu.
+// Lines 26–30: q̈ (into `qdd`) and Ẍ (into sw.a) from sw.nu.
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd);
 
-// Line 29 alone: Ẍ (into ws.a) from a known q̈.
+// Line 29 alone: Ẍ (into sw.a) from a known q̈.
 void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd);
 
 // After the accelerations: the base's classical acceleration [p̈; ω̇] of its
@@ -84,7 +89,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
 // The joints whose q lies outside their limits, into the solution (a warning).
 void jointsOutsideLimits(const Model& model, const VectorRef& q, Solution& out);
 
-// After the final accelerations (ws.a): ‖Aᵀ Ẍ − b‖ and whether every row is
+// After the final accelerations (sw.a): ‖Aᵀ Ẍ − b‖ and whether every row is
 // met, into ws.solution.balance.
 void taskResidual(const Task& task, Workspace& ws);
 
@@ -101,11 +106,11 @@ void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_contr
 // (τ_c adjusted to keep the sum), from out.tau_constraint.
 void controlTorques(const Model& model, const VectorRef& tau, Solution& out);
 
-// Gauss function of the true accelerations ws.a − [−g; 0], with joint torques `tau`.
+// Gauss function of the true accelerations sw.a − [−g; 0], with joint torques `tau`.
 double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
                      const Workspace& ws);
 
-// ws.nu (solver order) into the solution's ν (the task's row order).
+// sw.nu (solver order) into the solution's ν (the task's row order).
 void publishNu(const Task& task, Workspace& ws);
 
 }  // namespace zwang::internal

@@ -11,6 +11,8 @@
 
 #include "zwang/workspace.hpp"
 
+#include "dynamics/workspace_scratch.hpp"
+
 // On a per-body step: every call inside it inlined. The compiler's size
 // limits otherwise leave Eigen's small fixed-size kernels (a 6-vector sum, a
 // 3-vector cross product) as calls in the loops.
@@ -32,8 +34,9 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
 
 // ᶠX₀ of a frame, after outwardKinematics.
 inline Transform framePlacementInBase(const Model& model, const Workspace& ws, int frame) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   const Frame& f = model.frame(frame);
-  return f.placement * ws.Xworld[static_cast<std::size_t>(f.body)];
+  return f.placement * sw.Xworld[static_cast<std::size_t>(f.body)];
 }
 
 // A spatial force given at a frame's origin (local or world axes), in base

@@ -180,13 +180,14 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
 Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
                                const Eigen::Ref<const Eigen::VectorXd>& qd, const std::vector<int>& stuck,
                                Workspace& ws, FrictionScratch& fs) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.solverColumns();
   const auto k = static_cast<Eigen::Index>(stuck.size());
   outwardSweep(model, task, q, qd, ws);
   if (Status s = inwardSweep(model, task, fs.tau_effective, ws); !s) return s;
   balance(task, ws);
   outwardAccelerations(model, task, ws, fs.qdd0);
-  fs.nu0.head(m) = ws.nu.head(m);
+  fs.nu0.head(m) = sw.nu.head(m);
   fs.stuck_dofs.clear();  // reserved for every DOF: no allocation
   for (const int j : stuck) fs.stuck_dofs.push_back(dofOfEntry(model, j));
   if (k > 0)
@@ -205,11 +206,12 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
 // to the base (line 29, every motion in the world frame).
 Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const FrictionScratch& fs, Eigen::Index a,
                              int body) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   // A joint's motion S δq̈ is one term, however many DOFs it has (its DOFs
   // share a body: their parts are the components of one motion).
   Vec6 terms = Vec6::Zero(), joint_motion = Vec6::Zero();
   for (int l = model.parent(body); l > 0; l = model.parent(l)) {
-    joint_motion += ws.S[static_cast<std::size_t>(l)] * fs.dqdd(l - 1, a);
+    joint_motion += sw.S[static_cast<std::size_t>(l)] * fs.dqdd(l - 1, a);
     if (model.jointStart(l) != l) continue;  // the compact array, not the 120-byte Dof
     terms += joint_motion.cwiseAbs();
     joint_motion.setZero();
@@ -219,19 +221,20 @@ Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const Fric
 
 void termSizes(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
                FrictionScratch& fs) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   for (std::size_t b = 0; b < stuck.size(); ++b) {
     const auto a = static_cast<Eigen::Index>(b);
     const int i = bodyOfDof(dofOfEntry(model, stuck[b]));
     const auto at_i = static_cast<std::size_t>(i);
-    const int first = task.firstColumn(i), count = task.activeColumns(i) - first;
-    const auto SA = ws.SA.col(i).segment(first, count).cwiseAbs();
-    const Vec6 IAS = ws.IAS[at_i].cwiseAbs();
+    const int first = solverOrder(task).firstColumn(i), count = solverOrder(task).activeColumns(i) - first;
+    const auto SA = sw.SA.col(i).segment(first, count).cwiseAbs();
+    const Vec6 IAS = sw.IAS[at_i].cwiseAbs();
     fs.curvature_terms[a] = (1.0 + IAS.dot(parentAccelerationTerms(model, ws, fs, a, i)) +
                              SA.dot(fs.dnu.col(a).segment(first, count).cwiseAbs())) *
-                            ws.inverse_D[at_i];
-    fs.slope_terms[a] = (std::abs(ws.u[at_i]) + IAS.dot(ws.a[static_cast<std::size_t>(model.parent(i))].cwiseAbs()) +
-                         SA.dot(ws.nu.segment(first, count).cwiseAbs())) *
-                        ws.inverse_D[at_i];
+                            sw.inverse_D[at_i];
+    fs.slope_terms[a] = (std::abs(sw.u[at_i]) + IAS.dot(sw.a[static_cast<std::size_t>(model.parent(i))].cwiseAbs()) +
+                         SA.dot(sw.nu.segment(first, count).cwiseAbs())) *
+                        sw.inverse_D[at_i];
   }
 }
 
@@ -239,6 +242,7 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
 // its tests are relative to, and the box QP. μ* into fs.mu.
 QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
                       const FrictionOptions& options, double acc_scale, FrictionScratch& fs) {
+  const WorkspaceScratch& sw = scratchOf(ws);
   const auto k = static_cast<Eigen::Index>(stuck.size());
   const int iv = dofOfEntry(model, 0);  // the friction entries' rows of q̈
   auto K = fs.K.topLeftCorner(k, k);
@@ -276,7 +280,7 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
     if (m > 0)
       curvature_scale = std::max(
           curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
-                               ws.SA.block(0, bodyOfDof(dofOfEntry(model, 0)), m, model.dof()).cwiseAbs().maxCoeff() /
+                               sw.SA.block(0, bodyOfDof(dofOfEntry(model, 0)), m, model.dof()).cwiseAbs().maxCoeff() /
                                min_D);  // over the DOFs friction acts on
   }
   termSizes(model, task, ws, stuck, fs);
@@ -326,7 +330,8 @@ EffortChange effortAlongFlatDirections(const Model& model, const Task& task, con
   if (!task.hasContacts()) return EffortChange::Own;
   const int m = task.solverColumns(), n = model.dof();
   bool motor_rows = false;
-  for (int col = 0; col < m && !motor_rows; ++col) motor_rows = !task.contactColumns()[static_cast<std::size_t>(col)];
+  for (int col = 0; col < m && !motor_rows; ++col)
+    motor_rows = !solverOrder(task).contactColumns()[static_cast<std::size_t>(col)];
   if (!motor_rows) return EffortChange::Fixed;  // τ_c ≡ 0: τ_control = τ whatever μ
   MaximiserChoiceScratch& s = fs.choice;
   const auto N = s.null_basis.topLeftCorner(ns, nullity);
@@ -358,14 +363,15 @@ EffortChange effortAlongFlatDirections(const Model& model, const Task& task, con
 // superposition), then Ẍ from q̈ (line 29). With nothing stuck, μ* is
 // empty and the μ = 0 sweep already gave it.
 void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index k, Workspace& ws, FrictionScratch& fs) {
+  WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.solverColumns();
   Solution& out = ws.solution;
   out.qdd = fs.qdd0;
   if (k == 0) return;
   const auto mu = fs.mu.head(k);
   out.qdd.noalias() -= fs.dqdd.leftCols(k) * mu;
-  ws.nu.head(m) = fs.nu0.head(m);
-  ws.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
+  sw.nu.head(m) = fs.nu0.head(m);
+  sw.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
   bodyAccelerations(model, task, ws, out.qdd);
 }
 
@@ -413,12 +419,13 @@ Status limitInfeasible(const Model& model, const QpReport& report, const std::ve
 Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
                          const Task& task, const FrictionOptions& options) noexcept {
+  WorkspaceScratch& sw = scratchOf(ws);
   ws.kinematics.stage = KinematicsStage::None;  // until the sweeps compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   if (Status s = checkOptions(model, options); !s) return s;
   if (Status s = checkFrictionResultSizes(model, ws.friction); !s) return s;
   const int m = task.solverColumns();
-  FrictionScratch& fs = ws.frictionScratch();
+  FrictionScratch& fs = (*sw.friction_scratch);
   FrictionResult& fr = ws.friction;
   Solution& out = ws.solution;
 
@@ -462,7 +469,7 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   out.base_acceleration_world = baseClassicalAcceleration(model, ws);
   taskResidual(task, ws);
   publishNu(task, ws);
-  constraintTorques(model, task, ws, ws.nu.head(m), out.tau_constraint);
+  constraintTorques(model, task, ws, sw.nu.head(m), out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   const double mu_dot_qdd = frictionStates(model, out.qdd, acc_tolerance, fs, fr);
   for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader

@@ -7,6 +7,8 @@
 
 #include <Eigen/Geometry>
 
+#include "model/split_mix64.hpp"
+
 namespace zwang {
 namespace {
 
@@ -224,7 +226,7 @@ double wrapAngle(double d) {
 // ---- Random draws
 
 // Uniform in [0, 1) from the top 53 bits of one draw.
-double uniform01(std::uint64_t& state) { return static_cast<double>(splitMix64(state) >> 11) * 0x1.0p-53; }
+double uniform01(std::uint64_t& state) { return static_cast<double>(internal::splitMix64(state) >> 11) * 0x1.0p-53; }
 
 // Uniform in [lo, hi); (1 − u)·lo + u·hi stays finite for any finite lo, hi.
 double uniform(std::uint64_t& state, double lo, double hi) {
@@ -418,7 +420,7 @@ Status checkConfigurationNamed(const Model& model, const char* what, const Const
 
 }  // namespace
 
-std::uint64_t splitMix64(std::uint64_t& state) noexcept {
+std::uint64_t internal::splitMix64(std::uint64_t& state) noexcept {
   std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;

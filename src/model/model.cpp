@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 
+#include "model/validate.hpp"
+
 namespace zwang {
 
 const char* toString(JointType type) {

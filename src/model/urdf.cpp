@@ -60,8 +60,13 @@
 #include <sstream>
 #include <vector>
 
+#include "model/urdf_option_names.hpp"
+#include "model/validate.hpp"
+
 namespace zwang {
 namespace {
+
+using internal::NamedUrdfOptions;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -632,12 +637,12 @@ Joint makeJoint(const Reporter& report, const urdf::Joint& uj, const std::map<st
 using LinkPtr = urdf::LinkConstSharedPtr;
 
 // A moving joint that MimicJoints::Lock welds: it is not a degree of freedom.
-bool isLockedMimic(const urdf::Joint& joint, const UrdfOptions& options) {
+bool isLockedMimic(const urdf::Joint& joint, const NamedUrdfOptions& options) {
   return isMoving(joint) && joint.mimic && options.mimic == MimicJoints::Lock;
 }
 
 // A joint that becomes a joint of the model (moving, and not locked).
-bool isDegreeOfFreedom(const urdf::Joint& joint, const UrdfOptions& options) {
+bool isDegreeOfFreedom(const urdf::Joint& joint, const NamedUrdfOptions& options) {
   return isMoving(joint) && !isLockedMimic(joint, options);
 }
 
@@ -648,7 +653,7 @@ std::string mimicLaw(const urdf::Joint& uj) {
 // Where a locked mimic joint is welded: locked_positions[joint], else the
 // position its leader at rest implies, multiplier · q_leader + offset with
 // q_leader = locked_positions[leader] (default 0).
-double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const UrdfOptions& options) {
+double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const NamedUrdfOptions& options) {
   if (const auto given = options.locked_positions.find(uj.name); given != options.locked_positions.end())
     return given->second;
   const auto leader = options.locked_positions.find(uj.mimic->joint_name);
@@ -662,7 +667,7 @@ double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const Ur
 // A <mimic> joint follows its leader (q = a·q_leader + b); the caller asked
 // for none (MimicJoints::Refuse): refused, with the ways around it.
 // `chain_before` is the link before it on a chain (empty in a tree).
-[[noreturn]] void refuseMimic(const Reporter& report, const urdf::Joint& uj, const UrdfOptions& options,
+[[noreturn]] void refuseMimic(const Reporter& report, const urdf::Joint& uj, const NamedUrdfOptions& options,
                               const std::string& chain_before) {
   const std::string lock = options.names.lock_mimic +
                            " to weld it at q = " + fmt(mimicLockPosition(report, uj, options)) +
@@ -677,7 +682,7 @@ double mimicLockPosition(const Reporter& report, const urdf::Joint& uj, const Ur
 }
 
 // A note on a locked mimic joint (MimicLocked, which strict mode lets pass).
-ModelWarning mimicLockedNote(const urdf::Joint& uj, double q, const UrdfOptions& options) {
+ModelWarning mimicLockedNote(const urdf::Joint& uj, double q, const NamedUrdfOptions& options) {
   return {WarningCode::MimicLocked, "joint '" + uj.name + "' mimics joint '" + uj.mimic->joint_name + "' (" +
                                         mimicLaw(uj) + "): locked at q = " + fmt(q) + " (" + options.names.lock_mimic +
                                         "), link '" + uj.child_link_name + "' welded to link '" + uj.parent_link_name +
@@ -802,7 +807,7 @@ void requireMovingJoint(const Reporter& report, const urdf::ModelInterface& mode
 }
 
 std::map<std::string, double> rotorInertias(const Reporter& report, const TiXmlElement* robot,
-                                            const urdf::ModelInterface& urdf_model, const UrdfOptions& options) {
+                                            const urdf::ModelInterface& urdf_model, const NamedUrdfOptions& options) {
   std::map<std::string, double> rotor = readTransmissions(report, robot, urdf_model);
   for (const auto& [name, value] : options.rotor_inertia) {
     if (!std::isfinite(value) || value < 0.0)
@@ -814,7 +819,7 @@ std::map<std::string, double> rotorInertias(const Reporter& report, const TiXmlE
 }
 
 // Every rotor_inertia override names a joint of the model (`moving`, described by `what`).
-void checkRotorNames(const Reporter& report, const urdf::ModelInterface& urdf_model, const UrdfOptions& options,
+void checkRotorNames(const Reporter& report, const urdf::ModelInterface& urdf_model, const NamedUrdfOptions& options,
                      const std::vector<std::string>& moving, const std::string& what) {
   for (const auto& entry : options.rotor_inertia) {
     if (std::find(moving.begin(), moving.end(), entry.first) != moving.end()) continue;
@@ -828,7 +833,7 @@ void checkRotorNames(const Reporter& report, const urdf::ModelInterface& urdf_mo
 // Each loaded mimic joint follows its leader (MimicJoints::Model), which must
 // be a loaded moving joint too: a coupling to a joint outside the model
 // cannot be kept, and dropping it would be a silent wrong answer.
-void addMimicLaws(const Reporter& report, const urdf::ModelInterface& urdf_model, const UrdfOptions& options,
+void addMimicLaws(const Reporter& report, const urdf::ModelInterface& urdf_model, const NamedUrdfOptions& options,
                   const std::vector<std::string>& moving, const std::string& what, ModelBuilder& builder) {
   if (options.mimic != MimicJoints::Model) return;
   for (const std::string& name : moving) {
@@ -892,7 +897,7 @@ void addWelded(const Reporter& report, ModelBuilder& builder, Placement& placeme
 
 // A mimic joint welded by MimicJoints::Lock: its child link becomes a frame of the parent's body.
 void addLockedMimic(const Reporter& report, ModelBuilder& builder, Placement& placement, const urdf::Joint& uj,
-                    const urdf::Link& child, bool on_base, const UrdfOptions& options) {
+                    const urdf::Link& child, bool on_base, const NamedUrdfOptions& options) {
   const double q = mimicLockPosition(report, uj, options);
   const Transform X = lockedPlacement(report, uj, q);
   const RigidInertia inertia = linkInertia(report, child, on_base);
@@ -903,7 +908,7 @@ void addLockedMimic(const Reporter& report, ModelBuilder& builder, Placement& pl
 
 // The chain links in order; after each, the links welded to it.
 void addChain(const Reporter& report, ModelBuilder& builder, Placement& placement, const std::vector<LinkPtr>& chain,
-              const std::map<std::string, double>& rotor, const UrdfOptions& options) {
+              const std::map<std::string, double>& rotor, const NamedUrdfOptions& options) {
   for (const LinkPtr& link : chain) placement.placed.insert(link->name);
   bool on_base = !placement.base_floats;  // until the first moving joint (a floating base moves: never)
   placement.tip_body = {chain.front()};
@@ -934,7 +939,8 @@ void addChain(const Reporter& report, ModelBuilder& builder, Placement& placemen
 // last body added or one of its ancestors (ModelBuilder::addJoint). Before it,
 // the links welded above the root. Explicit stack: no recursion, whatever the depth.
 void addTree(const Reporter& report, ModelBuilder& builder, Placement& placement, const LinkPtr& root,
-             const std::map<std::string, double>& rotor, const UrdfOptions& options, std::vector<std::string>& moving) {
+             const std::map<std::string, double>& rotor, const NamedUrdfOptions& options,
+             std::vector<std::string>& moving) {
   placement.placed.insert(root->name);
   addWelded(report, builder, placement, root, !placement.base_floats, false);
   struct Pending {
@@ -980,7 +986,7 @@ void addTree(const Reporter& report, ModelBuilder& builder, Placement& placement
 // Whether a link moves with the chain: a moving joint lies between it and the
 // chain's root (a branch off the fixed base never affects the dynamics), or
 // the base floats (a branch off a floating base rides on it).
-bool movesWithChain(const LinkPtr& link, const std::string& root, const UrdfOptions& options, bool base_floats) {
+bool movesWithChain(const LinkPtr& link, const std::string& root, const NamedUrdfOptions& options, bool base_floats) {
   if (base_floats) return true;
   for (LinkPtr l = link; l && l->name != root; l = l->getParent())
     if (l->parent_joint && isDegreeOfFreedom(*l->parent_joint, options)) return true;
@@ -992,7 +998,7 @@ bool movesWithChain(const LinkPtr& link, const std::string& root, const UrdfOpti
 // in the model, though they would ride on it: say how much mass that is, as
 // for the mass beyond the tip.
 void warnMassOffChain(Placement& placement, const urdf::ModelInterface& model, const std::string& root,
-                      const UrdfOptions& options) {
+                      const NamedUrdfOptions& options) {
   std::set<std::string> tip_body;
   for (const LinkPtr& link : placement.tip_body) tip_body.insert(link->name);
   std::vector<std::string> joints, links;
@@ -1048,8 +1054,8 @@ BeyondTip findBeyondTip(const Placement& placement) {
 
 // Every locked_positions entry names a joint that was locked (`beyond`: the
 // moving joints beyond the tip, empty for a tree; and the locked mimic joints).
-void checkLockedPositions(const Reporter& report, const UrdfOptions& options, const std::vector<std::string>& beyond,
-                          const std::vector<std::string>& mimic, bool chain) {
+void checkLockedPositions(const Reporter& report, const NamedUrdfOptions& options,
+                          const std::vector<std::string>& beyond, const std::vector<std::string>& mimic, bool chain) {
   for (const auto& [name, q] : options.locked_positions) {
     const bool known = std::find(beyond.begin(), beyond.end(), name) != beyond.end() ||
                        std::find(mimic.begin(), mimic.end(), name) != mimic.end();
@@ -1068,7 +1074,7 @@ void checkLockedPositions(const Reporter& report, const UrdfOptions& options, co
 
 // Report the mass beyond the tip, or weld it to the tip body as a payload.
 void handleBeyondTip(const Reporter& report, ModelBuilder& builder, Placement& placement, const std::string& tip,
-                     const UrdfOptions& options) {
+                     const NamedUrdfOptions& options) {
   const BeyondTip beyond = findBeyondTip(placement);
   std::vector<std::string> links, joints;
   for (const auto& [joint, link] : beyond.links) {
@@ -1143,7 +1149,7 @@ Transform planeOf(const Reporter& report, const urdf::Joint& uj) {
   return planeFrameOf(axis, checkedPlacementOf(report, uj, "joint '" + uj.name + "'"));
 }
 
-BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model, const UrdfOptions& options) {
+BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model, const NamedUrdfOptions& options) {
   BaseChoice choice;
   const LinkPtr file_root = model.getRoot();
   choice.root = options.root.empty() ? file_root : model.getLink(options.root);
@@ -1227,7 +1233,7 @@ void requireInertialData(const Reporter& report, const TiXmlElement* robot, cons
 // The chain from `root` to the tip (options.tip, or the unique leaf of a tree
 // that does not branch into moving joints).
 void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, const TiXmlElement* robot,
-               const LinkPtr& root, const std::map<std::string, double>& rotor, const UrdfOptions& options,
+               const LinkPtr& root, const std::map<std::string, double>& rotor, const NamedUrdfOptions& options,
                ModelBuilder& builder, Placement& placement) {
   const std::vector<LinkPtr> chain = chainLinks(report, urdf_model, root, options.tip);
   const std::string tip_name = chain.back()->name;
@@ -1254,7 +1260,7 @@ void loadChain(const Reporter& report, const urdf::ModelInterface& urdf_model, c
 
 // The whole tree below `root` (no tip, and it branches into moving joints).
 void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, const TiXmlElement* robot,
-              const LinkPtr& root, const std::map<std::string, double>& rotor, const UrdfOptions& options,
+              const LinkPtr& root, const std::map<std::string, double>& rotor, const NamedUrdfOptions& options,
               ModelBuilder& builder, Placement& placement) {
   std::vector<std::string> moving;
   addTree(report, builder, placement, root, rotor, options, moving);
@@ -1266,7 +1272,7 @@ void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, co
   checkLockedPositions(report, options, {}, placement.locked_mimic, false);
 }
 
-Model load(const Reporter& report, const std::string& text, const UrdfOptions& options) {
+Model load(const Reporter& report, const std::string& text, const NamedUrdfOptions& options) {
   // TinyXML 2.6 (what urdfdom parses with) trusts a UTF-8 lead byte's length:
   // a text that ends inside a multi-byte name makes it step over the final
   // NUL and read on into whatever memory follows (found by fuzz_urdf). Both
@@ -1306,11 +1312,11 @@ Model load(const Reporter& report, const std::string& text, const UrdfOptions& o
 
 }  // namespace
 
-Model loadUrdfString(const std::string& xml, const UrdfOptions& options) {
+Model internal::loadUrdfString(const std::string& xml, const internal::NamedUrdfOptions& options) {
   return load(Reporter("<string>"), xml, options);
 }
 
-Model loadUrdfFile(const std::string& path, const UrdfOptions& options) {
+Model internal::loadUrdfFile(const std::string& path, const internal::NamedUrdfOptions& options) {
   const Reporter report(path);
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) report.fail("cannot read the file: it is a directory");
@@ -1323,6 +1329,15 @@ Model loadUrdfFile(const std::string& path, const UrdfOptions& options) {
   content << in.rdbuf();
   if (in.bad()) report.fail("cannot read the file");
   return load(report, content.str(), options);
+}
+
+// Without names: the messages name the options as UrdfOptions spells them.
+Model loadUrdfString(const std::string& xml, const UrdfOptions& options) {
+  return internal::loadUrdfString(xml, internal::NamedUrdfOptions{options, {}});
+}
+
+Model loadUrdfFile(const std::string& path, const UrdfOptions& options) {
+  return internal::loadUrdfFile(path, internal::NamedUrdfOptions{options, {}});
 }
 
 }  // namespace zwang

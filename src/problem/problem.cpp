@@ -101,8 +101,8 @@ Expressed parseExpressed(const Spelling& spelling, const std::string& text, Axes
                      "unknown value " + quoted(spelling, text, 40) + " (expected " + expected + hint + ")");
 }
 
-UrdfOptions urdfOptions(const ModelRequest& request) {
-  UrdfOptions urdf;
+internal::NamedUrdfOptions urdfOptions(const ModelRequest& request) {
+  internal::NamedUrdfOptions urdf;
   urdf.root = request.root;
   urdf.tip = request.tip;
   urdf.strict = request.strict;

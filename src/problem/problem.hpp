@@ -10,6 +10,8 @@
 
 #include "zwang/zwang.hpp"
 
+#include "model/urdf_option_names.hpp"  // the front ends spell the URDF options their own way in its messages
+
 namespace zwang::problem {
 
 // What is wrong: a value out of its range or form, or one the model refuses (a name it lacks).
@@ -60,9 +62,9 @@ struct ModelRequest {
   bool attach_beyond_tip = false;
   bool lock_mimic = false;  // weld the mimic joints (MimicJoints::Lock)
   BaseType base = BaseType::Fixed;
-  UrdfOptions::Names names;
+  internal::UrdfOptionNames names;
 };
-UrdfOptions urdfOptions(const ModelRequest& request);
+internal::NamedUrdfOptions urdfOptions(const ModelRequest& request);
 
 // "fixed", "free", "planar"; ProblemError(Value) naming the allowed ones. Where
 // "fixed" is no value (`no_fixed` given), "fixed" is refused with `no_fixed` as the hint.

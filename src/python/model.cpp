@@ -15,13 +15,13 @@ std::string pathArg(py::handle path) {
   return fs.cast<std::string>();
 }
 
-UrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia, bool strict,
-                        bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
+internal::NamedUrdfOptions urdfOptions(const std::string& root, const std::string& tip, const py::object& rotor_inertia,
+                                       bool strict, bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
   problem::ModelRequest request{root, tip, strict, attach_beyond_tip, lock_mimic, BaseType::Fixed, {}};
   request.base = checked("base", [&] { return problem::parseBaseType(kPython, base); });
   request.names = {"tip=", "rotor_inertia=", "attach_beyond_tip=True", "lock_mimic=True"};
   request.names.base = "base='" + base + "'";
-  UrdfOptions options = problem::urdfOptions(request);
+  internal::NamedUrdfOptions options = problem::urdfOptions(request);
   if (!rotor_inertia.is_none()) {
     if (!py::isinstance<py::dict>(rotor_inertia))
       raise(PyExc_TypeError, "rotor_inertia: expected a dict {joint name: inertia}");
@@ -511,8 +511,8 @@ void bindLoaders(py::module_& m) {
       "load_urdf",
       [](py::handle path, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
          bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
-    return issueWarnings(std::make_shared<Model>(
-        loadUrdfFile(pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic, base))));
+    return issueWarnings(std::make_shared<Model>(internal::loadUrdfFile(
+        pathArg(path), urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic, base))));
       },
       py::arg("path"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
       py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,
@@ -534,7 +534,7 @@ void bindLoaders(py::module_& m) {
       [](const std::string& xml, const std::string& root, const std::string& tip, const py::object& rotor, bool strict,
          bool attach_beyond_tip, bool lock_mimic, const std::string& base) {
     return issueWarnings(std::make_shared<Model>(
-        loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic, base))));
+        internal::loadUrdfString(xml, urdfOptions(root, tip, rotor, strict, attach_beyond_tip, lock_mimic, base))));
       },
       py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
       py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,

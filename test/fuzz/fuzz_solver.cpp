@@ -33,6 +33,10 @@
 #include "fuzz_common.hpp"
 #include "zwang/zwang.hpp"
 
+#include "dynamics/task_solver_order.hpp"  // the task's groups, to mutate their matrices
+
+#include "dynamics/workspace_scratch.hpp"  // the sweep's accelerations, checked finite too
+
 namespace {
 
 using namespace zwang;
@@ -170,7 +174,7 @@ void checkSolution(const Workspace& ws, const char* where) {
   fuzz::requireFinite(ws.solution.tau_control, "tau_control", where);
   fuzz::requireFinite(ws.solution.gauss, "gauss", where);
   fuzz::requireFinite(ws.solution.balance.residual, "balance residual", where);
-  for (const Vec6& a : ws.a) fuzz::requireFinite(a, "body accelerations (ws.a)", where);
+  for (const Vec6& a : scratchOf(ws).a) fuzz::requireFinite(a, "body accelerations (the sweep's)", where);
 }
 
 void checkFriction(const Workspace& ws, const FrictionOptions& options, const char* where) {
@@ -296,7 +300,7 @@ TaskDraw drawTask(FuzzedDataProvider& in, const Model& chain, int frames) {
         group.reference >= 0 && group.reference != group.frame ? RowGroup::Kind::Relative : RowGroup::Kind::Frame;
     addGroup(group, task);
     draw.groups.push_back(group);
-    previous = &task.groups().back().A;
+    previous = &solverOrder(task).groups().back().A;
   }
   draw.targets.resize(task.constraintRows());
   for (Eigen::Index r = 0; r < draw.targets.size(); ++r) draw.targets[r] = signedLog(in, 1e-3, 1e3);

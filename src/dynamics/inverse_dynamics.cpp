@@ -100,6 +100,7 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
   // formed and handed to the parent (the world, body 0, takes nothing).
   for (int i = 1; i <= N; ++i)
     if (i == N || model.jointStart(i + 1) == i + 1) sw.Ic[at(i)] = sw.I[at(i)].matrix();
+  double* const H = ws.H.data();  // column-major N × N; H_rc at H[r + c·N] (the loop's stores do not reload ws.H)
   for (int last = N; last >= 1;) {
     const int first = model.jointStart(last), p = model.parent(first);
     const Mat6& Ic = sw.Ic[at(last)];
@@ -107,7 +108,7 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
     for (int i = last; i >= first; --i) {
       const Vec6 F = Ic * sw.S[at(i)];
       const int row = i - 1;
-      ws.H(row, row) = sw.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
+      H[row + row * N] = sw.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
       // H_kj ≠ 0 only for the DOFs j supporting k (its ancestors); the rest of
       // row k below the diagonal is the zeros of the branches between them
       // (none on a chain): each entry written once, with no pass over all of H.
@@ -117,7 +118,7 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
           h = sw.S[at(j)].dot(F);
           a = model.parent(a);
         }
-        ws.H(row, j - 1) = ws.H(j - 1, row) = h;
+        H[row + (j - 1) * N] = H[(j - 1) + row * N] = h;
       }
     }
     last = first - 1;

@@ -257,8 +257,7 @@ namespace {
 // A_parent = P^A A_i (line 19). Without kBias, Ẍ_bias,i = 0 (a multi-DOF
 // joint's bodies before its last) and line 20 skips Aᵀ Ẍ_bias.
 template <bool kBalance, bool kBias>
-inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
+inline void constraintColumnsStep(const Task& task, int i, double u_D, WorkspaceScratch& sw) {
   ConstraintMatrix& A = sw.Ahat;
   const Vec6& S = sw.S[at(i)];
   const Vec6& IAS = sw.IAS[at(i)];
@@ -287,8 +286,7 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
 // sees the columns before activeColumns(k) (a joint row on one of the joint's
 // DOFs sits on that DOF's body): its SᵀA is zero beyond. kDofs 0: n at run time.
 template <int kDofs>
-void jointBalanceUpdate(const Task& task, int first, int dofs, Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
+void jointBalanceUpdate(const Task& task, int first, int dofs, WorkspaceScratch& sw) {
   const int n = kDofs > 0 ? kDofs : dofs;
   const int c0 = solverOrder(task).firstColumn(first), c1 = solverOrder(task).activeColumns(first);
   const double* sA[6];
@@ -318,19 +316,18 @@ void jointBalanceUpdate(const Task& task, int first, int dofs, Workspace& ws) {
 }
 
 // The joint types' DOF counts as constants: a free joint's 6, a spherical or planar one's 3.
-void jointBalanceUpdate(const Task& task, int first, int last, Workspace& ws) {
+void jointBalanceUpdate(const Task& task, int first, int last, WorkspaceScratch& sw) {
   const int n = last - first + 1;
   if (n == 6)
-    jointBalanceUpdate<6>(task, first, n, ws);
+    jointBalanceUpdate<6>(task, first, n, sw);
   else if (n == 3)
-    jointBalanceUpdate<3>(task, first, n, ws);
+    jointBalanceUpdate<3>(task, first, n, sw);
   else
-    jointBalanceUpdate<0>(task, first, n, ws);
+    jointBalanceUpdate<0>(task, first, n, sw);
 }
 
 // Line 13's D and 1/D of DOF body i from its I^A S, or Degenerate.
-inline Status pivot(const Dof& dof, int i, Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
+inline Status pivot(const Dof& dof, int i, WorkspaceScratch& sw) {
   const double D = dof.rotor_inertia + sw.S[at(i)].dot(sw.IAS[at(i)]);  // line 13
   sw.D[at(i)] = D;
   if (!(D > 1e-300))
@@ -344,8 +341,8 @@ inline Status pivot(const Dof& dof, int i, Workspace& ws) {
 // joint's DOF bodies [first, last] and F^a = p^A + Σ I^A S D⁻¹ u. The first
 // child to arrive (the last in depth-first order: its subtree ends where p's
 // does) starts p's sums from I_p and F_bias,p.
-inline void passToParent(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA, Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
+inline void passToParent(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA,
+                         WorkspaceScratch& sw) {
   const int p = model.parent(first);
   if (p == 0) return;  // the world takes nothing
   Mat6& IA_parent = sw.IA[at(p)];
@@ -374,15 +371,14 @@ inline void passToParent(const Model& model, int first, int last, const Mat6& IA
 // (the LDLᵀ of the joint's D, last DOF first) are the one-DOF steps' numbers,
 // but each pivot waits on a 6-vector update, not on a 6 × 6 downdate of I^A.
 inline Status jointPivots(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA, const VectorRef& tau,
-                          Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
+                          WorkspaceScratch& sw) {
   const std::vector<Dof>& dofs = model.dofs();
   for (int k = first; k <= last; ++k) {
     sw.IAS[at(k)].noalias() = IA * sw.S[at(k)];  // the columns of I^A S: independent
     sw.u[at(k)] = tau[k - 1] - sw.S[at(k)].dot(pA);
   }
   for (int m = last; m >= first; --m) {
-    if (Status s = pivot(dofs[at(m - 1)], m, ws); !s) return s;
+    if (Status s = pivot(dofs[at(m - 1)], m, sw); !s) return s;
     const Vec6& IAS_m = sw.IAS[at(m)];
     const double inverse_D = sw.inverse_D[at(m)], u_m = sw.u[at(m)];
     for (int k = first; k < m; ++k) {
@@ -417,21 +413,21 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     pA.noalias() += IA * sw.c[at(i)];  // F^A + I^A Ẍ_bias
     if (first == i) {                  // one DOF: lines 13–15 as the report has them
       sw.IAS[at(i)].noalias() = IA * sw.S[at(i)];
-      if (Status s = pivot(dofs[at(i - 1)], i, ws); !s) return s;
+      if (Status s = pivot(dofs[at(i - 1)], i, sw); !s) return s;
       sw.u[at(i)] = tau[i - 1] - sw.S[at(i)].dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
-    } else if (Status s = jointPivots(model, first, i, IA, pA, tau, ws); !s) {
+    } else if (Status s = jointPivots(model, first, i, IA, pA, tau, sw); !s) {
       return s;
     }
     // P^A = 1 − I^A S D⁻¹ Sᵀ (line 14) is applied, never formed.
     if (first == i) {
-      constraintColumnsStep<true, true>(task, i, sw.u[at(i)] * sw.inverse_D[at(i)], ws);
+      constraintColumnsStep<true, true>(task, i, sw.u[at(i)] * sw.inverse_D[at(i)], sw);
     } else {
-      constraintColumnsStep<false, true>(task, i, sw.u[at(i)] * sw.inverse_D[at(i)], ws);
+      constraintColumnsStep<false, true>(task, i, sw.u[at(i)] * sw.inverse_D[at(i)], sw);
       for (int k = i - 1; k >= first; --k)
-        constraintColumnsStep<false, false>(task, k, sw.u[at(k)] * sw.inverse_D[at(k)], ws);
-      jointBalanceUpdate(task, first, i, ws);
+        constraintColumnsStep<false, false>(task, k, sw.u[at(k)] * sw.inverse_D[at(k)], sw);
+      jointBalanceUpdate(task, first, i, sw);
     }
-    passToParent(model, first, i, IA, pA, ws);
+    passToParent(model, first, i, IA, pA, sw);
     i = first - 1;
   }
   return {};
@@ -569,9 +565,8 @@ void balanceSolveLanes(const Eigen::MatrixXd& C, int m, double* lanes, Eigen::In
 // W. Body i's δẌ hangs from its parent's: s.da's column i, W × 6 (a column
 // per component).
 template <int W>
-void outwardLanes(const Model& model, const Task& task, const Workspace& ws, Eigen::Index c0, bool solve_balance,
+void outwardLanes(const Model& model, const Task& task, const WorkspaceScratch& sw, Eigen::Index c0, bool solve_balance,
                   UnitTorqueScratch& s, Eigen::Ref<Eigen::MatrixXd> dnu, Eigen::Ref<Eigen::MatrixXd> dqdd) {
-  const WorkspaceScratch& sw = scratchOf(ws);
   using Lanes = Eigen::Matrix<double, W, 1>;  // one entry per column
   const int N = model.nv(), m = task.solverColumns();
   auto dnu_lanes = s.dnu_lanes.topLeftCorner(W, m);  // SᵀA δν: whole lanes per row
@@ -622,17 +617,15 @@ void columnRuns(const Model& model, const std::vector<int>& dofs, UnitTorqueScra
 
 // Line 20 at body i for one column: δU₀ += SᵀA_i δu_i / D_i on the rows
 // [first, end) of i's subtree (dU_c: the column's δU₀).
-ZWANG_ALWAYS_INLINE void constraintColumnsDelta(const Workspace& ws, int i, int first, int end, double du_D,
+ZWANG_ALWAYS_INLINE void constraintColumnsDelta(const WorkspaceScratch& sw, int i, int first, int end, double du_D,
                                                 double* dU_c) {
-  const WorkspaceScratch& sw = scratchOf(ws);
   for (int r = first; r < end; ++r) dU_c[r] += sw.SA(r, i) * du_D;
 }
 
 // Lines 13–20 of a one-DOF joint (body i) on its run of columns: δu_i = [i is
 // the column's DOF] − Sᵀ δF^a, then δU₀ and δF^a for the parent.
-void oneDofColumns(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& dofs, int i,
-                   UnitTorqueScratch& s) {
-  const WorkspaceScratch& sw = scratchOf(ws);
+void oneDofColumns(const Model& model, const Task& task, const WorkspaceScratch& sw, const std::vector<int>& dofs,
+                   int i, UnitTorqueScratch& s) {
   const Vec6& S = sw.S[at(i)];
   const Vec6& IAS = sw.IAS[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
@@ -647,7 +640,7 @@ void oneDofColumns(const Model& model, const Task& task, const Workspace& ws, co
     const double du_ic = (c == own ? 1.0 : 0.0) - S.dot(dF);
     du[c * du_stride] = du_ic;
     const double du_D = du_ic * inverse_D;
-    constraintColumnsDelta(ws, i, first, end, du_D, s.dU.data() + c * dU_stride);
+    constraintColumnsDelta(sw, i, first, end, du_D, s.dU.data() + c * dU_stride);
     if (!to_world) dF += IAS * du_D;  // lines 17–18
   }
 }
@@ -660,9 +653,8 @@ void oneDofColumns(const Model& model, const Task& task, const Workspace& ws, co
 // joint. So each column costs one 6 × 6 product, not a 6-vector update per
 // DOF (a free root's six bodies carry every column); the parent gets
 // Σ_k I^A_k S_k δu_k / D_k more (lines 17–18).
-void multiDofColumns(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& dofs, int first,
-                     int last, UnitTorqueScratch& s) {
-  const WorkspaceScratch& sw = scratchOf(ws);
+void multiDofColumns(const Model& model, const Task& task, const WorkspaceScratch& sw, const std::vector<int>& dofs,
+                     int first, int last, UnitTorqueScratch& s) {
   const int n = last - first + 1;
   double g[6][6];  // g[k][l] for 0 ≤ k < l < n
   Mat6 W = Mat6::Zero(), IAS_D = Mat6::Zero();
@@ -741,9 +733,9 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   for (int i = model.nv(); i >= 1;) {  // joint by joint from the leaves; body i is a joint's last DOF body
     const int first = model.jointStart(i);
     if (first == i)
-      oneDofColumns(model, task, ws, dofs, i, s);
+      oneDofColumns(model, task, sw, dofs, i, s);
     else
-      multiDofColumns(model, task, ws, dofs, first, i, s);
+      multiDofColumns(model, task, sw, dofs, first, i, s);
     i = first - 1;
   }
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
@@ -767,16 +759,16 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   for (Eigen::Index c0 = 0; c0 < k;) {
     const Eigen::Index left = k - c0;
     if (left >= kLanes) {
-      outwardLanes<kLanes>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      outwardLanes<kLanes>(model, task, sw, c0, solve_in_lanes, s, dnu, dqdd);
       c0 += kLanes;
     } else if (left >= 4) {
-      outwardLanes<4>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      outwardLanes<4>(model, task, sw, c0, solve_in_lanes, s, dnu, dqdd);
       c0 += 4;
     } else if (left >= 2) {
-      outwardLanes<2>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      outwardLanes<2>(model, task, sw, c0, solve_in_lanes, s, dnu, dqdd);
       c0 += 2;
     } else {
-      outwardLanes<1>(model, task, ws, c0, solve_in_lanes, s, dnu, dqdd);
+      outwardLanes<1>(model, task, sw, c0, solve_in_lanes, s, dnu, dqdd);
       c0 += 1;
     }
   }

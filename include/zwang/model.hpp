@@ -22,7 +22,7 @@
 /// order: every body comes after its parent, and the bodies of a subtree are
 /// the contiguous range [b, subtreeEnd(b)). The sweeps rely on that range: the
 /// constraints a body feels are those on its subtree, a contiguous block of
-/// columns (Task::columnRange). Fixed URDF joints are merged into their parent
+/// columns (the task's solver order, docs/solver.md). Fixed URDF joints are merged into their parent
 /// body at load time, but every link stays addressable as a Frame attached to
 /// a body.
 #pragma once

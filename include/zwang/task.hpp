@@ -193,20 +193,21 @@ class Task {
   };
   /// Groups sorted by body, last body first ("solver order"): since the
   /// bodies are in depth-first order, the columns acting on a body's subtree
-  /// are then a contiguous block (columnRange), and for a chain the columns
+  /// are then a contiguous block ([firstColumn(b), columnsEnd(b))), and for a chain the columns
   /// acting on bodies i..N a leading block.
   const std::vector<ConstraintGroup>& groups() const { return groups_; }
   /// The row of each solver column: a user row (< constraintRows()) or a mimic row.
   const std::vector<int>& solverRowToUserRow() const { return solver_row_; }
-  /// Number of solver columns acting on bodies b, b+1, … (a leading block).
-  int activeColumns(int body) const { return active_[static_cast<std::size_t>(body)]; }
+  /// End of the solver columns acting on bodies b, b+1, … (a leading block
+  /// [0, columnsEnd(b)): also their count).
+  int columnsEnd(int body) const { return columns_end_[static_cast<std::size_t>(body)]; }
   /// First solver column acting on body b's subtree; the block is
-  /// [firstColumn(b), activeColumns(b)).
+  /// [firstColumn(b), columnsEnd(b)).
   int firstColumn(int body) const { return first_column_[static_cast<std::size_t>(body)]; }
   /// True when some balance row has several solver columns (a relative
   /// constraint or a mimic joint): then the balance works on rows, each the
   /// sum of its solver columns (balanceRowOfColumn).
-  bool hasRelative() const { return has_relative_; }
+  bool balanceOnRows() const { return balance_on_rows_; }
   /// The balance row of each solver column (the identity without relative constraints).
   const std::vector<int>& balanceRowOfColumn() const { return balance_row_; }
   /// Per solver column: 1 when its force is a contact's (the environment's), else 0.
@@ -223,9 +224,9 @@ class Task {
   std::vector<int> subtree_end_;  // per body, copied from the model
   std::vector<int> solver_row_;
   std::vector<int> balance_row_;
-  std::vector<int> active_;
+  std::vector<int> columns_end_;
   std::vector<int> first_column_;
-  bool has_relative_ = false;
+  bool balance_on_rows_ = false;
   int mimic_rows_ = 0;
   bool has_contacts_ = false;
   std::vector<char> contact_column_;

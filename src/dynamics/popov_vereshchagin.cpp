@@ -12,7 +12,7 @@
 //  * trees (the report treats chains): the bodies are in depth-first order,
 //    "i − 1" of the report is parent(i), a parent sums what all its children
 //    pass it (lines 16–18), and the columns of a subtree are one contiguous
-//    block [firstColumn(i), activeColumns(i)), so each column is projected in
+//    block [firstColumn(i), columnsEnd(i)), so each column is projected in
 //    place by every joint between its body and the base. 𝓛 gets an entry only
 //    from the bodies two columns share: columns on different branches meet
 //    only at their common ancestors;
@@ -263,7 +263,7 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
   const Vec6& IAS = sw.IAS[at(i)];
   const Vec6& c = sw.c[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
-  const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).activeColumns(i);
+  const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).columnsEnd(i);
   double* sA = sw.SA.col(i).data();
   const double SS_D = S.squaredNorm() * inverse_D;
   for (int col = first; col < k; ++col) {
@@ -283,16 +283,16 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
 // Line 21 for a joint of several DOFs, after its steps: 𝓛 += Σ_k (SᵀA_k)ᵀ
 // SᵀA_k / D_k over its n DOF bodies in one pass over 𝓛's lower triangle (not
 // a pass per DOF; n a constant, so the sum over k stays in registers). Body k
-// sees the columns before activeColumns(k) (a joint row on one of the joint's
+// sees the columns before columnsEnd(k) (a joint row on one of the joint's
 // DOFs sits on that DOF's body): its SᵀA is zero beyond. kDofs 0: n at run time.
 template <int kDofs>
 void jointBalanceUpdate(const Task& task, int first, int dofs, WorkspaceScratch& sw) {
   const int n = kDofs > 0 ? kDofs : dofs;
-  const int c0 = solverOrder(task).firstColumn(first), c1 = solverOrder(task).activeColumns(first);
+  const int c0 = solverOrder(task).firstColumn(first), c1 = solverOrder(task).columnsEnd(first);
   const double* sA[6];
   for (int k = 0; k < n; ++k) {
     double* sA_k = sw.SA.col(first + k).data();
-    for (int r = solverOrder(task).activeColumns(first + k); r < c1; ++r) sA_k[r] = 0.0;
+    for (int r = solverOrder(task).columnsEnd(first + k); r < c1; ++r) sA_k[r] = 0.0;
     sA[k] = sA_k;
   }
   for (int col = c0; col < c1; ++col) {
@@ -471,7 +471,7 @@ void expandToColumns(const Task& task, const Eigen::Ref<const Eigen::MatrixXd>& 
 void balance(const Task& task, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.balanceRows();
-  const bool condensed = solverOrder(task).hasRelative();
+  const bool condensed = solverOrder(task).balanceOnRows();
   if (condensed) condensedBalance(task, ws);
   Eigen::MatrixXd& L = condensed ? sw.L_rows : sw.L;
   const Eigen::VectorXd& L_scale = condensed ? sw.L_scale_rows : sw.L_scale;
@@ -518,7 +518,7 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   for (int i = 1; i <= model.nv(); ++i) {
     const int p = model.parent(i);
     const Vec6 a_parent = p == i - 1 ? a_previous : sw.a[at(p)];
-    const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).activeColumns(i) - first;
+    const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).columnsEnd(i) - first;
     const double constraint = sw.SA.col(i).segment(first, k).dot(sw.nu.segment(first, k));        // Sᵀ A_i ν
     qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];  // line 28
     a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];                 // line 29
@@ -584,7 +584,7 @@ void outwardLanes(const Model& model, const Task& task, const WorkspaceScratch& 
     Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
     const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
     for (Eigen::Index c = from; c < to; ++c) dq[c - c0] = s.du(i, c);
-    const int first = solverOrder(task).firstColumn(i), ki = solverOrder(task).activeColumns(i);
+    const int first = solverOrder(task).firstColumn(i), ki = solverOrder(task).columnsEnd(i);
     for (int r = first; r < ki; ++r) dq += sw.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
     const double* parent = da + model.parent(i) * da_stride;
     const Vec6& IAS = sw.IAS[at(i)];
@@ -630,7 +630,7 @@ void oneDofColumns(const Model& model, const Task& task, const WorkspaceScratch&
   const Vec6& IAS = sw.IAS[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
   const bool to_world = model.parent(i) == 0;  // the world takes δF^a and does nothing with it
-  const int first = solverOrder(task).firstColumn(i), end = solverOrder(task).activeColumns(i);
+  const int first = solverOrder(task).firstColumn(i), end = solverOrder(task).columnsEnd(i);
   const Eigen::Index begin = s.run_begin[i], run_end = s.run_end[i];
   const Eigen::Index own = begin < run_end && bodyOfDof(dofs[at(static_cast<int>(begin))]) == i ? begin : -1;
   double* const du = s.du.data() + i;  // row i
@@ -670,10 +670,9 @@ void multiDofColumns(const Model& model, const Task& task, const WorkspaceScratc
   // The joint's constraint rows: its subtree's [rows_first, rows_first +
   // rows), DOF body k taking those before rows_end[k] (a joint row on one of
   // the joint's DOFs sits on that DOF's body, and only the bodies before see it).
-  const int rows_first = solverOrder(task).firstColumn(first),
-            rows = solverOrder(task).activeColumns(first) - rows_first;
+  const int rows_first = solverOrder(task).firstColumn(first), rows = solverOrder(task).columnsEnd(first) - rows_first;
   int rows_end[6];
-  for (int k = 0; k < n; ++k) rows_end[k] = solverOrder(task).activeColumns(first + k) - rows_first;
+  for (int k = 0; k < n; ++k) rows_end[k] = solverOrder(task).columnsEnd(first + k) - rows_first;
   // Line 20 for a column from below, all DOFs at once: δU₀ −= Y δF^a with
   // Y = Σ_k SᵀA_k W_k / D_k (kept transposed: a row's 6 entries side by side).
   auto Yt = s.joint_rows.leftCols(rows);
@@ -740,9 +739,9 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
   // outward pass's lanes, a block of columns at a time; else here, all at once.
-  const bool solve_in_lanes = !solverOrder(task).hasRelative() && !sw.balance_factorisation.by_eigen;
-  dU *= -1.0;                             // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
-  if (solverOrder(task).hasRelative()) {  // on the balance's rows: each the sum of its columns
+  const bool solve_in_lanes = !solverOrder(task).balanceOnRows() && !sw.balance_factorisation.by_eigen;
+  dU *= -1.0;                               // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
+  if (solverOrder(task).balanceOnRows()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
     auto dU_rows = sw.dU_rows.topLeftCorner(rows, k);
     dU_rows.setZero();
@@ -809,7 +808,7 @@ void taskResidual(const Task& task, Workspace& ws) {
   // picked components 1e-12).
   const int m = task.balanceRows();
   BalanceReport& report = ws.solution.balance;
-  if (!solverOrder(task).hasRelative()) {  // one column per row
+  if (!solverOrder(task).balanceOnRows()) {  // one column per row
     double sum2 = 0.0;
     bool met = true;
     int col = 0;
@@ -874,7 +873,7 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   if (model.isChain()) {  // one running sum from the tip inward
     Vec6 carried = Vec6::Zero();
     for (int i = N; i >= 1; --i) {
-      const int k_beyond = solverOrder(task).activeColumns(i + 1), k = solverOrder(task).activeColumns(i);
+      const int k_beyond = solverOrder(task).columnsEnd(i + 1), k = solverOrder(task).columnsEnd(i);
       if (k > k_beyond)  // most bodies carry none: no product of zero width
         carried.noalias() += sw.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
       tau_c[i - 1] = sw.S[at(i)].dot(carried);
@@ -883,7 +882,7 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   }
   std::vector<Vec6>& carried = sw.constraint_wrench;
   for (int i = 1; i <= N; ++i) {  // body i's own columns: those on bodies ≥ i but not ≥ i + 1
-    const int k_beyond = solverOrder(task).activeColumns(i + 1), k = solverOrder(task).activeColumns(i);
+    const int k_beyond = solverOrder(task).columnsEnd(i + 1), k = solverOrder(task).columnsEnd(i);
     if (k == k_beyond)  // most bodies carry none: no product of zero width
       carried[at(i)].setZero();
     else

@@ -18,9 +18,9 @@ class TaskSolverOrder {
 
   const std::vector<ConstraintGroup>& groups() const { return task_.groups(); }
   const std::vector<int>& solverRowToUserRow() const { return task_.solverRowToUserRow(); }
-  int activeColumns(int body) const { return task_.activeColumns(body); }
+  int columnsEnd(int body) const { return task_.columnsEnd(body); }
   int firstColumn(int body) const { return task_.firstColumn(body); }
-  bool hasRelative() const { return task_.hasRelative(); }
+  bool balanceOnRows() const { return task_.balanceOnRows(); }
   const std::vector<int>& balanceRowOfColumn() const { return task_.balanceRowOfColumn(); }
   const std::vector<char>& contactColumns() const { return task_.contactColumns(); }
 

@@ -226,7 +226,7 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
     const auto a = static_cast<Eigen::Index>(b);
     const int i = bodyOfDof(dofOfEntry(model, stuck[b]));
     const auto at_i = static_cast<std::size_t>(i);
-    const int first = solverOrder(task).firstColumn(i), count = solverOrder(task).activeColumns(i) - first;
+    const int first = solverOrder(task).firstColumn(i), count = solverOrder(task).columnsEnd(i) - first;
     const auto SA = sw.SA.col(i).segment(first, count).cwiseAbs();
     const Vec6 IAS = sw.IAS[at_i].cwiseAbs();
     fs.curvature_terms[a] = (1.0 + IAS.dot(parentAccelerationTerms(model, ws, fs, a, i)) +

@@ -213,7 +213,7 @@ void Task::reorder() {
   // between those on bodies ≥ end and those on bodies ≥ b: a contiguous block.
   std::stable_sort(groups_.begin(), groups_.end(),
                    [](const ConstraintGroup& a, const ConstraintGroup& b) { return a.body > b.body; });
-  has_relative_ =
+  balance_on_rows_ =
       std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.reference_side; });
   solver_row_.clear();
   balance_row_.clear();
@@ -224,19 +224,19 @@ void Task::reorder() {
       const int row = g.mimic_row ? constraintRows() + g.first_row : g.first_row + k;
       // With relative constraints the balance works on the rows (each the sum
       // of its sides); otherwise on the solver columns themselves.
-      balance_row_.push_back(has_relative_ ? row : static_cast<int>(solver_row_.size()));
+      balance_row_.push_back(balance_on_rows_ ? row : static_cast<int>(solver_row_.size()));
       solver_row_.push_back(row);
       contact_column_.push_back(g.contact ? 1 : 0);
     }
   has_contacts_ = std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.contact; });
   const std::size_t bodies = subtree_end_.size();
-  active_.assign(bodies + 1, 0);  // active_[N + 1] = 0: no body beyond the last
+  columns_end_.assign(bodies + 1, 0);  // columns_end_[N + 1] = 0: no body beyond the last
   for (std::size_t body = 0; body <= bodies; ++body)
     for (const ConstraintGroup& g : groups_)
-      if (static_cast<std::size_t>(g.body) >= body) active_[body] += g.rows;
+      if (static_cast<std::size_t>(g.body) >= body) columns_end_[body] += g.rows;
   first_column_.assign(bodies, 0);
   for (std::size_t body = 0; body < bodies; ++body)
-    first_column_[body] = active_[static_cast<std::size_t>(subtree_end_[body])];
+    first_column_[body] = columns_end_[static_cast<std::size_t>(subtree_end_[body])];
 }
 
 Status checkBalanceOptions(const BalanceOptions& o) {

@@ -871,20 +871,37 @@ void bindKinematics(py::module_& m) {
       "6×nv J with frame_velocity = J qd (nv = dof on a fixed base)");
 }
 
+// forward_dynamics and inverse_dynamics: (q, qd, x) with `x_name` τ or q̈, the task of wrenches and gravity
+// built once per workspace; `algorithm` runs the C++ call and returns where its result lands.
+template <class Algorithm>
+py::array dynamicsCall(const std::shared_ptr<Model>& model, const py::object& ws_obj, py::handle q, py::handle qd,
+                       py::handle x, const char* x_name, py::handle wrenches, py::handle gravity, const char* name,
+                       Algorithm algorithm) {
+  PyWorkspace& pw = workspaceArg(model, ws_obj);
+  Task& task = idTask(pw, wrenches, gravity);
+  const auto qv = vectorArg("q", q, pw.q_buf);
+  const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
+  const auto xv = optionalVector(x_name, x, pw.qdd_buf, pw.zeros);
+  ++pw.generation;
+  const Eigen::VectorXd* result = nullptr;
+  if (const Status s = algorithm(*pw.ws, qv, qdv, xv, task, result); !s) raiseStatus(s, name);
+  return vectorCopy(*result);
+}
+
+using ConstVector = Eigen::Ref<const Eigen::VectorXd>;
+
 // forward_dynamics, inverse_dynamics, joint_space_inertia.
 void bindDynamics(py::module_& m) {
   m.def(
       "forward_dynamics",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
          py::handle wrenches, py::handle gravity) {
-    PyWorkspace& pw = workspaceArg(model, ws_obj);
-    Task& task = idTask(pw, wrenches, gravity);
-    const auto qv = vectorArg("q", q, pw.q_buf);
-    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
-    const auto tauv = optionalVector("tau", tau, pw.tau_buf, pw.zeros);
-    ++pw.generation;
-    if (const Status s = forwardDynamics(*model, *pw.ws, qv, qdv, tauv, task); !s) raiseStatus(s, "forward_dynamics");
-    return vectorCopy(pw.ws->solution.qdd);
+    return dynamicsCall(model, ws_obj, q, qd, tau, "tau", wrenches, gravity, "forward_dynamics",
+                        [&](Workspace& ws, const ConstVector& qv, const ConstVector& qdv, const ConstVector& tauv,
+                            const Task& task, const Eigen::VectorXd*& result) {
+      result = &ws.solution.qdd;
+      return forwardDynamics(*model, ws, qv, qdv, tauv, task);
+    });
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("tau") = py::none(),
       py::kw_only(), py::arg("wrenches") = py::none(), py::arg("gravity") = py::none(),
@@ -894,14 +911,12 @@ void bindDynamics(py::module_& m) {
       "inverse_dynamics",
       [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle qdd,
          py::handle wrenches, py::handle gravity) {
-    PyWorkspace& pw = workspaceArg(model, ws_obj);
-    Task& task = idTask(pw, wrenches, gravity);
-    const auto qv = vectorArg("q", q, pw.q_buf);
-    const auto qdv = optionalVector("qd", qd, pw.qd_buf, pw.zeros);
-    const auto qddv = optionalVector("qdd", qdd, pw.qdd_buf, pw.zeros);
-    ++pw.generation;
-    if (const Status s = inverseDynamics(*model, *pw.ws, qv, qdv, qddv, task); !s) raiseStatus(s, "inverse_dynamics");
-    return vectorCopy(pw.ws->tau);
+    return dynamicsCall(model, ws_obj, q, qd, qdd, "qdd", wrenches, gravity, "inverse_dynamics",
+                        [&](Workspace& ws, const ConstVector& qv, const ConstVector& qdv, const ConstVector& qddv,
+                            const Task& task, const Eigen::VectorXd*& result) {
+      result = &ws.tau;
+      return inverseDynamics(*model, ws, qv, qdv, qddv, task);
+    });
       },
       py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(), py::arg("qdd") = py::none(),
       py::kw_only(), py::arg("wrenches") = py::none(), py::arg("gravity") = py::none(),

@@ -20,8 +20,7 @@ ZWANG_ALWAYS_INLINE void motionSubspace(bool rotation, const Vec3& a, const Vec3
 template <bool kInertia, bool kVelocity>
 ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint,
                                           const Eigen::Ref<const Eigen::VectorXd>& q,
-                                          const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
+                                          const Eigen::Ref<const Eigen::VectorXd>& qd, WorkspaceScratch& sw) {
   const int i = joint.v_index + 1;
   const auto b = static_cast<std::size_t>(i);
   const auto p = static_cast<std::size_t>(model.parent(i));
@@ -46,8 +45,7 @@ ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint
 // others carry nothing (no inertia, so no bias force either).
 template <bool kInertia, bool kVelocity>
 void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref<const Eigen::VectorXd>& q,
-                        const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
+                        const Eigen::Ref<const Eigen::VectorXd>& qd, WorkspaceScratch& sw) {
   const std::vector<Dof>& dofs = model.dofs();
   const int first = joint.v_index + 1, last = joint.v_index + joint.nv();
   const auto p = static_cast<std::size_t>(model.parent(first));
@@ -94,12 +92,12 @@ void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref
 // its DOFs' axes); every other stage visits DOFs.
 template <bool kInertia, bool kVelocity>
 ZWANG_FLATTEN void kinematicsOfJoints(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
-                                      const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws) {
+                                      const Eigen::Ref<const Eigen::VectorXd>& qd, WorkspaceScratch& sw) {
   for (const Joint& joint : model.allJoints()) {
     if (joint.nv() == 1)
-      oneDofKinematics<kInertia, kVelocity>(model, joint, q, qd, ws);
+      oneDofKinematics<kInertia, kVelocity>(model, joint, q, qd, sw);
     else
-      multiDofKinematics<kInertia, kVelocity>(model, joint, q, qd, ws);
+      multiDofKinematics<kInertia, kVelocity>(model, joint, q, qd, sw);
   }
 }
 
@@ -110,12 +108,13 @@ void outwardKinematics(const Model& model, const Eigen::Ref<const Eigen::VectorX
   const bool with_velocity = qd.size() == model.nv();
   ws.kinematics.q = q;  // the state the results are of (the queries compare it); sizes kept, no allocation
   if (with_velocity) ws.kinematics.qd = qd;
+  WorkspaceScratch& sw = scratchOf(ws);
   if (with_inertia)
-    with_velocity ? kinematicsOfJoints<true, true>(model, q, qd, ws)
-                  : kinematicsOfJoints<true, false>(model, q, qd, ws);
+    with_velocity ? kinematicsOfJoints<true, true>(model, q, qd, sw)
+                  : kinematicsOfJoints<true, false>(model, q, qd, sw);
   else
-    with_velocity ? kinematicsOfJoints<false, true>(model, q, qd, ws)
-                  : kinematicsOfJoints<false, false>(model, q, qd, ws);
+    with_velocity ? kinematicsOfJoints<false, true>(model, q, qd, sw)
+                  : kinematicsOfJoints<false, false>(model, q, qd, sw);
 }
 
 void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws) {

@@ -13,8 +13,8 @@ allowed = {
     "linalg": {"linalg"},
     "qp": {"linalg", "qp"},
     "model": {"model"},
-    "dynamics": {"linalg", "dynamics"},
-    "friction": {"linalg", "qp", "dynamics", "friction"},
+    "dynamics": {"linalg", "model", "dynamics"},  # model/task_layout.hpp: the task's constraints as the solver reads them
+    "friction": {"linalg", "qp", "model", "dynamics", "friction"},
     # The front ends' problem layer: above the library (which never includes it), below the front ends.
     "problem": {"problem", "model"},  # model/urdf_option_names.hpp: the front ends' spelling of the URDF options
     "cli": {"problem"},

@@ -107,6 +107,47 @@ TEST_CASE("resized targets: both solvers refuse them, naming the sizes", "[acces
   CHECK(task.targets()[6] == 0.0);
 }
 
+TEST_CASE("a copied task is independent of its original, and so is a moved-from one", "[accessors]") {
+  // The task's solver layout sits behind a pointer (Task::Layout): a copy
+  // must own its own, and a move (a copy) must leave the source a whole task.
+  const Model model = panda();
+  const State x;
+  const auto hold_tool = [&model]() {
+    Task task(model);
+    task.addConstraint("tool0", ConstraintMatrix::Identity(6, 3), Expressed::World);
+    task.targets() << 0.2, -0.1, 0.3;
+    task.wrench(task.addWrench("panda_link5")) << 1.0, 0.0, -2.0, 0.0, 0.1, 0.0;
+    return task;
+  };
+  const auto solved = [&](const Task& task) {
+    Workspace ws(model, task);
+    REQUIRE(solveHybridDynamics(model, ws, x.q, x.qd, x.tau, task));
+    return Eigen::VectorXd(ws.solution.qdd);
+  };
+  const Eigen::VectorXd expected = solved(hold_tool());
+
+  Task original = hold_tool();
+  const Task copy = original;  // NOLINT(performance-unnecessary-copy-initialization): the copy is the test
+  original.addRelativeConstraint("panda_link3", "tool0", ConstraintMatrix::Identity(6, 2));
+  original.addJointConstraint(1);
+  CHECK(copy.constraintRows() == 3);
+  CHECK(copy.solverColumns() == 3);
+  CHECK(solved(copy) == expected);
+  const Eigen::VectorXd changed = solved(original);
+  CHECK(changed != expected);
+
+  Task assigned(model);
+  assigned.addJointConstraint(4);
+  assigned = original;  // over a layout of another shape
+  CHECK(assigned.solverColumns() == original.solverColumns());
+  CHECK(solved(assigned) == changed);
+
+  Task source = hold_tool();
+  const Task moved = std::move(source);
+  CHECK(solved(moved) == expected);
+  CHECK(solved(source) == expected);  // NOLINT(bugprone-use-after-move): a move copies
+}
+
 TEST_CASE("resized workspace results: the solves refuse them, naming the result", "[accessors]") {
   // Before the fix a solve wrote q̈, τ_c, τ_control and the friction results
   // through whatever size these public vectors had.

@@ -84,6 +84,26 @@ void countCase(const Case& c) {
   count(c.name + "_crba", [&] { (void)jointSpaceInertia(ZWANG_CRBA_ARGUMENTS(m, ws, s.q)); });
 }
 
+// A URDF of `links` moving links, link k hanging from link parent(k) by a
+// revolute joint with an axis and offset that vary from joint to joint (a
+// long chain, or a tree, where cache misses rather than instructions may
+// decide the time: their counts show what the instructions cost there).
+template <class Parent>
+std::string generatedUrdf(int links, Parent parent) {
+  std::string xml = "<robot name='generated'><link name='l0'/>";
+  const char* axes[] = {"0 0 1", "0 1 0", "1 0 0"};
+  for (int k = 1; k <= links; ++k) {
+    const std::string name = "l" + std::to_string(k), offset = std::to_string(0.05 + 0.01 * (k % 5));
+    xml += "<link name='" + name + "'><inertial><origin xyz='0 0 " + offset + "'/><mass value='" +
+           std::to_string(1.0 + 0.1 * (k % 7)) +
+           "'/><inertia ixx='0.02' iyy='0.03' izz='0.01' ixy='0' ixz='0' iyz='0'/></inertial></link>";
+    xml += "<joint name='j" + std::to_string(k) + "' type='revolute'><parent link='l" + std::to_string(parent(k)) +
+           "'/><child link='" + name + "'/><origin xyz='0 0.02 " + offset + "' rpy='0.1 0 0'/><axis xyz='" +
+           axes[k % 3] + "'/><limit lower='-3' upper='3' effort='100' velocity='10'/></joint>";
+  }
+  return xml + "</robot>";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -98,6 +118,8 @@ int main(int argc, char** argv) {
   const Model dual = loadUrdfFile(dir + "dual_panda.urdf");
   const Model humanoid = loadUrdfFile(dir + "simple_humanoid.urdf", free_base);
   const Model solo = loadUrdfFile(dir + "solo12.urdf", free_base);
+  const Model chain64 = loadUrdfString(generatedUrdf(64, [](int k) { return k - 1; }));
+  const Model tree63 = loadUrdfString(generatedUrdf(63, [](int k) { return k / 2; }));  // binary, in heap order
   const std::string tip = panda.frames().back().name;
   const std::vector<Case> cases = {
       {"panda_m0", &panda, {}, false},
@@ -106,6 +128,9 @@ int main(int argc, char** argv) {
       {"humanoid_m0", &humanoid, {}, true},
       {"humanoid_m12", &humanoid, {{"r_ankle", 6}, {"l_ankle", 6}}, true},
       {"solo12_m0", &solo, {}, true},
+      {"chain64_m0", &chain64, {}, false},
+      {"chain64_m6", &chain64, {{"l64", 6}}, false},
+      {"tree63_m0", &tree63, {}, false},
       {"solo12_m12", &solo, {{"FL_FOOT", 3}, {"FR_FOOT", 3}, {"HL_FOOT", 3}, {"HR_FOOT", 3}}, true},
   };
   for (const Case& c : cases) countCase(c);

@@ -6,6 +6,7 @@
 /// every control cycle (this does not).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -63,6 +64,11 @@ class Task {
  public:
   /// An empty task for `model`: default gravity, no constraints, no wrenches.
   explicit Task(const Model& model);
+  /// A copy owns its own constraints: changing one task leaves the other as it was.
+  Task(const Task& other) = default;
+  /// Copy assignment, likewise. There is no move: a moved-from Task would be
+  /// left without its constraints, so a move copies and the source stays whole.
+  Task& operator=(const Task& other) = default;
 
   Vec3 gravity{0.0, 0.0, -9.81};  ///< world axes [m/s²] (docs/conventions.md, "Gravity")
   BalanceOptions balance;         ///< thresholds of the balance (BalanceOptions)
@@ -157,7 +163,7 @@ class Task {
   };
   /// Number of solver columns: one per row, two for a row of a relative
   /// constraint (one on each side).
-  int solverColumns() const { return static_cast<int>(solver_row_.size()); }
+  int solverColumns() const { return solver_columns_; }
   /// True when some constraint is a contact (addContact).
   bool hasContacts() const { return has_contacts_; }
   /// The wrenches, in the order of addWrench.
@@ -168,50 +174,26 @@ class Task {
   int modelFrames() const { return frames_; }
 
  private:
-  // --- the solver's view (src/dynamics/task_solver_order.hpp) ------------
+  // --- the solver's view (src/model/task_layout.hpp, read through
+  // src/dynamics/task_solver_order.hpp) ------------------------------------
   friend class TaskSolverOrder;
-  /// The constraints on one frame, as the solver reads them. A relative
-  /// constraint appears twice: on the constrained frame's body, and (with
-  /// `reference_side`) on the reference frame's body, where its force is −A ν.
-  struct ConstraintGroup {
-    int frame;                    ///< frame index (of the constrained frame, on both sides)
-    int body;                     ///< the body this side's force acts on
-    Expressed expressed;          ///< axes of A's columns
-    int first_row;                ///< in the user's row order (b, ν)
-    int rows;                     ///< number of rows (columns of A)
-    ConstraintMatrix A;           ///< 6 × rows
-    int reference = -1;           ///< the frame a relative constraint refers to (−1: the world)
-    bool reference_side = false;  ///< this entry is the reference (or parent body's) side
-    /// A piece of a joint row (rows = 1, A unused): coefficient·q̈_dof, for
-    /// the DOF of this entry of v, read as a unit effort along it on the body
-    /// it moves and its opposite on the parent body (reference_side). −1: a
-    /// frame constraint.
-    int dof = -1;
-    double coefficient = 0.0;  ///< 1 for the joint of a joint row or a mimic joint, −multiplier for a leader
-    bool mimic_row = false;    ///< a piece of a mimic row (its first_row counts the mimic rows)
-    bool contact = false;      ///< the environment supplies its force (addContact)
+  struct Layout;
+  // Owns the layout and copies it with the task (a copied Task is independent;
+  // a move copies too, so no Task is left without one). Out of line: Layout is
+  // complete only in src/.
+  class LayoutPointer {
+   public:
+    LayoutPointer();
+    LayoutPointer(const LayoutPointer& other);
+    LayoutPointer& operator=(const LayoutPointer& other);
+    ~LayoutPointer();
+    Layout* operator->() const { return layout_.get(); }
+    Layout& operator*() const { return *layout_; }
+
+   private:
+    std::unique_ptr<Layout> layout_;
   };
-  /// Groups sorted by body, last body first ("solver order"): since the
-  /// bodies are in depth-first order, the columns acting on a body's subtree
-  /// are then a contiguous block ([firstColumn(b), columnsEnd(b))), and for a chain the columns
-  /// acting on bodies i..N a leading block.
-  const std::vector<ConstraintGroup>& groups() const { return groups_; }
-  /// The row of each solver column: a user row (< constraintRows()) or a mimic row.
-  const std::vector<int>& solverRowToUserRow() const { return solver_row_; }
-  /// End of the solver columns acting on bodies b, b+1, … (a leading block
-  /// [0, columnsEnd(b)): also their count).
-  int columnsEnd(int body) const { return columns_end_[static_cast<std::size_t>(body)]; }
-  /// First solver column acting on body b's subtree; the block is
-  /// [firstColumn(b), columnsEnd(b)).
-  int firstColumn(int body) const { return first_column_[static_cast<std::size_t>(body)]; }
-  /// True when some balance row has several solver columns (a relative
-  /// constraint or a mimic joint): then the balance works on rows, each the
-  /// sum of its solver columns (balanceRowOfColumn).
-  bool balanceOnRows() const { return balance_on_rows_; }
-  /// The balance row of each solver column (the identity without relative constraints).
-  const std::vector<int>& balanceRowOfColumn() const { return balance_row_; }
-  /// Per solver column: 1 when its force is a contact's (the environment's), else 0.
-  const std::vector<char>& contactColumns() const { return contact_column_; }
+  LayoutPointer layout_;
 
   int dof_;
   int frames_;
@@ -220,16 +202,9 @@ class Task {
   std::vector<int> frame_bodies_;
   double fixed_base_mass_;  // body 0's mass when the base is fixed (the world holds it), else 0
   std::vector<ModelWarning> warnings_;
-  std::vector<ConstraintGroup> groups_;
-  std::vector<int> subtree_end_;  // per body, copied from the model
-  std::vector<int> solver_row_;
-  std::vector<int> balance_row_;
-  std::vector<int> columns_end_;
-  std::vector<int> first_column_;
-  bool balance_on_rows_ = false;
   int mimic_rows_ = 0;
+  int solver_columns_ = 0;  // the layout's, kept here for the inline accessor
   bool has_contacts_ = false;
-  std::vector<char> contact_column_;
   std::vector<std::pair<int, int>> joint_dofs_;  // per joint, its v_index and nv (copied from the model)
   std::vector<int> dof_parent_bodies_;           // per DOF, the parent of the body it moves
   std::vector<int> body_frames_;                 // per body, its frame

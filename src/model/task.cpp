@@ -1,5 +1,7 @@
 #include "zwang/task.hpp"
 
+#include "task_layout.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +18,7 @@ Task::Task(const Model& model)
     frame_bodies_.push_back(f.body);
   }
   for (int b = 0; b < model.bodyCount(); ++b) {
-    subtree_end_.push_back(model.subtreeEnd(b));
+    layout_->subtree_end.push_back(model.subtreeEnd(b));
     body_frames_.push_back(model.bodyFrame(b));
   }
   for (const Joint& joint : model.joints()) {
@@ -27,6 +29,14 @@ Task::Task(const Model& model)
   addMimicRows(model);
   reorder();
 }
+
+Task::LayoutPointer::LayoutPointer() : layout_(std::make_unique<Layout>()) {}
+Task::LayoutPointer::LayoutPointer(const LayoutPointer& other) : layout_(std::make_unique<Layout>(*other)) {}
+Task::LayoutPointer& Task::LayoutPointer::operator=(const LayoutPointer& other) {
+  if (this != &other) *layout_ = *other;  // reuses this layout's storage
+  return *this;
+}
+Task::LayoutPointer::~LayoutPointer() = default;
 
 void Task::addMimicRows(const Model& model) {
   // Row r: q̈_m − a·q̈_l = 0, four pieces: each joint's body and the body it
@@ -41,12 +51,12 @@ void Task::addMimicRows(const Model& model) {
       if (piece.coefficient == 0.0) continue;  // a = 0: the mimic joint is held at its offset
       for (const bool parent_side : {false, true}) {
         const int body = parent_side ? model.parent(piece.dof + 1) : piece.dof + 1;
-        ConstraintGroup g{model.bodyFrame(body), body, Expressed::World, mimic_rows_, 1, ConstraintMatrix()};
+        Layout::ConstraintGroup g{model.bodyFrame(body), body, Expressed::World, mimic_rows_, 1, ConstraintMatrix()};
         g.reference_side = parent_side;
         g.dof = piece.dof;
         g.coefficient = piece.coefficient;
         g.mimic_row = true;
-        groups_.push_back(g);
+        layout_->groups.push_back(g);
       }
     }
     mimic_laws_.push_back(law);
@@ -89,8 +99,8 @@ int Task::addConstraint(int frame, const ConstraintMatrix& A, Expressed expresse
                      "' is not finite");
   const int first = constraintRows();
   growTargets(static_cast<int>(A.cols()));  // first: it may refuse, and the task stays as it was
-  groups_.push_back(ConstraintGroup{frame, frame_bodies_[static_cast<std::size_t>(frame)], expressed, first,
-                                    static_cast<int>(A.cols()), A});
+  layout_->groups.push_back(Layout::ConstraintGroup{frame, frame_bodies_[static_cast<std::size_t>(frame)], expressed,
+                                                    first, static_cast<int>(A.cols()), A});
   reorder();
   return first;
 }
@@ -117,13 +127,13 @@ int Task::addRelativeConstraint(int frame, int reference, const ConstraintMatrix
     throw ModelError("task: a relative constraint on frame '" + frame_names_[static_cast<std::size_t>(frame)] +
                      "' needs another frame to refer to, not itself");
   const int first = addConstraint(frame, A, expressed);  // checks frame and A, sorts
-  const auto user_group = [first](const ConstraintGroup& g) { return !g.mimic_row && g.first_row == first; };
-  for (ConstraintGroup& g : groups_)
+  const auto user_group = [first](const Layout::ConstraintGroup& g) { return !g.mimic_row && g.first_row == first; };
+  for (Layout::ConstraintGroup& g : layout_->groups)
     if (user_group(g)) g.reference = reference;
-  ConstraintGroup side = *std::find_if(groups_.begin(), groups_.end(), user_group);
+  Layout::ConstraintGroup side = *std::find_if(layout_->groups.begin(), layout_->groups.end(), user_group);
   side.body = frame_bodies_[static_cast<std::size_t>(reference)];
   side.reference_side = true;
-  groups_.push_back(side);
+  layout_->groups.push_back(side);
   reorder();
   return first;
 }
@@ -145,12 +155,12 @@ int Task::addJointConstraint(int joint) {
     const int dof = v_index + k;
     for (const bool parent_side : {false, true}) {
       const int body = parent_side ? dof_parent_bodies_[static_cast<std::size_t>(dof)] : dof + 1;
-      ConstraintGroup g{
+      Layout::ConstraintGroup g{
           body_frames_[static_cast<std::size_t>(body)], body, Expressed::World, first_row + k, 1, ConstraintMatrix()};
       g.reference_side = parent_side;
       g.dof = dof;
       g.coefficient = 1.0;
-      groups_.push_back(g);
+      layout_->groups.push_back(g);
     }
   }
   reorder();
@@ -182,7 +192,7 @@ ModelWarning fixedBaseContact(const std::string& frame, const std::string& base_
 
 int Task::addContact(int frame, const ConstraintMatrix& A, Expressed expressed) {
   const int first = addConstraint(frame, A, expressed);
-  for (ConstraintGroup& g : groups_)
+  for (Layout::ConstraintGroup& g : layout_->groups)
     if (!g.mimic_row && g.dof < 0 && g.first_row == first) g.contact = true;
   reorder();
   const bool warned = std::any_of(warnings_.begin(), warnings_.end(),
@@ -208,35 +218,38 @@ int Task::addWrench(const std::string& frame, Expressed expressed) {
 }
 
 void Task::reorder() {
+  using Group = Layout::ConstraintGroup;
+  Layout& layout = *layout_;
   // Last body first (stable: equal bodies keep the user's order). The bodies
   // are in depth-first order, so body b's subtree [b, end) owns the columns
   // between those on bodies ≥ end and those on bodies ≥ b: a contiguous block.
-  std::stable_sort(groups_.begin(), groups_.end(),
-                   [](const ConstraintGroup& a, const ConstraintGroup& b) { return a.body > b.body; });
-  balance_on_rows_ =
-      std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.reference_side; });
-  solver_row_.clear();
-  balance_row_.clear();
-  contact_column_.clear();
-  for (const ConstraintGroup& g : groups_)
+  std::stable_sort(layout.groups.begin(), layout.groups.end(),
+                   [](const Group& a, const Group& b) { return a.body > b.body; });
+  layout.balance_on_rows =
+      std::any_of(layout.groups.begin(), layout.groups.end(), [](const Group& g) { return g.reference_side; });
+  layout.solver_row.clear();
+  layout.balance_row.clear();
+  layout.contact_column.clear();
+  for (const Group& g : layout.groups)
     for (int k = 0; k < g.rows; ++k) {
       // A mimic piece's row follows the user's rows, however many there are.
       const int row = g.mimic_row ? constraintRows() + g.first_row : g.first_row + k;
       // With relative constraints the balance works on the rows (each the sum
       // of its sides); otherwise on the solver columns themselves.
-      balance_row_.push_back(balance_on_rows_ ? row : static_cast<int>(solver_row_.size()));
-      solver_row_.push_back(row);
-      contact_column_.push_back(g.contact ? 1 : 0);
+      layout.balance_row.push_back(layout.balance_on_rows ? row : static_cast<int>(layout.solver_row.size()));
+      layout.solver_row.push_back(row);
+      layout.contact_column.push_back(g.contact ? 1 : 0);
     }
-  has_contacts_ = std::any_of(groups_.begin(), groups_.end(), [](const ConstraintGroup& g) { return g.contact; });
-  const std::size_t bodies = subtree_end_.size();
-  columns_end_.assign(bodies + 1, 0);  // columns_end_[N + 1] = 0: no body beyond the last
+  solver_columns_ = static_cast<int>(layout.solver_row.size());
+  has_contacts_ = std::any_of(layout.groups.begin(), layout.groups.end(), [](const Group& g) { return g.contact; });
+  const std::size_t bodies = layout.subtree_end.size();
+  layout.columns_end.assign(bodies + 1, 0);  // columns_end[N + 1] = 0: no body beyond the last
   for (std::size_t body = 0; body <= bodies; ++body)
-    for (const ConstraintGroup& g : groups_)
-      if (static_cast<std::size_t>(g.body) >= body) columns_end_[body] += g.rows;
-  first_column_.assign(bodies, 0);
+    for (const Group& g : layout.groups)
+      if (static_cast<std::size_t>(g.body) >= body) layout.columns_end[body] += g.rows;
+  layout.first_column.assign(bodies, 0);
   for (std::size_t body = 0; body < bodies; ++body)
-    first_column_[body] = columns_end_[static_cast<std::size_t>(subtree_end_[body])];
+    layout.first_column[body] = layout.columns_end[static_cast<std::size_t>(layout.subtree_end[body])];
 }
 
 Status checkBalanceOptions(const BalanceOptions& o) {

@@ -60,7 +60,6 @@ namespace zwang::cli {
 
 namespace {
 
-using energy::fmt;
 using energy::small;
 
 constexpr double kCheckTolerance = 1e-9;       // the checks: torques [N·m], forces [N], accelerations [rad/s², m/s²]
@@ -637,16 +636,17 @@ void printRobot(const RobotResult& robot) {
 }
 
 // Each robot of kRobots standing still in each of its postures.
-class StandingScenario final : public energy::Scenario {
+class StandingScenario final : public Scenario {
  public:
   explicit StandingScenario(const ReportCommand& report) {
     for (const StandingRobot& robot : kRobots) robots_.push_back(runRobot(report, robot));
   }
-  energy::ScenarioFiles files() const override {
-    return {"standing_energy.csv",
+  ScenarioFiles files() const override {
+    return {{"standing_energy.csv"},
             "robot, posture, variant, quantity, name, value: q, tau = tau_control, mu,\nground = nu of the contacts, "
             "effort; breakaway per joint",
-            "standing_energy.gp", "standing_energy.png, standing_humanoid_joints.png, standing_solo12_joints.png"};
+            "standing_energy.gp",
+            "standing_energy.png, standing_humanoid_joints.png, standing_solo12_joints.png"};
   }
   bool ok() const override {
     bool all_ok = true;
@@ -657,7 +657,7 @@ class StandingScenario final : public energy::Scenario {
   void print() const override {
     for (const RobotResult& robot : robots_) printRobot(robot);
   }
-  std::string csvText() const override { return standingCsv(robots_); }
+  std::string csvText(std::size_t) const override { return standingCsv(robots_); }
   std::string plotScript() const override { return standingPlotScript(files().script, robots_); }
 
  private:
@@ -666,7 +666,7 @@ class StandingScenario final : public energy::Scenario {
 
 }  // namespace
 
-std::unique_ptr<energy::Scenario> energy::standingScenario(const ReportCommand& report) {
+std::unique_ptr<Scenario> energy::standingScenario(const ReportCommand& report) {
   return std::make_unique<StandingScenario>(report);
 }
 

@@ -104,7 +104,7 @@ energy::PostureResult run(const Model& model, const Pose& pose, PoseDetail& deta
 }
 
 // The Panda holding still in each pose of kPoses.
-class PandaScenario final : public energy::Scenario {
+class PandaScenario final : public Scenario {
  public:
   explicit PandaScenario(const ReportCommand& report) : report_(report) {
     for (const Pose& pose : kPoses) {
@@ -112,15 +112,17 @@ class PandaScenario final : public energy::Scenario {
       poses_.push_back(run(report.model, pose, details_.back()));
     }
   }
-  energy::ScenarioFiles files() const override {
-    return {"panda_energy.csv", "pose, variant, q1-7, tau1-7 = tau_control, mu1-7, tau_norm, tau_sq, tau_abs_sum",
-            "energy.gp", "panda_energy.png, panda_energy_joints.png"};
+  ScenarioFiles files() const override {
+    return {{"panda_energy.csv"},
+            "pose, variant, q1-7, tau1-7 = tau_control, mu1-7, tau_norm, tau_sq, tau_abs_sum",
+            "energy.gp",
+            "panda_energy.png, panda_energy_joints.png"};
   }
   bool ok() const override {
     return std::all_of(poses_.begin(), poses_.end(), [](const energy::PostureResult& r) { return r.ok; });
   }
   void print() const override;
-  std::string csvText() const override { return energy::armCsv(poses_); }
+  std::string csvText(std::size_t) const override { return energy::armCsv(poses_); }
   std::string plotScript() const override;
 
  private:
@@ -151,7 +153,7 @@ void PandaScenario::printSetting() const {
   std::printf("zwang energy: %s holding still against gravity (0, 0, -9.81), at rest\n", report_.shownUrdf().c_str());
   std::printf("task: tool0 fixed (6 rows, world axes) + panda_link1 angular z (= qdd1) fixed: qdd = 0 exactly\n");
   std::printf("breakaway friction f [N·m] (URDF <dynamics friction>):");
-  for (int j = 0; j < kJoints; ++j) std::printf(" %s", energy::fmt(report_.model.joint(j).breakaway_friction).c_str());
+  for (int j = 0; j < kJoints; ++j) std::printf(" %s", fmt(report_.model.joint(j).breakaway_friction).c_str());
   std::printf(
       "\nplain: solveHybridDynamics (tau_control = gravity torques G(q)); friction-aware: solveWithFriction,\n"
       "all joints stick, mu* indeterminate, the maximiser with the least |tau_control|^2 using at most\n"
@@ -165,9 +167,9 @@ void PandaScenario::printPoses() const {
       {"pose", "what", "q1", "q2", "q3", "q4", "q5", "q6", "q7", "tool x", "y", "z"}};
   for (std::size_t p = 0; p < poses_.size(); ++p) {
     std::vector<std::string> row{kPoses[p].name, kPoses[p].what};
-    for (const double x : kPoses[p].q) row.push_back(energy::fmt(x));
+    for (const double x : kPoses[p].q) row.push_back(fmt(x));
     const Eigen::Vector3d& tool = details_[p].tool;
-    for (int k = 0; k < 3; ++k) row.push_back(energy::fmt(std::abs(tool[k]) < 5e-4 ? 0.0 : tool[k], "%.3f"));
+    for (int k = 0; k < 3; ++k) row.push_back(fmt(std::abs(tool[k]) < 5e-4 ? 0.0 : tool[k], "%.3f"));
     poses.push_back(row);
   }
   printColumns(poses, 2);
@@ -181,7 +183,7 @@ void PandaScenario::printTorques() const {
   for (const energy::PostureResult& r : poses_)
     for (int v = 0; v < energy::kVariantCount; ++v) {
       std::vector<std::string> row{v == 0 ? r.name : "", energy::kVariants[v].name};
-      for (const double tau : r.variant[static_cast<std::size_t>(v)].tau) row.push_back(energy::fmt(tau));
+      for (const double tau : r.variant[static_cast<std::size_t>(v)].tau) row.push_back(fmt(tau));
       joints.push_back(row);
     }
   printColumns(joints, 2);
@@ -203,14 +205,14 @@ int commandEnergy(int argc, char** argv) {
       {"panda.urdf", kJoints, {"tool0", "panda_link1"}, "the 7-joint Panda with frames panda_link1 and tool0"});
   if (!report) return kExitOk;  // --help
   // Every scenario is solved and checked before anything is written.
-  std::vector<std::unique_ptr<energy::Scenario>> scenarios;
+  std::vector<std::unique_ptr<Scenario>> scenarios;
   scenarios.push_back(std::make_unique<PandaScenario>(*report));
   scenarios.push_back(energy::dualArmScenario(*report));
   scenarios.push_back(energy::standingScenario(*report));
 
   bool plotted = true, all_ok = true;
   for (std::size_t k = 0; k < scenarios.size(); ++k) {
-    const bool wrote = energy::writeScenario(*report, *scenarios[k], plotted);
+    const bool wrote = writeScenario(*report, *scenarios[k], plotted);
     if (k == 0) plotted = wrote;  // gnuplot failing on the first is said once, the others write their scripts only
     all_ok = scenarios[k]->ok() && all_ok;
   }

@@ -76,7 +76,6 @@ struct PostureDetail {
   double worst_qdd = 0, worst_closed_form = 0, worst_closure = 0, worst_torso_internal = 0;
 };
 
-using energy::fmt;
 using energy::small;
 
 // The posture's q from the IK (dual_arm_ik.hpp), checked: the hands on the box, every joint inside its limits.
@@ -221,7 +220,7 @@ Model loadDualPanda(const ReportCommand& report, std::filesystem::path& urdf) {
 }
 
 // The dual arm holding the box still in each posture of kPostures.
-class DualArmScenario final : public energy::Scenario {
+class DualArmScenario final : public Scenario {
  public:
   explicit DualArmScenario(const ReportCommand& report) : model_(loadDualPanda(report, urdf_)) {
     for (const Posture& posture : kPostures) {
@@ -229,16 +228,17 @@ class DualArmScenario final : public energy::Scenario {
       postures_.push_back(run(model_, posture, details_.back()));
     }
   }
-  energy::ScenarioFiles files() const override {
-    return {"dual_energy.csv",
+  ScenarioFiles files() const override {
+    return {{"dual_energy.csv"},
             "pose, variant, q1-15, tau1-15 = tau_control, mu1-15, tau_norm, tau_sq, tau_abs_sum,\nloop_fx..loop_nz",
-            "dual_energy.gp", "dual_energy.png, dual_energy_joints.png"};
+            "dual_energy.gp",
+            "dual_energy.png, dual_energy_joints.png"};
   }
   bool ok() const override {
     return std::all_of(postures_.begin(), postures_.end(), [](const energy::PostureResult& r) { return r.ok; });
   }
   void print() const override;
-  std::string csvText() const override {
+  std::string csvText(std::size_t) const override {
     return energy::armCsv(postures_, ",loop_fx,loop_fy,loop_fz,loop_nx,loop_ny,loop_nz", [this](std::size_t p, int v) {
       return Eigen::VectorXd(details_[p].loop[static_cast<std::size_t>(v)]);
     });
@@ -372,7 +372,7 @@ void DualArmScenario::print() const {
 
 }  // namespace
 
-std::unique_ptr<energy::Scenario> energy::dualArmScenario(const ReportCommand& report) {
+std::unique_ptr<Scenario> energy::dualArmScenario(const ReportCommand& report) {
   return std::make_unique<DualArmScenario>(report);
 }
 

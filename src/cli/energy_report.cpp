@@ -1,4 +1,4 @@
-// What the scenarios of `zwang energy` share (energy_report.hpp): the writer,
+// What the scenarios of `zwang energy` share (energy_report.hpp): the
 // variants, effort measures, number formats, the effort table, the arms' CSV
 // and charts, and the bar charts' pieces.
 #include "energy_report.hpp"
@@ -45,14 +45,6 @@ std::array<Eigen::VectorXd, kVariantCount> PostureResult::torques() const {
   return {variant[0].tau, variant[1].tau, variant[2].tau};
 }
 
-bool writeScenario(const ReportCommand& report, const Scenario& scenario, bool run_gnuplot) {
-  scenario.print();
-  const ScenarioFiles files = scenario.files();
-  writeOutput((report.out / files.csv).string(), scenario.csvText());
-  std::printf("wrote %s/%s (%s)\n", report.out.string().c_str(), files.csv.c_str(), files.columns.c_str());
-  return writePlots(report, files.script, scenario.plotScript(), files.pngs, run_gnuplot);
-}
-
 Model loadScenarioModel(const ReportCommand& report, const std::string& file, const UrdfOptions& options,
                         std::filesystem::path& urdf) {
   urdf = std::filesystem::path(modelsDirectory(report.args, file)) / file;
@@ -67,12 +59,6 @@ std::string shownPath(const std::filesystem::path& path) {
   std::error_code ec;
   const std::filesystem::path proximate = std::filesystem::proximate(path, ec);
   return (ec ? path : proximate).string();
-}
-
-std::string fmt(double x, const char* format) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, format, std::abs(x) < 1e-12 ? 0.0 : x);
-  return buffer;
 }
 
 std::string small(double x) {

@@ -1,10 +1,10 @@
 // What the scenarios of `zwang energy` share (energy.cpp: the Panda,
 // energy_dual.cpp: the dual arm holding a box, energy_standing.cpp: the
-// humanoid and Solo 12 standing): the scenario interface and its writer, the
-// three variants compared, the effort measures of τ_control, the number
-// formats of the tables, CSVs and gnuplot data, the effort table every
-// scenario prints, the arms' CSV and charts, and the pieces of the gnuplot
-// bar charts (docs/evaluation.md, sections 2-4).
+// humanoid and Solo 12 standing), each a Scenario of scenario.hpp: the three
+// variants compared, the effort measures of τ_control, the number formats of
+// the CSVs and gnuplot data, the effort table every scenario prints, the
+// arms' CSV and charts, and the pieces of the gnuplot bar charts
+// (docs/evaluation.md, sections 2-4).
 #pragma once
 
 #include <array>
@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "scenario.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli::energy {
@@ -59,31 +60,6 @@ struct PostureResult {
   std::array<Eigen::VectorXd, kVariantCount> torques() const;
 };
 
-// The files a scenario writes into --out, and what the report says of them.
-struct ScenarioFiles {
-  std::string csv;      // the CSV's file name
-  std::string columns;  // its columns, as the "wrote" line lists them
-  std::string script;   // the gnuplot script's file name
-  std::string pngs;     // the plots it draws
-};
-
-// One scenario of `zwang energy`. It is solved and checked when it is made
-// (CliError when something cannot be solved), so nothing is written until
-// every scenario is; writeScenario then prints and writes it.
-class Scenario {
- public:
-  virtual ~Scenario() = default;
-  virtual ScenarioFiles files() const = 0;
-  virtual bool ok() const = 0;     // every check passed
-  virtual void print() const = 0;  // the report's tables
-  virtual std::string csvText() const = 0;
-  virtual std::string plotScript() const = 0;
-};
-
-// Print the scenario, write its CSV and say so, then its plots (writePlots,
-// run_gnuplot as there). Returns whether there are plots.
-bool writeScenario(const ReportCommand& report, const Scenario& scenario, bool run_gnuplot);
-
 // The scenarios after the Panda: the dual arm holding a box (energy_dual.cpp)
 // and the humanoid and Solo 12 standing (energy_standing.cpp). Each loads its
 // models from the models directory (CliError when one does not load or is
@@ -97,8 +73,6 @@ Model loadScenarioModel(const ReportCommand& report, const std::string& file, co
 // A path as the report shows it: relative to the working directory when it can be.
 std::string shownPath(const std::filesystem::path& path);
 
-// A number for the tables: printf `format`, with |x| < 1e-12 shown as 0.
-std::string fmt(double x, const char* format = "%.4g");
 // A check's residual, as it is ("%.1e"; fmt would show |x| < 1e-12 as 0).
 std::string small(double x);
 // ",x" with 17 significant digits: a CSV cell that reads back exactly.

@@ -199,24 +199,8 @@ JointValues parseJointValues(const JsonReader& in, const Json& value, const std:
   return v;
 }
 
-// Per-joint overrides must be non-negative.
-Eigen::VectorXd nonNegative(const JsonReader& in, const Json& value, const std::string& path) {
-  Eigen::VectorXd v = in.numbers(value, path);
-  for (Eigen::Index j = 0; j < v.size(); ++j)
-    if (v[j] < 0) in.fail(childPath(path, static_cast<std::size_t>(j)), "is " + formatNumber(v[j]) + ", must be >= 0");
-  return v;
-}
-
 // True when every joint below the root has one DOF (the per-joint arrays are then one per joint).
 bool oneDofJoints(const Model& model) { return model.dof() == static_cast<int>(model.joints().size()); }
-
-// The names of the DOFs below the root, for messages.
-std::string dofList(const Model& model) {
-  std::string list;
-  for (std::size_t k = static_cast<std::size_t>(model.baseVelocitySize()); k < model.dofs().size(); ++k)
-    list += (list.empty() ? "" : ", ") + model.dofs()[k].name;
-  return list;
-}
 
 // The coordinates of a joint's q, for messages ("" for a one-DOF joint).
 const char* coordinateNames(JointType type) {
@@ -230,8 +214,8 @@ const char* coordinateNames(JointType type) {
 
 // What an array of the joints' q (configuration) or v (velocity) entries holds, for messages.
 std::string layout(const Model& model, bool configuration) {
+  if (!configuration) return problem::dofLayout(model);
   if (oneDofJoints(model)) return "one per moving joint: " + problem::jointNames(model);
-  if (!configuration) return "one per DOF: " + dofList(model);
   std::string list;
   for (const Joint& joint : model.joints()) {
     list += (list.empty() ? "" : ", ") + joint.name;
@@ -333,33 +317,6 @@ Model loadModel(const JsonReader& in, const Problem& p) {
   return model;
 }
 
-// "rotor_inertia" (one per joint) and "breakaway" (one per DOF): their lengths, then the inertias into the model.
-void applyPerJointValues(const JsonReader& in, const Problem& p, Model& model) {
-  const int joints = static_cast<int>(model.joints().size());
-  auto checkLength = [&](const std::optional<Eigen::VectorXd>& v, const char* key, long n, bool per_joint) {
-    if (!v || v->size() == n) return;
-    in.fail(key, "has " + std::to_string(v->size()) + (v->size() == 1 ? " entry" : " entries") + ", expected " +
-                     std::to_string(n) + " (" +
-                     (per_joint ? "one per moving joint: " + problem::jointNames(model) : layout(model, false)) + ")");
-  };
-  checkLength(p.rotor_inertia, "rotor_inertia", joints, true);  // a joint's rotor inertia applies to each of its DOFs
-  checkLength(p.breakaway, "breakaway", model.dof(), false);
-  if (!p.rotor_inertia) return;
-  ModelBuilder builder(model);
-  for (int j = 0; j < joints; ++j) {
-    try {
-      builder.setRotorInertia(model.joint(j).name, (*p.rotor_inertia)[j]);
-    } catch (const ModelError& e) {
-      in.fail(childPath("rotor_inertia", static_cast<std::size_t>(j)), e.what());
-    }
-  }
-  try {
-    model = builder.build();
-  } catch (const ModelError& e) {
-    in.fail("rotor_inertia", e.what());
-  }
-}
-
 // q, qd, tau in full: the base's coordinates first, then the joints' (docs/conventions.md, "Floating base").
 // Unset entries: zero, each quaternion the identity (a free base's from "base").
 void placeState(const JsonReader& in, const Problem& p, BoundProblem& b) {
@@ -442,8 +399,8 @@ Problem readProblem(const std::string& file) {
   if (doc.contains("gravity")) p.gravity = Vec3(in.numbers(doc["gravity"], "gravity", 3, "gx, gy, gz"));
   for (const char* key : {"q", "qd", "tau"})
     if (doc.contains(key)) (key[1] == '\0' ? p.q : key[1] == 'd' ? p.qd : p.tau) = parseJointValues(in, doc[key], key);
-  if (doc.contains("rotor_inertia")) p.rotor_inertia = nonNegative(in, doc["rotor_inertia"], "rotor_inertia");
-  if (doc.contains("breakaway")) p.breakaway = nonNegative(in, doc["breakaway"], "breakaway");
+  if (doc.contains("rotor_inertia")) p.rotor_inertia = in.numbers(doc["rotor_inertia"], "rotor_inertia");
+  if (doc.contains("breakaway")) p.breakaway = in.numbers(doc["breakaway"], "breakaway");
   if (doc.contains("wrenches")) {
     const Json& list = in.array(doc["wrenches"], "wrenches");
     for (std::size_t k = 0; k < list.size(); ++k)
@@ -465,13 +422,16 @@ Problem readProblem(const std::string& file) {
 BoundProblem bindProblem(const Problem& p) {
   const JsonReader in(p.file);
   Model model = loadModel(in, p);
-  applyPerJointValues(in, p, model);
-  BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, {}, {}};
+  // The per-joint overrides by the problem layer's rules: their lengths against the model, each finite and >= 0.
+  if (p.rotor_inertia)
+    model = atPath(in, "", [&] { return problem::withRotorInertia(model, "rotor_inertia", *p.rotor_inertia); });
+  FrictionOptions friction = p.friction.options;
+  if (p.breakaway) friction.breakaway = *p.breakaway;
+  atPath(in, "", [&] { problem::checkFrictionOverrides(model, friction); });
+  BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, std::move(friction), {}};
   placeState(in, p, b);
   buildTask(in, p, b);
   b.with_friction = p.friction.present && p.friction.enabled;
-  b.friction_options = p.friction.options;
-  if (p.breakaway) b.friction_options.breakaway = *p.breakaway;
   return b;
 }
 

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "cli.hpp"
@@ -12,8 +11,6 @@
 namespace zwang::cli::standing {
 
 namespace {
-
-constexpr double kBoundTolerance = 1e-9;  // μ within this of ±margin·f counts as on the bound [N·m]
 
 void require(const Status& s, const std::string& context) {
   if (!s) throw CliError(kExitError, context + s.message);
@@ -60,9 +57,6 @@ DenseBalance denseBalance(const Model& model, Workspace& ws, const std::vector<s
   require(inverseDynamics(model, ws, q, zero, zero, gravity_only), context + "RNEA: ");
   d.gravity = ws.tau;
   d.tau0 = d.Gt.solve(d.gravity).tail(n);
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(model.nv(), n);
-  unit.bottomRows(n).setIdentity();
-  d.M = d.Gt.solve(unit).bottomRows(n);
   return d;
 }
 
@@ -77,29 +71,6 @@ BestSplit bestSplit(const DenseBalance& d, int contact_rows) {
   for (Eigen::Index foot = 0; foot + contact_rows <= nu.size() - n; foot += contact_rows)
     best.tangential = std::max(best.tangential, nu.segment<2>(foot).norm() / nu[foot + 2]);
   return best;
-}
-
-double kktViolation(const DenseBalance& d, const Eigen::VectorXd& mu, const Eigen::VectorXd& bound) {
-  const Eigen::VectorXd gradient = d.M.transpose() * (d.tau0 + d.M * mu);
-  double worst = 0;
-  for (Eigen::Index j = 0; j < mu.size(); ++j) {
-    if (mu[j] >= bound[j] - kBoundTolerance)
-      worst = std::max(worst, gradient[j]);
-    else if (mu[j] <= -bound[j] + kBoundTolerance)
-      worst = std::max(worst, -gradient[j]);
-    else
-      worst = std::max(worst, std::abs(gradient[j]));
-  }
-  return worst;
-}
-
-Eigen::VectorXd leastEffort(const DenseBalance& d, const Eigen::VectorXd& bound) {
-  const Eigen::MatrixXd MtM = d.M.transpose() * d.M;
-  const double step = 1.0 / Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(MtM).eigenvalues().maxCoeff();
-  Eigen::VectorXd mu = Eigen::VectorXd::Zero(bound.size());
-  for (int iteration = 0; iteration < 100000 && kktViolation(d, mu, bound) > 1e-12; ++iteration)
-    mu = (mu - step * (d.M.transpose() * (d.tau0 + d.M * mu))).cwiseMax(-bound).cwiseMin(bound);
-  return mu;
 }
 
 }  // namespace zwang::cli::standing

@@ -31,6 +31,34 @@ std::string number(double value) {
   throw ProblemError(Fault::Value, key, what + ", got " + number(value));
 }
 
+// "1 entry", "3 entries".
+std::string entries(Eigen::Index n) { return std::to_string(n) + (n == 1 ? " entry" : " entries"); }
+
+// Each entry of a per-joint array finite and >= 0 (NaN fails the comparison).
+void checkEntries(const std::string& name, const Eigen::Ref<const Eigen::VectorXd>& values) {
+  for (Eigen::Index k = 0; k < values.size(); ++k)
+    if (!(values[k] >= 0.0 && std::isfinite(values[k])))
+      throw ProblemError(Fault::Value, name + "[" + std::to_string(k) + "]",
+                         "must be finite and >= 0, got " + number(values[k]));
+}
+
+// The one value of each joint from an array of one per DOF; ProblemError(Model) where a joint's DOFs disagree.
+Eigen::VectorXd jointsOfDofs(const Model& model, const std::string& name, const Eigen::Ref<const Eigen::VectorXd>& v) {
+  Eigen::VectorXd per_joint(static_cast<Eigen::Index>(model.joints().size()));
+  for (std::size_t j = 0; j < model.joints().size(); ++j) {
+    const Joint& joint = model.joints()[j];
+    const int first = joint.v_index - model.baseVelocitySize();
+    per_joint[static_cast<Eigen::Index>(j)] = v[first];
+    for (int k = first + 1; k < first + joint.nv(); ++k)
+      if (v[k] != v[first])
+        throw ProblemError(Fault::Model, name,
+                           "entries " + std::to_string(first) + "-" + std::to_string(first + joint.nv() - 1) +
+                               " (the DOFs of joint '" + joint.name +
+                               "') differ: a joint has one value for all its DOFs");
+  }
+  return per_joint;
+}
+
 // A fault of the model's (a ModelError) as the part `key` of the item.
 template <class F>
 auto keyed(const char* key, F lookup) -> decltype(lookup()) {
@@ -174,6 +202,50 @@ int addConstraint(const Spelling& spelling, const Model& model, Task& task, cons
 int addWrench(const Model& model, Task& task, const std::string& frame, Expressed expressed) {
   const int f = keyed("frame", [&] { return frameIndex(model, frame); });
   return keyed("", [&] { return task.addWrench(f, expressed); });
+}
+
+std::string dofLayout(const Model& model) {
+  if (model.dof() == static_cast<int>(model.joints().size())) return "one per moving joint: " + jointNames(model);
+  std::string list;
+  for (std::size_t k = static_cast<std::size_t>(model.baseVelocitySize()); k < model.dofs().size(); ++k)
+    list += (list.empty() ? "" : ", ") + model.dofs()[k].name;
+  return "one per DOF: " + list;
+}
+
+Eigen::VectorXd perJoint(const Model& model, const std::string& name, const Eigen::Ref<const Eigen::VectorXd>& values) {
+  const auto joints = static_cast<Eigen::Index>(model.joints().size());
+  if (values.size() != joints && values.size() != model.dof()) {
+    const std::string or_dofs =
+        model.dof() == joints ? "" : " or " + std::to_string(model.dof()) + " (" + dofLayout(model) + ")";
+    throw ProblemError(Fault::Model, name,
+                       "has " + entries(values.size()) + ", expected " + std::to_string(joints) +
+                           " (one per moving joint: " + jointNames(model) + ")" + or_dofs);
+  }
+  checkEntries(name, values);
+  return values.size() == joints ? Eigen::VectorXd(values) : jointsOfDofs(model, name, values);
+}
+
+Model withRotorInertia(const Model& model, const std::string& name, const Eigen::Ref<const Eigen::VectorXd>& values) {
+  const Eigen::VectorXd inertia = perJoint(model, name, values);
+  return keyed(name.c_str(), [&] {
+    ModelBuilder builder(model);
+    for (std::size_t j = 0; j < model.joints().size(); ++j)
+      builder.setRotorInertia(model.joints()[j].name, inertia[static_cast<Eigen::Index>(j)]);
+    return builder.build();
+  });
+}
+
+void checkFrictionOverrides(const Model& model, const FrictionOptions& o) {
+  const std::pair<const char*, const Eigen::VectorXd*> overrides[] = {
+      {"breakaway", &o.breakaway}, {"kinetic", &o.kinetic}, {"viscous", &o.viscous}};
+  for (const auto& [name, values] : overrides) {
+    if (values->size() == 0) continue;  // the model's
+    if (values->size() != model.dof())
+      throw ProblemError(Fault::Model, name,
+                         "has " + entries(values->size()) + ", expected " + std::to_string(model.dof()) + " (" +
+                             dofLayout(model) + ")");
+    checkEntries(name, *values);
+  }
 }
 
 void checkBalance(const BalanceOptions& o) {

@@ -99,6 +99,24 @@ int addConstraint(const Spelling& spelling, const Model& model, Task& task, cons
 // A wrench on a frame into `task`; its index. ProblemError keyed "frame".
 int addWrench(const Model& model, Task& task, const std::string& frame, Expressed expressed);
 
+// What an array of one entry per DOF below the root holds, for messages:
+// "one per moving joint: a, b" (every joint one DOF) or "one per DOF: a, b.x, b.y".
+std::string dofLayout(const Model& model);
+
+// A per-joint array `name` (rotor inertia, friction) of a copy of the model:
+// one entry per joint, or one per DOF as the model's per-DOF arrays list them
+// (a joint's DOFs must then agree), each finite and >= 0. One per joint;
+// ProblemError(Model, name) for a length the model does not have or DOFs
+// that disagree, ProblemError(Value, "name[k]") for an entry.
+Eigen::VectorXd perJoint(const Model& model, const std::string& name, const Eigen::Ref<const Eigen::VectorXd>& values);
+
+// The model with these reflected rotor inertias (perJoint's rules, named `name`).
+Model withRotorInertia(const Model& model, const std::string& name, const Eigen::Ref<const Eigen::VectorXd>& values);
+
+// The per-solve friction overrides (breakaway, kinetic, viscous; empty: the
+// model's): one per DOF, each finite and >= 0. ProblemError keyed as perJoint's.
+void checkFrictionOverrides(const Model& model, const FrictionOptions& options);
+
 // The ranges of the balance and friction options; ProblemError(Value) keyed by the option.
 void checkBalance(const BalanceOptions& options);
 void checkFriction(const FrictionOptions& options);

@@ -49,33 +49,12 @@ py::array perDof(const Model& model, F field) {
   return vectorCopy(v);
 }
 
-// Per-joint values for the builder's setters, one per joint or one per DOF
-// (model.dof entries, as the getters give them: the DOFs of one joint must
-// then agree, a joint has one value for all its DOFs).
+// Per-joint values for the builder's setters by the problem layer's rules
+// (one per joint, or one per DOF as the getters give them; finite, >= 0).
 Eigen::VectorXd perJointArg(const Model& model, const char* name, py::handle value) {
   Eigen::VectorXd buffer;
-  const Eigen::VectorXd v = vectorArg(name, value, buffer);
-  const int joints = jointCount(model);
-  if (v.size() == joints) return v;
-  if (v.size() != model.dof()) {
-    const std::string dofs = model.dof() == joints ? "" : std::to_string(model.dof()) + " DOFs and ";
-    raise(exceptions().model_error, std::string(name) + ": has " + std::to_string(v.size()) +
-                                        " entries, the model has " + dofs + std::to_string(joints) + " joints (" +
-                                        problem::jointNames(model) + ")");
-  }
-  Eigen::VectorXd per_joint(joints);
-  const int below = model.nv() - model.dof();
-  for (int j = 0; j < joints; ++j) {
-    const Joint& joint = model.joint(j);
-    const int first = joint.v_index - below;
-    per_joint[j] = v[first];
-    for (int k = first + 1; k < first + joint.nv(); ++k)
-      if (v[k] != v[first])
-        raise(exceptions().model_error, std::string(name) + ": entries " + std::to_string(first) + "-" +
-                                            std::to_string(first + joint.nv() - 1) + " (the DOFs of joint '" +
-                                            joint.name + "') differ: a joint has one value for all its DOFs");
-  }
-  return per_joint;
+  const Eigen::Map<const Eigen::VectorXd> v = vectorArg(name, value, buffer);
+  return checked("", [&] { return problem::perJoint(model, name, v); });
 }
 
 py::array transformMatrix(const Eigen::Matrix3d& R, const Vec3& p) {
@@ -387,10 +366,9 @@ void addCopies(ModelClass& cls) {
   cls.def(
          "with_rotor_inertia",
          [](const Model& model, py::handle values) {
-    const Eigen::VectorXd v = perJointArg(model, "rotor_inertia", values);
-    ModelBuilder builder(model);
-    for (int j = 0; j < jointCount(model); ++j) builder.setRotorInertia(model.joint(j).name, v[j]);
-    return std::make_shared<Model>(builder.build());
+    Eigen::VectorXd buffer;
+    const Eigen::Map<const Eigen::VectorXd> v = vectorArg("rotor_inertia", values, buffer);
+    return std::make_shared<Model>(checked("", [&] { return problem::withRotorInertia(model, "rotor_inertia", v); }));
          },
          py::arg("rotor_inertia"),
          "a copy with these reflected rotor inertias, one per joint or one per DOF (model.dof entries; a joint's\n"

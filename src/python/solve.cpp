@@ -719,6 +719,8 @@ SolveArgs solveArgs(const std::shared_ptr<Model>& model, py::handle ws_obj, py::
                     py::handle balance) {
   PyWorkspace& pw = workspaceArg(model, ws_obj);
   const FrictionOptions* options = frictionArg(friction);
+  if (options)
+    checked("", [&] { problem::checkFrictionOverrides(*model, *options); });  // before the solve: the CLI's words
   const BalanceOptions& balance_options = balanceArg(balance);
   Task& task = solveTask(pw, constraints, wrenches, gravity);
   task.balance = balance_options;

@@ -665,7 +665,7 @@ TEST_CASE("Errors in the problem file", "[errors]") {
       {"err_duplicate_key.json", {": q: duplicate key"}},
       {"err_breakaway_without_friction.json", {": breakaway: has no effect", "friction"}},
       {"err_margin.json", {": friction.margin: must be between 0 and 1"}},
-      {"err_negative_rotor.json", {": rotor_inertia[0]: is -1, must be >= 0"}},
+      {"err_negative_rotor.json", {": rotor_inertia[0]: must be finite and >= 0, got -1"}},
       {"err_missing_frame_key.json", {": constraints[0]: missing key \"frame\""}},
       {"err_no_directions.json", {": constraints[0].directions: needs at least one direction"}},
       {"err_bad_tip.json", {": model: ", "nowhere"}},
@@ -738,8 +738,9 @@ TEST_CASE("Errors in the problem file: the problem layer's shared table", "[erro
       Json p = {{"model", ZWANG_MODELS_DIR "/panda.urdf"}, {"root", "panda_link0"}, {"tip", "tool0"}};
       if (row.contains("constraint")) p["constraints"] = Json::array({row["constraint"]});
       if (row.contains("wrench")) p["wrenches"] = Json::array({row["wrench"]});
-      for (const char* key : {"balance", "friction"})
+      for (const char* key : {"balance", "friction", "rotor_inertia", "breakaway"})
         if (row.contains(key)) p[key] = row[key];
+      if (row.contains("breakaway") && !p.contains("friction")) p["friction"] = Json::object();  // else refused
       const std::string file = cli_test::scratchDir() + "/shared_table.json";
       cli_test::writeText(file, p.dump());
       const Run r = run({"solve", file});

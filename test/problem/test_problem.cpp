@@ -47,6 +47,12 @@ void addConstraint(const zwang::Model& model, zwang::Task& task, const Json& c) 
   problem::addConstraint(kSpelling, model, task, d);
 }
 
+Eigen::VectorXd vectorOf(const Json& values) {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(values.size()));
+  for (std::size_t k = 0; k < values.size(); ++k) v[static_cast<Eigen::Index>(k)] = values[k].get<double>();
+  return v;
+}
+
 void addWrench(const zwang::Model& model, zwang::Task& task, const Json& w) {
   const zwang::Expressed e =
       problem::parseExpressed(kSpelling, w.value("expressed_in", "local"), problem::AxesOf::Wrench);
@@ -81,9 +87,20 @@ std::string messageOf(const zwang::Model& model, const Json& row, problem::Fault
       o.velocity_tolerance = row["friction"].value("velocity_tolerance", o.velocity_tolerance);
       problem::checkFriction(o);
     }
+    if (row.contains("rotor_inertia")) {  // the per-joint arrays: their own name is the path
+      where = "";
+      problem::withRotorInertia(model, "rotor_inertia", vectorOf(row["rotor_inertia"]));
+    }
+    if (row.contains("breakaway")) {
+      where = "";
+      zwang::FrictionOptions o;
+      o.breakaway = vectorOf(row["breakaway"]);
+      problem::checkFrictionOverrides(model, o);
+    }
   } catch (const ProblemError& e) {
     fault = e.fault();
-    return where + (e.key().empty() ? "" : "." + e.key()) + ": " + e.what();
+    const std::string key = e.key().empty() || where.empty() ? e.key() : "." + e.key();
+    return where + key + ": " + e.what();
   }
   return "(no error)";
 }

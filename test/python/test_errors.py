@@ -152,8 +152,10 @@ def test_bad_constraints_wrenches_and_options(panda, ws):
         solve(panda, ws, friction=0.8)
     with pytest.raises(ValueError, match=r"margin: must be between 0 and 1, got 1.5"):
         zwang.Friction(margin=1.5)
-    with pytest.raises(zwang.SolveError, match="breakaway' has 3 entries"):
+    with pytest.raises(zwang.ModelError, match=r"breakaway: has 3 entries, expected 7 \(one per moving joint"):
         solve(panda, ws, friction=zwang.Friction(breakaway=[1, 2, 3]))
+    with pytest.raises(ValueError, match=r"kinetic\[0\]: must be finite and >= 0, got nan"):
+        solve(panda, ws, friction=zwang.Friction(kinetic=[np.nan] + [0.0] * 6))
     with pytest.raises(ValueError, match="method"):
         zwang.Friction(method="newton")
     with pytest.raises(ValueError, match="expected 3 numbers"):
@@ -187,9 +189,9 @@ def test_urdf_errors(tmp_path):
     with pytest.raises(TypeError):
         zwang.load_urdf(PANDA, rotor_inertia=[1, 2])
     arm = zwang.load_urdf(ARM)
-    with pytest.raises(zwang.ModelError, match="has 2 entries, the model has 1 joints"):
+    with pytest.raises(zwang.ModelError, match=r"rotor_inertia: has 2 entries, expected 1 \(one per moving joint: joint1\)"):
         arm.with_rotor_inertia([1.0, 2.0])
-    with pytest.raises(zwang.ModelError):
+    with pytest.raises(ValueError, match=r"rotor_inertia\[0\]: must be finite and >= 0, got -1"):
         arm.with_rotor_inertia([-1.0])
 
 

@@ -34,9 +34,21 @@ def solve_row(panda, ws, row):
         kwargs["wrenches"] = [zwang.Wrench(w["frame"], expressed=w.get("expressed_in", "local"))]
     if "balance" in row:
         kwargs["balance"] = zwang.Balance(**row["balance"])
-    if "friction" in row:
-        kwargs["friction"] = zwang.Friction(**row["friction"])
+    if "friction" in row or "breakaway" in row:
+        breakaway = {"breakaway": row["breakaway"]} if "breakaway" in row else {}
+        kwargs["friction"] = zwang.Friction(**row.get("friction", {}), **breakaway)
+    if "rotor_inertia" in row:
+        panda = panda.with_rotor_inertia(row["rotor_inertia"])
+        ws = panda.workspace()
     zwang.solve(panda, ws, np.zeros(panda.nq), **kwargs)
+
+
+def check_raised(row, call):
+    error = zwang.ModelError if row["kind"] == "model" else ValueError
+    with pytest.raises(error) as e:
+        call()
+    assert isinstance(e.value, zwang.ModelError) == (row["kind"] == "model")  # a ModelError is a ValueError too
+    assert same_quotes(row["expect"]) in same_quotes(str(e.value))
 
 
 def test_the_table_has_rows():
@@ -45,8 +57,13 @@ def test_the_table_has_rows():
 
 @pytest.mark.parametrize("row", TABLE["rows"], ids=[row["name"] for row in TABLE["rows"]])
 def test_shared_bad_input(panda, row):
-    error = zwang.ModelError if row["kind"] == "model" else ValueError
-    with pytest.raises(error) as e:
-        solve_row(panda, panda.workspace(), row)
-    assert isinstance(e.value, zwang.ModelError) == (row["kind"] == "model")  # a ModelError is a ValueError too
-    assert same_quotes(row["expect"]) in same_quotes(str(e.value))
+    check_raised(row, lambda: solve_row(panda, panda.workspace(), row))
+
+
+BREAKAWAY_ROWS = [row for row in TABLE["rows"] if "breakaway" in row]
+
+
+@pytest.mark.parametrize("row", BREAKAWAY_ROWS, ids=[row["name"] for row in BREAKAWAY_ROWS])
+def test_shared_bad_breakaway_as_the_models_friction(panda, row):
+    """Model.with_friction takes the same per-joint array as Friction(breakaway=...), with the same words."""
+    check_raised(row, lambda: panda.with_friction(row["breakaway"]))

@@ -110,12 +110,19 @@ struct Mimic {
 struct Joint {
   std::string name;                      ///< unique among the model's joints
   JointType type = JointType::Revolute;  ///< see JointType
-  Vec3 axis = Vec3::UnitZ();             ///< unit vector in the joint (= child body) frame (one-DOF joints)
-  Transform placement;                   ///< ʲX_parent: parent body frame → joint frame at q = 0
-  double rotor_inertia = 0.0;            ///< d_j, reflected armature inertia per DOF [kg·m² or kg]
-  double breakaway_friction = 0.0;       ///< f_j ≥ 0, static friction bound per DOF
-  double kinetic_friction = 0.0;         ///< f_c,j ≥ 0, Coulomb friction while moving
-  double viscous_friction = 0.0;         ///< b_j ≥ 0, viscous friction coefficient (URDF `dynamics damping`)
+  // The sweeps read type, the indices, axis and placement of every joint: kept
+  // together, they span three cache lines, not four.
+  /// First entry of the joint's coordinates in the model's q (set by ModelBuilder::build).
+  int q_index = -1;
+  /// First entry of its velocity coordinates in q̇, τ and q̈; its DOFs move
+  /// bodies v_index + 1 … v_index + nv() (set by ModelBuilder::build).
+  int v_index = -1;
+  Vec3 axis = Vec3::UnitZ();        ///< unit vector in the joint (= child body) frame (one-DOF joints)
+  Transform placement;              ///< ʲX_parent: parent body frame → joint frame at q = 0
+  double rotor_inertia = 0.0;       ///< d_j, reflected armature inertia per DOF [kg·m² or kg]
+  double breakaway_friction = 0.0;  ///< f_j ≥ 0, static friction bound per DOF
+  double kinetic_friction = 0.0;    ///< f_c,j ≥ 0, Coulomb friction while moving
+  double viscous_friction = 0.0;    ///< b_j ≥ 0, viscous friction coefficient (URDF `dynamics damping`)
   double lower = -std::numeric_limits<double>::infinity();  ///< position limits: lower [rad or m]
   double upper = std::numeric_limits<double>::infinity();   ///< position limits: upper [rad or m]
   /// Largest torque [N·m] or force [N] (URDF `<limit effort>`).
@@ -125,11 +132,6 @@ struct Joint {
   /// The leader this joint follows, if it is a mimic joint (chains of mimic
   /// joints are resolved to the first leader when the model is built).
   Mimic mimic;
-  /// First entry of the joint's coordinates in the model's q (set by ModelBuilder::build).
-  int q_index = -1;
-  /// First entry of its velocity coordinates in q̇, τ and q̈; its DOFs move
-  /// bodies v_index + 1 … v_index + nv() (set by ModelBuilder::build).
-  int v_index = -1;
 
   /// Entries of q: configurationSize(type).
   int nq() const { return configurationSize(type); }
@@ -264,6 +266,9 @@ class Model {
   const std::vector<Joint>& allJoints() const { return all_joints_; }
   /// Every DOF in the order of v (nv() entries): DOF k moves body k + 1.
   const std::vector<Dof>& dofs() const { return dofs_; }
+  /// d_k of every DOF in the order of v (nv() entries; 0 on a floating root):
+  /// Dof::rotor_inertia, contiguous as the sweeps read it.
+  const Eigen::VectorXd& rotorInertia() const { return rotor_inertia_; }
   /// The parent body of body b (−1 for body 0).
   int parent(int b) const { return parents_[static_cast<std::size_t>(b)]; }
   /// One past the last body of b's subtree: the subtree is [b, subtreeEnd(b)).
@@ -336,6 +341,7 @@ class Model {
   std::vector<Joint> root_;        // the root joint of a floating base (none on a fixed one)
   std::vector<Joint> all_joints_;  // root_, then joints_
   std::vector<Dof> dofs_;
+  Eigen::VectorXd rotor_inertia_;  // per DOF, from dofs_
   int nq_ = 0, nv_ = 0;
   std::vector<RigidInertia> inertias_{{}};  // bodyCount() entries
   std::vector<Frame> frames_;

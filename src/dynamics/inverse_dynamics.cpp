@@ -19,7 +19,7 @@ ZWANG_FLATTEN void recursiveNewtonEuler(const Model& model, const Task& task,
   WorkspaceScratch& sw = scratchOf(ws);
   const int N = model.nv();
   Eigen::VectorXd& tau = ws.tau;
-  const std::vector<Dof>& dofs = model.dofs();
+  const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
   auto at = [](int i) { return static_cast<std::size_t>(i); };
 
   // Outward: poses, velocities, bias forces, accelerations. In base coordinates
@@ -48,7 +48,7 @@ ZWANG_FLATTEN void recursiveNewtonEuler(const Model& model, const Task& task,
   Vec6 to_previous = Vec6::Zero();
   for (int i = N; i >= 1; --i) {
     const Vec6 f = sw.f[at(i)] + to_previous;
-    tau[i - 1] = sw.S[at(i)].dot(f) + dofs[at(i - 1)].rotor_inertia * qdd[i - 1];
+    tau[i - 1] = sw.S[at(i)].dot(f) + rotor_inertia[i - 1] * qdd[i - 1];
     const int p = model.parent(i);
     to_previous.setZero();
     if (p == i - 1)
@@ -86,7 +86,7 @@ namespace {
 void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q_all, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int N = model.nv();
-  const std::vector<Dof>& dofs = model.dofs();
+  const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
   auto at = [](int i) { return static_cast<std::size_t>(i); };
 
   // Outward: poses, motion subspaces and inertias (no velocity: H depends on q only).
@@ -108,7 +108,7 @@ void compositeRigidBody(const Model& model, const Eigen::Ref<const Eigen::Vector
     for (int i = last; i >= first; --i) {
       const Vec6 F = Ic * sw.S[at(i)];
       const int row = i - 1;
-      H[row + row * N] = sw.S[at(i)].dot(F) + dofs[at(row)].rotor_inertia;
+      H[row + row * N] = sw.S[at(i)].dot(F) + rotor_inertia[row];
       // H_kj ≠ 0 only for the DOFs j supporting k (its ancestors); the rest of
       // row k below the diagonal is the zeros of the branches between them
       // (none on a chain): each entry written once, with no pass over all of H.

@@ -327,12 +327,12 @@ void jointBalanceUpdate(const Task& task, int first, int last, WorkspaceScratch&
 }
 
 // Line 13's D and 1/D of DOF body i from its I^A S, or Degenerate.
-inline Status pivot(const Dof& dof, int i, WorkspaceScratch& sw) {
-  const double D = dof.rotor_inertia + sw.S[at(i)].dot(sw.IAS[at(i)]);  // line 13
+inline Status pivot(const Model& model, int i, WorkspaceScratch& sw) {
+  const double D = model.rotorInertia()[i - 1] + sw.S[at(i)].dot(sw.IAS[at(i)]);  // line 13
   sw.D[at(i)] = D;
   if (!(D > 1e-300))
-    return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)", dof.name.c_str(),
-                         D);
+    return Status::error(StatusCode::Degenerate, "joint '%s' has no inertia to move here (D = %g)",
+                         model.dofs()[at(i - 1)].name.c_str(), D);
   sw.inverse_D[at(i)] = 1.0 / D;  // one division per DOF; the rest multiply
   return {};
 }
@@ -372,13 +372,12 @@ inline void passToParent(const Model& model, int first, int last, const Mat6& IA
 // but each pivot waits on a 6-vector update, not on a 6 × 6 downdate of I^A.
 inline Status jointPivots(const Model& model, int first, int last, const Mat6& IA, const Vec6& pA, const VectorRef& tau,
                           WorkspaceScratch& sw) {
-  const std::vector<Dof>& dofs = model.dofs();
   for (int k = first; k <= last; ++k) {
     sw.IAS[at(k)].noalias() = IA * sw.S[at(k)];  // the columns of I^A S: independent
     sw.u[at(k)] = tau[k - 1] - sw.S[at(k)].dot(pA);
   }
   for (int m = last; m >= first; --m) {
-    if (Status s = pivot(dofs[at(m - 1)], m, sw); !s) return s;
+    if (Status s = pivot(model, m, sw); !s) return s;
     const Vec6& IAS_m = sw.IAS[at(m)];
     const double inverse_D = sw.inverse_D[at(m)], u_m = sw.u[at(m)];
     for (int k = first; k < m; ++k) {
@@ -395,7 +394,6 @@ inline Status jointPivots(const Model& model, int first, int last, const Mat6& I
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int N = model.nv();
-  const std::vector<Dof>& dofs = model.dofs();
   const int m = task.solverColumns();
   sw.U.head(m).setZero();  // U_N = 0
   sw.L_scale.head(m).setZero();
@@ -413,7 +411,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     pA.noalias() += IA * sw.c[at(i)];  // F^A + I^A Ẍ_bias
     if (first == i) {                  // one DOF: lines 13–15 as the report has them
       sw.IAS[at(i)].noalias() = IA * sw.S[at(i)];
-      if (Status s = pivot(dofs[at(i - 1)], i, sw); !s) return s;
+      if (Status s = pivot(model, i, sw); !s) return s;
       sw.u[at(i)] = tau[i - 1] - sw.S[at(i)].dot(pA);  // τ − Sᵀ(F^A + I^A Ẍ_bias), docs/solver.md
     } else if (Status s = jointPivots(model, first, i, IA, pA, tau, sw); !s) {
       return s;
@@ -904,7 +902,7 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
   // in 3-vector pieces: with y = ½a + [−g; 0] = [y_l; y_a] and a = [a_l; α],
   // I y = [m y_l − h × y_a; h × y_l + Ī y_a].
   const Vec3& g = task.gravity;
-  const std::vector<Dof>& dofs = model.dofs();
+  const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
   double Z = 0.0;
   for (int i = 1; i <= model.nv(); ++i) {
     const RigidInertia& I = sw.I[at(i)];
@@ -917,7 +915,7 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
     Z += a_lin.dot(I.mass * y_lin - I.h.cross(y_ang) + F.head<3>()) +
          alpha.dot(I.h.cross(y_lin) + I.Ibar * y_ang + F.tail<3>());
     const double qdd_i = qdd[i - 1];
-    Z += (0.5 * dofs[at(i - 1)].rotor_inertia * qdd_i - tau[i - 1]) * qdd_i;
+    Z += (0.5 * rotor_inertia[i - 1] * qdd_i - tau[i - 1]) * qdd_i;
   }
   return Z;
 }

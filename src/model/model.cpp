@@ -526,6 +526,8 @@ void ModelBuilder::layOutBodies(Model& model) {
   if (model.root_.empty()) model.inertias_[0] = model.link_inertias_[0];
   model.nq_ = nq;
   model.nv_ = nv;
+  model.rotor_inertia_.resize(nv);
+  for (int k = 0; k < nv; ++k) model.rotor_inertia_[k] = model.dofs_[static_cast<std::size_t>(k)].rotor_inertia;
   std::copy(model.all_joints_.begin() + static_cast<std::ptrdiff_t>(model.root_.size()), model.all_joints_.end(),
             model.joints_.begin());
   for (std::size_t f = 0; f < model.frames_.size(); ++f)

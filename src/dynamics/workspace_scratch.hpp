@@ -65,7 +65,7 @@ struct WorkspaceScratch {
   // --- balance (line 25), src/dynamics/balance.cpp
   internal::BalanceFactorisation balance_factorisation;  // the last balance's factorisation
   Eigen::VectorXd rhs;                                   // b − A_0ᵀẌ_0 − U_0, per balance row
-  Eigen::VectorXd nu;                                    // ν per solver column (what the sweeps read)
+  Eigen::VectorXd nu_columns;                            // ν per solver column (what the sweeps read)
   Eigen::VectorXd nu_motors;                             // ν per solver column with the contacts' set to 0 (τ_c)
   // With relative constraints the balance works on rows, each the sum of its
   // solver columns: 𝓛, its rounding scale, ν and the unit-torque columns per row.

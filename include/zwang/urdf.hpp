@@ -58,8 +58,8 @@ enum class MimicJoints {
 ///   item) so that its z is the `<axis>`, is the plane
 ///   (Model::basePlacement()); the base link keeps the URDF's orientation
 ///   (its frame is placed on the base's body by the inverse rotation).
-/// * A `floating` or `planar` joint anywhere else is a joint of the model
-///   (issue #25): JointType::Free (q = [x, y, z, q_w, q_x, q_y, q_z] of the
+/// * A `floating` or `planar` joint anywhere else is a joint of the model:
+///   JointType::Free (q = [x, y, z, q_w, q_x, q_y, q_z] of the
 ///   child link in the joint frame, the URDF `<origin>`) or JointType::Planar
 ///   (q = [x, y, ψ]). URDF moves a planar joint's child in the plane normal to
 ///   its `<axis>`: zwang turns the joint frame by the shortest rotation that

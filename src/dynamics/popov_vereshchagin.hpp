@@ -72,7 +72,7 @@ struct UnitTorqueScratch {
   Matrix6X joint_rows;        // 6 × capacity: a multi-DOF joint's δU₀ per unit δF^A, transposed
   Eigen::MatrixXd da;         // column i: body i's δẌ for up to kLanes columns (kLanes × 6, column-major)
   Eigen::MatrixXd dnu_lanes;  // kLanes × capacity: δν of those columns, one row per column
-  // Body i's run of columns [run_begin[i], run_end[i]): those whose joint's
+  // Body i's run of columns [run_begin[i], run_end[i]): those whose DOF's
   // body lies in i's subtree, the only ones with δu_i ≠ 0 (du is set there only).
   Eigen::Matrix<Eigen::Index, Eigen::Dynamic, 1> run_begin, run_end;
 };

@@ -215,12 +215,12 @@ Eigen::Index flatDirections(const Eigen::Ref<const Eigen::MatrixXd>& K,
                             const Eigen::Ref<const Eigen::VectorXd>& hi,
                             const Eigen::Ref<const Eigen::VectorXd>& curvature_terms, double acc_tolerance,
                             MaximiserChoiceScratch& s, Eigen::Index& ns) {
-  const Eigen::Index k = K.rows();
-  auto qdd_star = s.qdd_star.head(k);
+  const Eigen::Index stuck_count = K.rows();
+  auto qdd_star = s.qdd_star.head(stuck_count);
   qdd_star = qdd0_stuck;
   qdd_star.noalias() -= K * mu;
   ns = 0;
-  for (Eigen::Index a = 0; a < k; ++a)
+  for (Eigen::Index a = 0; a < stuck_count; ++a)
     if (std::abs(qdd_star[a]) <= acc_tolerance) s.sticking[ns++] = static_cast<int>(a);
   if (ns == 0) return 0;  // every stuck joint slips: μ* is unique
   const auto sticking = s.sticking.head(ns);

@@ -78,7 +78,7 @@ struct WorkspaceScratch {
   Eigen::VectorXd row_size;      // the size of the terms of each row's error (taskResidual)
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
-  std::vector<Vec6> a;          // Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0] on a fixed base)
+  std::vector<Vec6> a;          // Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0], the world's: [−g; 0])
   Vec6 a_world = Vec6::Zero();  // the world's acceleration in the sweep, [−g; 0]: what a is shifted by
   std::vector<Vec6> f;          // accumulated forces (RNEA)
   // The constraint wrenches A ν on each body and its subtree (constraint torques)

@@ -42,7 +42,7 @@ WorkspaceScratch::WorkspaceScratch(const Model& model, int columns, int m) {
   balance_factorisation.near_null_weight.setZero(m);
   balance_factorisation.work.setZero(m);
   rhs.setZero(m);
-  nu.setZero(columns);
+  nu_columns.setZero(columns);
   nu_motors.setZero(columns);
   a.assign(bodies, Vec6::Zero());
   f.assign(bodies, Vec6::Zero());

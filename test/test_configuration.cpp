@@ -97,8 +97,9 @@ Eigen::VectorXd randomVelocity(std::mt19937_64& rng, const Model& model, const C
   } else if (model.baseType() == BaseType::Planar) {
     v[2] = uniform(rng, -3.1, 3.1);
   }
-  const int nvb = model.baseVelocitySize();
-  for (const MimicLaw& law : spec.mimicLaws()) v[nvb + law.joint] = law.multiplier * v[nvb + law.leader];
+  const int base_velocity_size = model.baseVelocitySize();
+  for (const MimicLaw& law : spec.mimicLaws())
+    v[base_velocity_size + law.joint] = law.multiplier * v[base_velocity_size + law.leader];
   return v;
 }
 
@@ -389,7 +390,7 @@ TEST_CASE("configuration: neutral and random configurations keep limits and mimi
     }
     for (const BaseType type : {BaseType::Fixed, BaseType::Free, BaseType::Planar}) {
       const Model model = type == BaseType::Fixed ? fixed : withBase(fixed, type);
-      const int nqb = model.baseConfigurationSize();
+      const int base_configuration_size = model.baseConfigurationSize();
       ++models;
       for (int k = 0; k <= 10; ++k, ++draws) {
         Eigen::VectorXd q(model.nq());
@@ -410,7 +411,7 @@ TEST_CASE("configuration: neutral and random configurations keep limits and mimi
         }
         for (int j = 0; j < spec.dof(); ++j) {
           const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
-          const double x = q[nqb + j];
+          const double x = q[base_configuration_size + j];
           const bool limited = joint.type != "continuous";
           if (!is_mimic[static_cast<std::size_t>(j)]) {
             INFO("joint " << joint.name << " = " << x);
@@ -428,7 +429,8 @@ TEST_CASE("configuration: neutral and random configurations keep limits and mimi
           }
         }
         for (const MimicLaw& law : laws) {
-          const double e = std::abs(q[nqb + law.joint] - (law.multiplier * q[nqb + law.leader] + law.offset));
+          const double e = std::abs(q[base_configuration_size + law.joint] -
+                                    (law.multiplier * q[base_configuration_size + law.leader] + law.offset));
           CHECK(e < 1e-15);
           e_law = std::max(e_law, e);
         }

@@ -148,13 +148,13 @@ TEST_CASE("floating trees: friction through the same sweeps, checked by the dens
     ++draws;
     FloatingProblem p = randomFloatingProblem(rng, options);
     if (p.spec.dof() == 0) continue;
-    const int nvb = p.base.nvBase();
+    const int base_velocity_size = p.base.baseVelocitySize();
     // 1–5 joints stuck exactly; breakaway friction 0–20 on every joint.
     std::vector<int> order(static_cast<std::size_t>(p.spec.dof()));
     for (std::size_t j = 0; j < order.size(); ++j) order[j] = static_cast<int>(j);
     std::shuffle(order.begin(), order.end(), rng);
     const int k = std::min<int>(static_cast<int>(order.size()), 1 + static_cast<int>(rng() % 5));
-    for (int a = 0; a < k; ++a) p.input.v[nvb + order[static_cast<std::size_t>(a)]] = 0.0;
+    for (int a = 0; a < k; ++a) p.input.v[base_velocity_size + order[static_cast<std::size_t>(a)]] = 0.0;
     const FloatingResult check = floatingDynamics(p.spec, p.base, p.input);
     if (!wellPosed(check)) continue;
     const Model plain = floatingModelFromSpec(p.spec, p.base);
@@ -180,7 +180,7 @@ TEST_CASE("floating trees: friction through the same sweeps, checked by the dens
     e_motion = std::max(e_motion, relativeError(ws.solution.qdd, dense.qdd));
     const double acc_scale = 1.0 + ws.solution.qdd.cwiseAbs().maxCoeff();
     for (const int j : fr.stuck) {
-      const double qdd = ws.solution.qdd[nvb + j], mu = fr.mu[j], f = fo.breakaway[j];
+      const double qdd = ws.solution.qdd[base_velocity_size + j], mu = fr.mu[j], f = fo.breakaway[j];
       const JointState st = fr.state[static_cast<std::size_t>(j)];
       states[st == JointState::Stick          ? 0
              : st == JointState::SlipPositive ? 1

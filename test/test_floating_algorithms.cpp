@@ -106,7 +106,7 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
     const Model model = floatingModelFromSpec(p.spec, p.base);
     const Task task = floatingTaskFromInput(model, p.input);
     Workspace ws(model, task);
-    const int nv = model.nv(), nvb = model.baseVelocitySize();
+    const int nv = model.nv(), base_velocity_size = model.baseVelocitySize();
     ++trees;
     (p.base.kind == BaseKind::Free ? free : planar) += 1;
     if (p.base.kind == BaseKind::Planar && !p.base.plane.isApprox(Eigen::Isometry3d::Identity())) ++turned_planes;
@@ -141,8 +141,9 @@ TEST_CASE("floating trees: RNEA, CRBA, kinematics and Jacobians against the dens
     e_HC = std::max(e_HC, relativeError(ws.H * qdd + C, tau));
     for (int i = 0; i < model.dof(); ++i)
       for (int j = 0; j < model.dof(); ++j)
-        if (!model.supports(nvb + i + 1, nvb + j + 1) && !model.supports(nvb + j + 1, nvb + i + 1)) {
-          CHECK(ws.H(nvb + i, nvb + j) == 0.0);
+        if (!model.supports(base_velocity_size + i + 1, base_velocity_size + j + 1) &&
+            !model.supports(base_velocity_size + j + 1, base_velocity_size + i + 1)) {
+          CHECK(ws.H(base_velocity_size + i, base_velocity_size + j) == 0.0);
           ++zero_entries;
         }
 

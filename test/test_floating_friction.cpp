@@ -49,16 +49,17 @@ bool contains(const std::vector<int>& set, int x) { return std::find(set.begin()
 void drawJointState(std::mt19937_64& rng, FloatingFrictionDraw& d) {
   const ChainSpec& spec = d.problem.spec;
   FloatingInput& in = d.problem.input;
-  const int n = spec.dof(), nqb = d.problem.base.nqBase(), nvb = d.problem.base.nvBase();
+  const int n = spec.dof(), base_configuration_size = d.problem.base.baseConfigurationSize(),
+            base_velocity_size = d.problem.base.baseVelocitySize();
   const std::vector<int> moving = spec.movingJoints();
   std::vector<int> order(static_cast<std::size_t>(n));
   for (int j = 0; j < n; ++j) {
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
     if (joint.type != "continuous") {
       const double margin = 0.05 * (joint.upper - joint.lower);
-      in.q(nqb + j) = uniform(rng, joint.lower + margin, joint.upper - margin);
+      in.q(base_configuration_size + j) = uniform(rng, joint.lower + margin, joint.upper - margin);
     }
-    in.v(nvb + j) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
+    in.v(base_velocity_size + j) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
     order[static_cast<std::size_t>(j)] = j;
   }
   const int k = uniformInt(rng, 1, std::min(5, n));
@@ -68,11 +69,11 @@ void drawJointState(std::mt19937_64& rng, FloatingFrictionDraw& d) {
   std::sort(d.setup.stuck.begin(), d.setup.stuck.end());
   d.setup.limit_side = Eigen::VectorXi::Zero(n);
   for (const int j : d.setup.stuck) {
-    in.v(nvb + j) = 0.0;
+    in.v(base_velocity_size + j) = 0.0;
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
     if (joint.type == "continuous" || uniform01(rng) >= 0.2) continue;
     const bool lower = uniform01(rng) < 0.5;
-    in.q(nqb + j) = lower ? joint.lower : joint.upper;
+    in.q(base_configuration_size + j) = lower ? joint.lower : joint.upper;
     d.setup.limit_side(j) = lower ? -1 : 1;
     d.on_limit = true;
   }
@@ -163,9 +164,10 @@ bool wellPosed(const FloatingResult& dense) {
 // The state a stuck joint must have, from the reference's q̈* (unique) and μ*
 // (when unique); -1 when the reference itself sits within rounding of a
 // boundary between two states (not compared).
-int expectedState(const FrictionReference& ref, const FrictionSetup& setup, int j, int nvb, bool mu_unique) {
+int expectedState(const FrictionReference& ref, const FrictionSetup& setup, int j, int base_velocity_size,
+                  bool mu_unique) {
   const double acc_scale = 1.0 + ref.qdd.cwiseAbs().maxCoeff();
-  const double qdd = ref.qdd(nvb + j), f = setup.breakaway(j);
+  const double qdd = ref.qdd(base_velocity_size + j), f = setup.breakaway(j);
   // The solver calls |q̈_j| ≤ 1e-9·(1 + max|q̈_Θ(0)|) sticking; the reference's q̈ is good to ~1e-12 of its scale.
   if (qdd > 1e-6 * acc_scale) return static_cast<int>(JointState::SlipPositive);
   if (qdd < -1e-6 * acc_scale) return static_cast<int>(JointState::SlipNegative);
@@ -236,7 +238,7 @@ bool contactShareMoves(const FloatingFrictionDraw& d, const FrictionReference& r
 // (Wolfe on the valid patterns' τ_control, the base's entries not counted).
 void compareLeastEffort(const FloatingFrictionDraw& d, const Workspace& ws, const FrictionReference& ref, Tally& t) {
   const int n = d.problem.spec.dof();
-  const LeastEffort least = leastEffortMaximiser(ref, d.problem.base.nvBase());
+  const LeastEffort least = leastEffortMaximiser(ref, d.problem.base.baseVelocitySize());
   const Eigen::VectorXd tau = ws.solution.tau_control.tail(n);
   const double ee = relativeError(tau, least.tau_control);
   const double excess = (tau.norm() - least.tau_control.norm()) / std::max(1.0, least.tau_control.norm());
@@ -274,7 +276,7 @@ void compareIndeterminate(const FloatingFrictionDraw& d, const Workspace& ws, co
 
 void compareStates(const FloatingFrictionDraw& d, const Workspace& ws, const FrictionReference& ref, bool mu_unique,
                    Tally& t) {
-  const int n = d.problem.spec.dof(), nvb = d.problem.base.nvBase();
+  const int n = d.problem.spec.dof(), base_velocity_size = d.problem.base.baseVelocitySize();
   for (int j = 0; j < n; ++j) {
     const JointState state = ws.friction.state[static_cast<std::size_t>(j)];
     ++t.states[static_cast<int>(state)];
@@ -287,7 +289,7 @@ void compareStates(const FloatingFrictionDraw& d, const Workspace& ws, const Fri
       continue;
     }
     ++t.stuck;
-    const int expected = expectedState(ref, d.setup, j, nvb, mu_unique);
+    const int expected = expectedState(ref, d.setup, j, base_velocity_size, mu_unique);
     if (expected < 0) {
       ++t.states_skipped;
       if (!mu_unique) CHECK((state == JointState::Stick || state == JointState::AtLimit));
@@ -434,11 +436,12 @@ FloatingFrictionDraw sharedLoadDraw(std::mt19937_64& rng) {
   if (d.problem.spec.dof() < 4) return d;
   d.problem.input.constraints.clear();
   drawJointState(rng, d);
-  const int n = d.problem.spec.dof(), nvb = d.problem.base.nvBase();
+  const int n = d.problem.spec.dof(), base_velocity_size = d.problem.base.baseVelocitySize();
   d.setup.stuck.clear();  // at rest: every joint stuck (those drawn moving stay inside their limits), the base still
-  d.problem.input.v.head(nvb).setZero();  // (a moving base would make the feet's constraints drive the joints)
+  d.problem.input.v.head(base_velocity_size)
+      .setZero();  // (a moving base would make the feet's constraints drive the joints)
   for (int j = 0; j < n; ++j) {
-    d.problem.input.v(nvb + j) = 0.0;
+    d.problem.input.v(base_velocity_size + j) = 0.0;
     d.setup.stuck.push_back(j);
   }
   drawFriction(rng, d);
@@ -654,13 +657,13 @@ struct HeldTally {
 // contacts' loop pushes into is really Infeasible. Where both find a
 // maximiser, q̈* (unique) must agree.
 void compareHeldOnLimits(const FloatingProblem& p, HeldTally& t) {
-  const int n = p.spec.dof(), nqb = p.base.nqBase();
+  const int n = p.spec.dof(), base_configuration_size = p.base.baseConfigurationSize();
   FrictionSetup setup = frictionSetupFromSpec(p.spec, p.input.v.tail(n));
   const double on_limit = FrictionOptions{}.limit_tolerance;
   setup.limit_side = Eigen::VectorXi::Zero(n);
   for (const int j : setup.stuck) {
     const JointSpec& joint = p.spec.joints[static_cast<std::size_t>(j)];
-    const double q = p.input.q(nqb + j);
+    const double q = p.input.q(base_configuration_size + j);
     setup.limit_side(j) = q <= joint.lower + on_limit ? -1 : q >= joint.upper - on_limit ? 1 : 0;
   }
   const FrictionReference ref = bruteForceFloatingFriction(p.spec, p.base, p.input, setup);

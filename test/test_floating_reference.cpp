@@ -538,9 +538,10 @@ TEST_CASE("floating reference: Jacobians, J̇v, constraints, Gauss minimum, inve
                              p.input.tau + r.tau_c));
     // Every mimic joint follows its resolved leader: v̇_m = a·v̇_l (the base entries come first).
     for (const MimicLaw& law : p.spec.mimicLaws()) {
-      const int nb = p.base.nvBase();
-      mimic = std::max(mimic, std::abs(r.qdd(nb + law.joint) - law.multiplier * r.qdd(nb + law.leader)) /
-                                  std::max(1.0, std::abs(r.qdd(nb + law.joint))));
+      const int base_velocity_size = p.base.baseVelocitySize();
+      mimic = std::max(mimic, std::abs(r.qdd(base_velocity_size + law.joint) -
+                                       law.multiplier * r.qdd(base_velocity_size + law.leader)) /
+                                  std::max(1.0, std::abs(r.qdd(base_velocity_size + law.joint))));
     }
     // Keep well-posed draws only (as wellPosed in random_problem.hpp): every row reachable. A row the base and joints
     // cannot affect (an out-of-plane force on a planar base, say) has G ≈ 0.

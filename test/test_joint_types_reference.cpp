@@ -113,7 +113,7 @@ void drawState(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& 
   } else if (base.kind == BaseKind::Planar) {
     in.q.head<3>() << uniform(rng, -2.0, 2.0), uniform(rng, -2.0, 2.0), uniform(rng, -3.14159, 3.14159);
   }
-  qi = base.nqBase();
+  qi = base.baseConfigurationSize();
   for (const int k : spec.movingJoints()) {
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
     if (joint.isSpherical()) {
@@ -134,7 +134,7 @@ void drawState(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& 
   const int nv = base.nv(spec);
   in.v = randomVector(rng, nv, 2.0);
   in.tau = randomVector(rng, nv, 5.0);
-  in.tau.head(base.nvBase()).setZero();
+  in.tau.head(base.baseVelocitySize()).setZero();
 }
 
 // The task's rows well posed (the KKT system conditioned below 1e6, G of full row rank, smallest singular value at
@@ -162,9 +162,10 @@ FrictionSetup sizedFrictionSetup(int n) {
   return setup;
 }
 
-// Every joint DOF (after the base's nb) moving at 0.1–2 either way.
-void moveEveryDof(std::mt19937_64& rng, int nb, int n, FloatingInput& in) {
-  for (int k = 0; k < n; ++k) in.v(nb + k) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
+// Every joint DOF (after the base's) moving at 0.1–2 either way.
+void moveEveryDof(std::mt19937_64& rng, int base_velocity_size, int n, FloatingInput& in) {
+  for (int k = 0; k < n; ++k)
+    in.v(base_velocity_size + k) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
 }
 
 // A random state of the tree on `base` with the loads and frame rows of randomProblem (its q unused), in that
@@ -288,11 +289,11 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
     options.max_constraint_frames = 2;
     options.relative_probability = 0.2;
     FloatingInput in = loadedInput(rng, spec, base, options);
-    const int nb = base.nvBase();
+    const int base_velocity_size = base.baseVelocitySize();
 
     // Every DOF moving at 0.1–2, then 1..min(6, n) DOFs stuck exactly; a spherical joint often all three at once.
     FrictionSetup setup = sizedFrictionSetup(n);
-    moveEveryDof(rng, nb, n, in);
+    moveEveryDof(rng, base_velocity_size, n, in);
     std::vector<bool> stuck(static_cast<std::size_t>(n), false);
     const bool own = uniform01(rng) < 0.5;  // the model's friction (per joint, on each DOF), else overrides per DOF
     own_friction += own ? 1 : 0;
@@ -322,7 +323,7 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
     for (int k = 0; k < n; ++k)
       if (stuck[static_cast<std::size_t>(k)]) {
         setup.stuck.push_back(k);
-        in.v(nb + k) = 0.0;
+        in.v(base_velocity_size + k) = 0.0;
       }
 
     const FloatingResult dense = floatingDynamics(spec, base, in);
@@ -388,7 +389,7 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
     // μ* to ~1e-9 of f.
     const double acc_scale = 1.0 + ref.qdd.cwiseAbs().maxCoeff();
     for (const int k : setup.stuck) {
-      const double qdd = ref.qdd(nb + k), f = setup.breakaway(k);
+      const double qdd = ref.qdd(base_velocity_size + k), f = setup.breakaway(k);
       int expected = -1;  // 0 stick, 1 slip+, 2 slip−, −1 within rounding of a boundary: not judged
       if (qdd > 1e-6 * acc_scale)
         expected = 1;
@@ -443,9 +444,9 @@ TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the
     options.max_constraint_rows = std::min(3, n);
     options.max_constraint_frames = 1;
     FloatingInput in = loadedInput(rng, spec, base, options);
-    const int nb = base.nvBase();
+    const int base_velocity_size = base.baseVelocitySize();
     FrictionSetup setup = sizedFrictionSetup(n);
-    moveEveryDof(rng, nb, n, in);
+    moveEveryDof(rng, base_velocity_size, n, in);
     for (int k = 0; k < n; ++k) {
       setup.breakaway(k) = uniform(rng, 0.0, 20.0);
       setup.kinetic(k) = uniform(rng, 0.0, setup.breakaway(k));
@@ -454,7 +455,7 @@ TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the
     }
     if (setup.stuck.empty()) setup.stuck.push_back(uniformInt(rng, 0, n - 1));
     for (const int k : setup.stuck) {
-      in.v(nb + k) = 0.0;
+      in.v(base_velocity_size + k) = 0.0;
       stuck_in_row_joint += k >= joint_rows.first_dof && k < joint_rows.first_dof + joint_rows.dofs ? 1 : 0;
     }
     const Model model = floatingModelFromSpec(spec, base);

@@ -186,11 +186,14 @@ void checkMujocoConventions(const ChainSpec& spec, const FloatingBase& base, con
   const int smooth_only = mjDSBL_CONTACT | mjDSBL_CONSTRAINT | mjDSBL_EQUALITY | mjDSBL_PASSIVE;
   CHECK((m->opt.disableflags & smooth_only) == smooth_only);
   CHECK(m->neq == 0);
-  const auto nb = static_cast<std::size_t>(base.nvBase());
+  const auto base_velocity_size = static_cast<std::size_t>(base.baseVelocitySize());
   const std::vector<int> moving = spec.movingJoints();
   for (std::size_t k = 0; k < map.dof.size(); ++k) {
     const int dof = map.dof[k];
-    const double armature = k < nb ? 0.0 : spec.joints[static_cast<std::size_t>(moving[k - nb])].reflectedInertia();
+    const double armature =
+        k < base_velocity_size
+            ? 0.0
+            : spec.joints[static_cast<std::size_t>(moving[k - base_velocity_size])].reflectedInertia();
     CHECK(m->dof_armature[dof] == Approx(armature).epsilon(1e-15).margin(0.0));  // the written %.17g, read back
     CHECK(m->dof_damping[dof] == 0.0);
     CHECK(m->dof_frictionloss[dof] == 0.0);
@@ -285,9 +288,9 @@ Errors compareWithMujoco(const FloatingProblem& p, const Eigen::VectorXd& qdd_in
                          Conversion conversion = Conversion::Correct) {
   const Answers ours = solveWithZwang(p, qdd_inverse);
   const Answers theirs = solveWithMujoco(p, qdd_inverse, conversion);
-  const int nb = p.base.nvBase(), n = p.spec.dof();
+  const int base_velocity_size = p.base.baseVelocitySize(), n = p.spec.dof();
   Errors e;
-  e.base_qdd = relativeError(ours.qdd.head(nb), theirs.qdd.head(nb));
+  e.base_qdd = relativeError(ours.qdd.head(base_velocity_size), theirs.qdd.head(base_velocity_size));
   e.joint_qdd = relativeError(ours.qdd.tail(n), theirs.qdd.tail(n));
   e.base_world = relativeError(ours.base_world, theirs.base_world);
   e.link_velocity = linkError(ours.link_velocity, theirs.link_velocity);
@@ -344,7 +347,7 @@ TEST_CASE("floating bases: solver, RNEA and CRBA match MuJoCo on 220 free-flyer 
     with_gravity += p.input.gravity.isZero(0.0) ? 0 : 1;
     with_wrenches += p.input.wrenches.empty() ? 0 : 1;
     for (const WrenchInput& w : p.input.wrenches) base_wrenches += w.link == p.spec.links[0].name ? 1 : 0;
-    base_forces += p.input.tau.head(p.base.nvBase()).isZero(0.0) ? 0 : 1;
+    base_forces += p.input.tau.head(p.base.baseVelocitySize()).isZero(0.0) ? 0 : 1;
     tilted_planes += kind == BaseKind::Planar && !p.base.plane.matrix().isIdentity(0.0) ? 1 : 0;
   }
   std::printf(

@@ -162,10 +162,10 @@ JointsProblem randomJointsProblem(std::mt19937_64& rng, bool free_root, double f
     }
     qi += joint.nq();
   }
-  const int nv = p.base.nv(p.spec), nb = p.base.nvBase();
+  const int nv = p.base.nv(p.spec), base_velocity_size = p.base.baseVelocitySize();
   in.v = randomVector(rng, nv, 2.0);
   in.tau = randomVector(rng, nv, 5.0);
-  if (nb > 0 && uniform01(rng) < 0.5) in.tau.head(nb).setZero();
+  if (base_velocity_size > 0 && uniform01(rng) < 0.5) in.tau.head(base_velocity_size).setZero();
   const double g = uniform01(rng);
   in.gravity = g < 0.1   ? Eigen::Vector3d::Zero()
                : g < 0.5 ? Eigen::Vector3d(0.0, 0.0, -9.81)
@@ -216,7 +216,7 @@ VelocityChange velocityChange(const JointsProblem& p, Conversion conversion) {
   const FloatingInput& in = p.input;
   VelocityChange change{mujocoVelocityMap(p.spec, p.base, in.q), mujocoVelocityMapRate(p.spec, p.base, in.q, in.v)};
   if (conversion == Conversion::Correct) return change;
-  Eigen::Index qi = p.base.nqBase(), vi = p.base.nvBase();
+  Eigen::Index qi = p.base.baseConfigurationSize(), vi = p.base.baseVelocitySize();
   for (const int k : p.spec.movingJoints()) {
     const JointSpec& joint = p.spec.joints[static_cast<std::size_t>(k)];
     if (conversion == Conversion::BallRatesInJointFrame && joint.isSpherical()) {
@@ -297,7 +297,7 @@ void checkMujocoConventions(const JointsProblem& p, const mjModel* m, const Mujo
   const int smooth_only = mjDSBL_CONTACT | mjDSBL_CONSTRAINT | mjDSBL_EQUALITY | mjDSBL_PASSIVE;
   CHECK((m->opt.disableflags & smooth_only) == smooth_only);
   CHECK(m->neq == 0);
-  std::vector<double> armature(static_cast<std::size_t>(p.base.nvBase()), 0.0);
+  std::vector<double> armature(static_cast<std::size_t>(p.base.baseVelocitySize()), 0.0);
   for (const int k : p.spec.movingJoints()) {
     const JointSpec& joint = p.spec.joints[static_cast<std::size_t>(k)];
     armature.insert(armature.end(), static_cast<std::size_t>(joint.nv()), joint.reflectedInertia());
@@ -328,7 +328,7 @@ Eigen::MatrixXd mujocoMassMatrix(const mjModel* m, const mjData* d, const std::v
 // a ω × v_lin on those entries (our coordinates), 0 elsewhere.
 Eigen::VectorXd armatureCorrection(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& v) {
   Eigen::VectorXd correction = Eigen::VectorXd::Zero(v.size());
-  Eigen::Index vi = base.nvBase();
+  Eigen::Index vi = base.baseVelocitySize();
   for (const int k : spec.movingJoints()) {
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
     if (joint.isFree())

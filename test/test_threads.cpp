@@ -113,7 +113,7 @@ struct Outcome {
 // A floating base's coordinates stay at home (the joints and τ vary).
 Outcome run(const Model& model, const Tasks& tasks, long solves) {
   Workspace ws(model, tasks.constrained);
-  const int n = model.dof(), iv = model.baseVelocitySize();
+  const int n = model.dof(), base_velocity_size = model.baseVelocitySize();
   Eigen::VectorXd q = tasks.home, qd(model.nv()), tau = Eigen::VectorXd::Zero(model.nv());
   const Eigen::VectorXd& home = tasks.home;
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
@@ -122,7 +122,7 @@ Outcome run(const Model& model, const Tasks& tasks, long solves) {
   Outcome out;
   for (long i = 0; i < solves; ++i) {
     for (const Joint& joint : model.joints()) {
-      const int j = joint.v_index - iv;
+      const int j = joint.v_index - base_velocity_size;
       const double phase = 0.001 * static_cast<double>(i) + j;
       if (joint.type == JointType::Spherical) {  // turned from the identity by up to 0.3 rad about a moving axis
         const Vec3 turn(std::sin(phase), std::sin(1.3 * phase + 1.0), std::sin(0.7 * phase + 2.0));
@@ -132,7 +132,7 @@ Outcome run(const Model& model, const Tasks& tasks, long solves) {
         q[joint.q_index] = home[joint.q_index] + tasks.amplitude[j] * std::sin(phase);
       }
     }
-    for (int j = 0; j < n; ++j) tau[iv + j] = 2.0 * std::cos(0.002 * static_cast<double>(i) * (j + 1));
+    for (int j = 0; j < n; ++j) tau[base_velocity_size + j] = 2.0 * std::cos(0.002 * static_cast<double>(i) * (j + 1));
     Status status;
     switch (i % 3) {
       case 0:  // every joint stuck, gravity only (a floating base falls)
@@ -141,7 +141,7 @@ Outcome run(const Model& model, const Tasks& tasks, long solves) {
         break;
       case 1:  // constrained, one joint moving, friction
         qd = zero;
-        qd[iv + 3] = 0.2;
+        qd[base_velocity_size + 3] = 0.2;
         status = solveWithFriction(model, ws, q, qd, tau, tasks.constrained, options);
         hash.add(ws.friction.mu);
         break;

@@ -2,7 +2,8 @@
 /// Static friction (docs/friction.md; the report's chapter 5): the exact
 /// maximum-dissipation motion for any number of stuck joints.
 ///
-/// Joints with |q̇_j| ≤ velocity_tolerance form the stuck set Θ₀ (k joints).
+/// The DOFs below the root with |q̇_j| ≤ velocity_tolerance form the stuck set
+/// Θ₀ (k of them; a mimic joint is not in it: its leader carries its friction).
 /// Moving joints carry kinetic friction −f_c,j sign(q̇_j) − b_j q̇_j as a
 /// feed-forward torque. A stuck joint j feels the reaction −μ_j, with
 ///   μ* = argmax_{μ ∈ Λ} g(μ),  g(μ) = min_q̈ Z(q̈) + μᵀ W q̈,  Λ = Π_j [−f_j, f_j]
@@ -39,7 +40,7 @@ struct FrictionOptions {
   /// Active set (exact, the default) or projected gradient.
   FrictionMethod method = FrictionMethod::ActiveSet;
   int max_iterations = 500;      ///< of the maximiser
-  double kkt_tolerance = 1e-12;  ///< relative to the largest |q̈(0)| on Θ₀
+  double kkt_tolerance = 1e-12;  ///< relative to 1 + the largest |q̈(0)| on Θ₀
   ///@{
   /// Per-solve overrides of the model's values (empty: use the model's).
   Eigen::VectorXd breakaway, kinetic, viscous;

@@ -47,8 +47,9 @@ class ModelError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// How the base (body 0: the root link and the links welded to it) is attached
-/// to the world (docs/conventions.md, "Floating base").
+/// How the base (the root link and the links welded to it: body 0 on a fixed
+/// base, baseBody() on a floating one) is attached to the world
+/// (docs/conventions.md, "Floating base").
 ///   Fixed  : bolted down (no base coordinates);
 ///   Free   : a free-flyer, unactuated: q_base = [x, y, z, q_w, q_x, q_y, q_z]
 ///            (the base origin in the world, the unit quaternion of the base's
@@ -395,9 +396,10 @@ class ModelBuilder {
   /// joint, a joint that mimics itself, or a multiplier or offset that is not finite.
   ModelBuilder& setMimic(const std::string& joint, const std::string& leader, double multiplier, double offset);
 
-  /// Add the base link's own inertia (given in its frame) to body 0. It enters
-  /// the dynamics only when the base floats (setBase); the links welded to the
-  /// base add theirs through addFixedFrame.
+  /// Add the base link's own inertia (given in its frame) to the root link's
+  /// body (body 0 on a fixed base, Model::baseBody() on a floating one). It
+  /// enters the dynamics only when the base floats (setBase); the links welded
+  /// to the base add theirs through addFixedFrame.
   ModelBuilder& addBaseLinkInertia(const RigidInertia& inertia);
   /// Let the base float: a free-flyer or a planar joint between the world and
   /// the root link (unactuated: the root joint, Model::allJoints()). `placement` is the plane's frame for a Planar base

@@ -43,11 +43,11 @@ enum class MimicJoints {
 /// loaded, or welded to one that is, is a named frame (also the links welded
 /// above the root).
 ///
-/// The base (docs/conventions.md, "Floating base"; body 0 is the root link and
-/// the links welded to it):
+/// The base (docs/conventions.md, "Floating base"; the root link and the links
+/// welded to it, Model::baseBody()):
 /// * A URDF whose root link's only joint is `floating` or `planar` (the
 ///   "world → base_link" pattern) loads with a Free or Planar base under that
-///   joint's child link, which becomes body 0 (when the model starts at the
+///   joint's child link, which becomes the base (when the model starts at the
 ///   URDF's root link, the default, or at that child link). The links above
 ///   the joint are the world: not frames, their mass ignored. Free: the base
 ///   pose is the configuration, the base link's pose in the root link's (the
@@ -57,9 +57,9 @@ enum class MimicJoints {
 ///   frame (`<origin>`), turned as for a planar joint below the root (next
 ///   item) so that its z is the `<axis>`, is the plane
 ///   (Model::basePlacement()); the base link keeps the URDF's orientation
-///   (its frame is placed on body 0 by the inverse rotation).
-/// * A `floating` or `planar` joint anywhere else is a joint of the model
-///   (issue #25): JointType::Free (q = [x, y, z, q_w, q_x, q_y, q_z] of the
+///   (its frame is placed on the base's body by the inverse rotation).
+/// * A `floating` or `planar` joint anywhere else is a joint of the model:
+///   JointType::Free (q = [x, y, z, q_w, q_x, q_y, q_z] of the
 ///   child link in the joint frame, the URDF `<origin>`) or JointType::Planar
 ///   (q = [x, y, ψ]). URDF moves a planar joint's child in the plane normal to
 ///   its `<axis>`: zwang turns the joint frame by the shortest rotation that
@@ -74,11 +74,11 @@ enum class MimicJoints {
 ///   origin; a locked position for it is a ModelError.
 /// * Otherwise `base` may give the root link a free-flyer or a planar joint
 ///   (the world's x-y plane) for the many legged-robot URDFs that leave it out.
-/// * The root link's own `<inertial>` is body 0's (with the links welded to
-///   it): in the dynamics when the base floats, only counted
-///   (Model::inertia(0), the "base mass") on a fixed base.
+/// * The root link's own `<inertial>` is the base's (with the links welded to
+///   it): in the dynamics when the base floats (Model::inertia(baseBody())),
+///   only counted (Model::inertia(0), the "base mass") on a fixed base.
 struct UrdfOptions {
-  /// The model starts at this link (its base, body 0). Empty: the URDF's root link.
+  /// The model starts at this link (its base). Empty: the URDF's root link.
   std::string root;
   /// The tip link of a chain from root to tip; empty: the whole tree below root (see above).
   std::string tip;

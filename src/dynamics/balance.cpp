@@ -167,10 +167,10 @@ double rampPosition(double sigma, const BalanceOptions& options) {
   return std::clamp(t, 0.0, 1.0);
 }
 
-// Z's first k columns made orthonormal in place (Gram–Schmidt, twice: "twice
-// is enough" for columns as independent as E v_k, E regular, v_k orthonormal).
-void orthonormaliseColumns(Eigen::Ref<Eigen::MatrixXd> Z, Eigen::Index k) {
-  for (Eigen::Index c = 0; c < k; ++c) {
+// Z's first `count` columns made orthonormal in place (Gram–Schmidt, twice:
+// "twice is enough" for columns as independent as E v_k, E regular, v_k orthonormal).
+void orthonormaliseColumns(Eigen::Ref<Eigen::MatrixXd> Z, Eigen::Index count) {
+  for (Eigen::Index c = 0; c < count; ++c) {
     for (int pass = 0; pass < 2; ++pass)
       for (Eigen::Index p = 0; p < c; ++p) Z.col(c) -= Z.col(p) * Z.col(p).dot(Z.col(c));
     Z.col(c) /= Z.col(c).norm();

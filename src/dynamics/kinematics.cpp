@@ -166,12 +166,12 @@ Status checkHeldState(const char* query, const char* name, const Eigen::VectorXd
   if (given.size() != held.size())
     return Status::error(StatusCode::SizeMismatch, "%s: %s has %ld entries, expected %ld", query, name,
                          static_cast<long>(given.size()), static_cast<long>(held.size()));
-  const Eigen::Index k = firstDifference(held, given);
-  if (k < 0) return {};
+  const Eigen::Index entry = firstDifference(held, given);
+  if (entry < 0) return {};
   return Status::error(StatusCode::NotComputed,
                        "%s: the workspace holds kinematics at another %s (%s[%ld] = %.15g held, %.15g given); call %s "
                        "first",
-                       query, name, name, static_cast<long>(k), held[k], given[k], call);
+                       query, name, name, static_cast<long>(entry), held[entry], given[entry], call);
 }
 
 // Both, and that the workspace holds the `needed` results for this model and

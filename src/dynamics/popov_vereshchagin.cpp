@@ -263,19 +263,19 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
   const Vec6& IAS = sw.IAS[at(i)];
   const Vec6& c = sw.c[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
-  const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).columnsEnd(i);
+  const int first = solverOrder(task).firstColumn(i), columns_end = solverOrder(task).columnsEnd(i);
   double* sA = sw.SA.col(i).data();
   const double SS_D = S.squaredNorm() * inverse_D;
-  for (int col = first; col < k; ++col) {
+  for (int col = first; col < columns_end; ++col) {
     sA[col] = S.dot(A.col(col));                         // (Sᵀ A_i)ᵀ
     sw.L_scale[col] += SS_D * A.col(col).squaredNorm();  // what rounding of sA² / D is relative to
   }
-  for (int col = first; col < k; ++col) {
+  for (int col = first; col < columns_end; ++col) {
     const double sA_D = sA[col] * inverse_D;
     sw.U[col] += kBias ? A.col(col).dot(c) + sA[col] * u_D : sA[col] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
     double* L_col = &sw.L(0, col);                                           // line 21 (sign: see top), lower triangle
     if (kBalance)
-      for (int r = col; r < k; ++r) L_col[r] += sA[r] * sA_D;
+      for (int r = col; r < columns_end; ++r) L_col[r] += sA[r] * sA_D;
     A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
   }
 }
@@ -493,10 +493,10 @@ void balance(const Task& task, Workspace& ws) {
     sw.rhs.head(m) = sw.b_body.head(m) - sw.U.head(m);                                                // line 25 …
     sw.rhs.head(m).noalias() -= sw.Ahat.leftCols(m).transpose() * gravityAcceleration(task.gravity);  // … − A₀ᵀẌ₀
   }
-  Eigen::VectorXd& nu = condensed ? sw.nu_rows : sw.nu;
+  Eigen::VectorXd& nu = condensed ? sw.nu_rows : sw.nu_columns;
   BalanceReport& report = ws.solution.balance;
   report = solveBalance(L.topLeftCorner(m, m), sw.rhs.head(m), nu.head(m), sw.balance_factorisation, task.balance);
-  if (condensed) expandToColumns(task, sw.nu_rows.head(m), sw.nu);
+  if (condensed) expandToColumns(task, sw.nu_rows.head(m), sw.nu_columns);
   // The report counts the task's rows. The mimic rows are independent of each
   // other whatever the task (each alone moves its own mimic joint; a leader is
   // never a mimic joint), so every direction the balance lost lies in the
@@ -516,10 +516,11 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   for (int i = 1; i <= model.nv(); ++i) {
     const int p = model.parent(i);
     const Vec6 a_parent = p == i - 1 ? a_previous : sw.a[at(p)];
-    const int first = solverOrder(task).firstColumn(i), k = solverOrder(task).columnsEnd(i) - first;
-    const double constraint = sw.SA.col(i).segment(first, k).dot(sw.nu.segment(first, k));        // Sᵀ A_i ν
-    qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];  // line 28
-    a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];                 // line 29
+    const int first = solverOrder(task).firstColumn(i), column_count = solverOrder(task).columnsEnd(i) - first;
+    const double constraint =
+        sw.SA.col(i).segment(first, column_count).dot(sw.nu_columns.segment(first, column_count));  // Sᵀ A_i ν
+    qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];    // line 28
+    a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];                   // line 29
   }
 }
 
@@ -582,8 +583,8 @@ void outwardLanes(const Model& model, const Task& task, const WorkspaceScratch& 
     Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
     const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
     for (Eigen::Index c = from; c < to; ++c) dq[c - c0] = s.du(i, c);
-    const int first = solverOrder(task).firstColumn(i), ki = solverOrder(task).columnsEnd(i);
-    for (int r = first; r < ki; ++r) dq += sw.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
+    const int first = solverOrder(task).firstColumn(i), columns_end = solverOrder(task).columnsEnd(i);
+    for (int r = first; r < columns_end; ++r) dq += sw.SA(r, i) * Eigen::Map<const Lanes>(s.dnu_lanes.col(r).data());
     const double* parent = da + model.parent(i) * da_stride;
     const Vec6& IAS = sw.IAS[at(i)];
     for (int e = 0; e < 6; ++e) dq -= IAS[e] * Eigen::Map<const Lanes>(parent + e * W);
@@ -600,24 +601,26 @@ namespace {
 // Each body's run of unit-torque columns [run_begin, run_end): those whose
 // DOF's body lies in its subtree, a contiguous run since the DOFs ascend.
 void columnRuns(const Model& model, const std::vector<int>& dofs, UnitTorqueScratch& s) {
-  const auto k = static_cast<Eigen::Index>(dofs.size());
-  Eigen::Index c_begin = k;  // the first column with its DOF's body ≥ i: falls with i
+  const auto unit_torque_count = static_cast<Eigen::Index>(dofs.size());
+  Eigen::Index c_begin = unit_torque_count;  // the first column with its DOF's body ≥ i: falls with i
   for (int i = model.nv(); i >= 1; --i) {
     while (c_begin > 0 && bodyOfDof(dofs[at(static_cast<int>(c_begin) - 1)]) >= i) --c_begin;
-    const int end = model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: k)
+    const int end =
+        model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: past the last column)
     s.run_begin[i] = c_begin;
-    s.run_end[i] =
-        k == 0 || end > bodyOfDof(dofs.back()) ? k : std::lower_bound(dofs.begin(), dofs.end(), end, [](int d, int b) {
-                                                       return bodyOfDof(d) < b;
-                                                     }) - dofs.begin();
+    s.run_end[i] = unit_torque_count == 0 || end > bodyOfDof(dofs.back())
+                       ? unit_torque_count
+                       : std::lower_bound(dofs.begin(), dofs.end(), end, [](int d, int b) {
+                           return bodyOfDof(d) < b;
+                         }) - dofs.begin();
   }
 }
 
 // Line 20 at body i for one column: δU₀ += SᵀA_i δu_i / D_i on the rows
-// [first, end) of i's subtree (dU_c: the column's δU₀).
-ZWANG_ALWAYS_INLINE void constraintColumnsDelta(const WorkspaceScratch& sw, int i, int first, int end, double du_D,
-                                                double* dU_c) {
-  for (int r = first; r < end; ++r) dU_c[r] += sw.SA(r, i) * du_D;
+// [first, columns_end) of i's subtree (dU_c: the column's δU₀).
+ZWANG_ALWAYS_INLINE void constraintColumnsDelta(const WorkspaceScratch& sw, int i, int first, int columns_end,
+                                                double du_D, double* dU_c) {
+  for (int r = first; r < columns_end; ++r) dU_c[r] += sw.SA(r, i) * du_D;
 }
 
 // Lines 13–20 of a one-DOF joint (body i) on its run of columns: δu_i = [i is
@@ -628,7 +631,7 @@ void oneDofColumns(const Model& model, const Task& task, const WorkspaceScratch&
   const Vec6& IAS = sw.IAS[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
   const bool to_world = model.parent(i) == 0;  // the world takes δF^a and does nothing with it
-  const int first = solverOrder(task).firstColumn(i), end = solverOrder(task).columnsEnd(i);
+  const int first = solverOrder(task).firstColumn(i), columns_end = solverOrder(task).columnsEnd(i);
   const Eigen::Index begin = s.run_begin[i], run_end = s.run_end[i];
   const Eigen::Index own = begin < run_end && bodyOfDof(dofs[at(static_cast<int>(begin))]) == i ? begin : -1;
   double* const du = s.du.data() + i;  // row i
@@ -638,7 +641,7 @@ void oneDofColumns(const Model& model, const Task& task, const WorkspaceScratch&
     const double du_ic = (c == own ? 1.0 : 0.0) - S.dot(dF);
     du[c * du_stride] = du_ic;
     const double du_D = du_ic * inverse_D;
-    constraintColumnsDelta(sw, i, first, end, du_D, s.dU.data() + c * dU_stride);
+    constraintColumnsDelta(sw, i, first, columns_end, du_D, s.dU.data() + c * dU_stride);
     if (!to_world) dF += IAS * du_D;  // lines 17–18
   }
 }
@@ -722,10 +725,10 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   // the inward sweep at body i works on i's run of columns (columnRuns).
   // dF.col(c) carries δF^a from the path's last body to the next.
   const int m = task.solverColumns();
-  const auto k = static_cast<Eigen::Index>(dofs.size());
-  auto dU = s.dU.topLeftCorner(m, k);
+  const auto unit_torque_count = static_cast<Eigen::Index>(dofs.size());
+  auto dU = s.dU.topLeftCorner(m, unit_torque_count);
   dU.setZero();
-  s.dF.leftCols(k).setZero();  // du is written where it is read: on each body's run of columns
+  s.dF.leftCols(unit_torque_count).setZero();  // du is written where it is read: on each body's run of columns
   columnRuns(model, dofs, s);
   for (int i = model.nv(); i >= 1;) {  // joint by joint from the leaves; body i is a joint's last DOF body
     const int first = model.jointStart(i);
@@ -741,10 +744,10 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   dU *= -1.0;                               // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (solverOrder(task).balanceOnRows()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();
-    auto dU_rows = sw.dU_rows.topLeftCorner(rows, k);
+    auto dU_rows = sw.dU_rows.topLeftCorner(rows, unit_torque_count);
     dU_rows.setZero();
     for (int col = 0; col < m; ++col) dU_rows.row(solverOrder(task).balanceRowOfColumn()[at(col)]) += dU.row(col);
-    auto dnu_rows = sw.dnu_rows.topLeftCorner(rows, k);
+    auto dnu_rows = sw.dnu_rows.topLeftCorner(rows, unit_torque_count);
     balanceApplyColumns(sw.balance_factorisation, dU_rows, dnu_rows, sw.balance_factorisation.work.head(rows));
     expandToColumns(task, dnu_rows, dnu.topRows(m));
   } else if (!solve_in_lanes) {
@@ -753,8 +756,8 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   // Lines 28–29 for the differences: the widest blocks of columns first, so
   // that few lanes idle (29 stuck joints: 8 + 8 + 8 + 4 + 1).
   constexpr int kLanes = UnitTorqueScratch::kLanes;
-  for (Eigen::Index c0 = 0; c0 < k;) {
-    const Eigen::Index left = k - c0;
+  for (Eigen::Index c0 = 0; c0 < unit_torque_count;) {
+    const Eigen::Index left = unit_torque_count - c0;
     if (left >= kLanes) {
       outwardLanes<kLanes>(model, task, sw, c0, solve_in_lanes, s, dnu, dqdd);
       c0 += kLanes;
@@ -802,8 +805,7 @@ void taskResidual(const Task& task, Workspace& ws) {
   // of it. A row can pick components that are ≈ 0 on both sides — a joint row
   // whose axis sees no angular acceleration while the gravity shift puts
   // 9.81 m/s² in the linear part — and its 1e-12 of rounding must not read as
-  // a missed row (Solo 12 on four contacts with all joints held: errors 4e-12,
-  // picked components 1e-12).
+  // a missed row (Solo 12 on four contacts with all joints held).
   const int m = task.balanceRows();
   BalanceReport& report = ws.solution.balance;
   if (!solverOrder(task).balanceOnRows()) {  // one column per row
@@ -871,21 +873,22 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
   if (model.isChain()) {  // one running sum from the tip inward
     Vec6 carried = Vec6::Zero();
     for (int i = N; i >= 1; --i) {
-      const int k_beyond = solverOrder(task).columnsEnd(i + 1), k = solverOrder(task).columnsEnd(i);
-      if (k > k_beyond)  // most bodies carry none: no product of zero width
-        carried.noalias() += sw.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+      const int own_first = solverOrder(task).columnsEnd(i + 1), own_end = solverOrder(task).columnsEnd(i);
+      if (own_end > own_first)  // most bodies carry none: no product of zero width
+        carried.noalias() +=
+            sw.A_body.middleCols(own_first, own_end - own_first) * nu_solver.segment(own_first, own_end - own_first);
       tau_c[i - 1] = sw.S[at(i)].dot(carried);
     }
     return;
   }
   std::vector<Vec6>& carried = sw.constraint_wrench;
   for (int i = 1; i <= N; ++i) {  // body i's own columns: those on bodies ≥ i but not ≥ i + 1
-    const int k_beyond = solverOrder(task).columnsEnd(i + 1), k = solverOrder(task).columnsEnd(i);
-    if (k == k_beyond)  // most bodies carry none: no product of zero width
+    const int own_first = solverOrder(task).columnsEnd(i + 1), own_end = solverOrder(task).columnsEnd(i);
+    if (own_end == own_first)  // most bodies carry none: no product of zero width
       carried[at(i)].setZero();
     else
       carried[at(i)].noalias() =
-          sw.A_body.middleCols(k_beyond, k - k_beyond) * nu_solver.segment(k_beyond, k - k_beyond);
+          sw.A_body.middleCols(own_first, own_end - own_first) * nu_solver.segment(own_first, own_end - own_first);
   }
   for (int i = N; i >= 1; --i) {
     tau_c[i - 1] = sw.S[at(i)].dot(carried[at(i)]);
@@ -928,7 +931,7 @@ void publishNu(const Task& task, Workspace& ws) {
   // Mimic rows (after the user's) are the mechanism's, not the task's.
   for (int col = 0; col < task.solverColumns(); ++col) {
     const int row = solverOrder(task).solverRowToUserRow()[at(col)];
-    if (row < m) ws.solution.nu[row] = sw.nu[col];
+    if (row < m) ws.solution.nu[row] = sw.nu_columns[col];
   }
 }
 

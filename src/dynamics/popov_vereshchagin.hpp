@@ -37,12 +37,12 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 // Fails (Degenerate) when a joint has no inertia to move.
 Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws);
 
-// Line 25: ν = 𝓛⁺(b − A₀ᵀẌ₀ − U₀) into sw.nu (solver order), factoring 𝓛
+// Line 25: ν = 𝓛⁺(b − A₀ᵀẌ₀ − U₀) into sw.nu_columns (solver order), factoring 𝓛
 // (kept in sw.balance_factorisation for unitTorqueColumns) and filling
 // ws.solution.balance (all but the residual: see taskResidual).
 void balance(const Task& task, Workspace& ws);
 
-// Lines 26–30: q̈ (into `qdd`) and Ẍ (into sw.a) from sw.nu.
+// Lines 26–30: q̈ (into `qdd`) and Ẍ (into sw.a) from sw.nu_columns.
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd);
 
 // Line 29 alone: Ẍ (into sw.a) from a known q̈.
@@ -72,7 +72,7 @@ struct UnitTorqueScratch {
   Matrix6X joint_rows;        // 6 × capacity: a multi-DOF joint's δU₀ per unit δF^A, transposed
   Eigen::MatrixXd da;         // column i: body i's δẌ for up to kLanes columns (kLanes × 6, column-major)
   Eigen::MatrixXd dnu_lanes;  // kLanes × capacity: δν of those columns, one row per column
-  // Body i's run of columns [run_begin[i], run_end[i]): those whose joint's
+  // Body i's run of columns [run_begin[i], run_end[i]): those whose DOF's
   // body lies in i's subtree, the only ones with δu_i ≠ 0 (du is set there only).
   Eigen::Matrix<Eigen::Index, Eigen::Dynamic, 1> run_begin, run_end;
 };
@@ -110,7 +110,7 @@ void controlTorques(const Model& model, const VectorRef& tau, Solution& out);
 double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,
                      const Workspace& ws);
 
-// sw.nu (solver order) into the solution's ν (the task's row order).
+// sw.nu_columns (solver order) into the solution's ν (the task's row order).
 void publishNu(const Task& task, Workspace& ws);
 
 }  // namespace zwang::internal

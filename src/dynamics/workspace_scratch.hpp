@@ -65,7 +65,7 @@ struct WorkspaceScratch {
   // --- balance (line 25), src/dynamics/balance.cpp
   internal::BalanceFactorisation balance_factorisation;  // the last balance's factorisation
   Eigen::VectorXd rhs;                                   // b − A_0ᵀẌ_0 − U_0, per balance row
-  Eigen::VectorXd nu;                                    // ν per solver column (what the sweeps read)
+  Eigen::VectorXd nu_columns;                            // ν per solver column (what the sweeps read)
   Eigen::VectorXd nu_motors;                             // ν per solver column with the contacts' set to 0 (τ_c)
   // With relative constraints the balance works on rows, each the sum of its
   // solver columns: 𝓛, its rounding scale, ν and the unit-torque columns per row.
@@ -78,7 +78,7 @@ struct WorkspaceScratch {
   Eigen::VectorXd row_size;      // the size of the terms of each row's error (taskResidual)
 
   // --- final outward sweep (lines 26–30) and the constraint-torque pass
-  std::vector<Vec6> a;          // Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0] = [−g; 0] on a fixed base)
+  std::vector<Vec6> a;          // Ẍ_i of the sweep: true acceleration + [−g; 0] (a[0], the world's: [−g; 0])
   Vec6 a_world = Vec6::Zero();  // the world's acceleration in the sweep, [−g; 0]: what a is shifted by
   std::vector<Vec6> f;          // accumulated forces (RNEA)
   // The constraint wrenches A ν on each body and its subtree (constraint torques)

@@ -117,10 +117,10 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
                                 const Eigen::Ref<const Eigen::VectorXd>& tau, const FrictionOptions& options,
                                 FrictionScratch& fs, FrictionResult& fr) {
   const int n = model.dof();
-  const int iv = dofOfEntry(model, 0);  // entry j is DOF iv + j
+  const int base_velocity_size = model.baseVelocitySize();  // entry j is DOF base_velocity_size + j
   const std::vector<Dof>& dofs = model.dofs();
   for (int j = 0; j < n; ++j) {
-    const Dof& dof = dofs[static_cast<std::size_t>(iv + j)];
+    const Dof& dof = dofs[static_cast<std::size_t>(base_velocity_size + j)];
     fs.breakaway[j] = options.breakaway.size() ? options.breakaway[j] : dof.breakaway_friction;
     fs.kinetic[j] = options.kinetic.size() ? options.kinetic[j] : dof.kinetic_friction;
     fs.viscous[j] = options.viscous.size() ? options.viscous[j] : dof.viscous_friction;
@@ -150,7 +150,7 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
       fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
       continue;
     }
-    const int v = iv + j;
+    const int v = base_velocity_size + j;
     const Dof& dof = dofs[static_cast<std::size_t>(v)];
     // Limits belong to one-DOF joints (a multi-DOF joint's are ±∞: never at one).
     const bool limited = options.joint_limits && (std::isfinite(dof.lower) || std::isfinite(dof.upper));
@@ -182,16 +182,17 @@ Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen
                                Workspace& ws, FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.solverColumns();
-  const auto k = static_cast<Eigen::Index>(stuck.size());
+  const auto stuck_count = static_cast<Eigen::Index>(stuck.size());
   outwardSweep(model, task, q, qd, ws);
   if (Status s = inwardSweep(model, task, fs.tau_effective, ws); !s) return s;
   balance(task, ws);
   outwardAccelerations(model, task, ws, fs.qdd0);
-  fs.nu0.head(m) = sw.nu.head(m);
+  fs.nu0.head(m) = sw.nu_columns.head(m);
   fs.stuck_dofs.clear();  // reserved for every DOF: no allocation
   for (const int j : stuck) fs.stuck_dofs.push_back(dofOfEntry(model, j));
-  if (k > 0)
-    unitTorqueColumns(model, task, ws, fs.stuck_dofs, fs.unit_torques, fs.dnu.topLeftCorner(m, k), fs.dqdd.leftCols(k));
+  if (stuck_count > 0)
+    unitTorqueColumns(model, task, ws, fs.stuck_dofs, fs.unit_torques, fs.dnu.topLeftCorner(m, stuck_count),
+                      fs.dqdd.leftCols(stuck_count));
   return {};
 }
 
@@ -212,7 +213,7 @@ Vec6 parentAccelerationTerms(const Model& model, const Workspace& ws, const Fric
   Vec6 terms = Vec6::Zero(), joint_motion = Vec6::Zero();
   for (int l = model.parent(body); l > 0; l = model.parent(l)) {
     joint_motion += sw.S[static_cast<std::size_t>(l)] * fs.dqdd(l - 1, a);
-    if (model.jointStart(l) != l) continue;  // the compact array, not the 120-byte Dof
+    if (model.jointStart(l) != l) continue;  // the compact array: cheaper to read than a Dof
     terms += joint_motion.cwiseAbs();
     joint_motion.setZero();
   }
@@ -233,7 +234,7 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
                              SA.dot(fs.dnu.col(a).segment(first, count).cwiseAbs())) *
                             sw.inverse_D[at_i];
     fs.slope_terms[a] = (std::abs(sw.u[at_i]) + IAS.dot(sw.a[static_cast<std::size_t>(model.parent(i))].cwiseAbs()) +
-                         SA.dot(sw.nu.segment(first, count).cwiseAbs())) *
+                         SA.dot(sw.nu_columns.segment(first, count).cwiseAbs())) *
                         sw.inverse_D[at_i];
   }
 }
@@ -243,21 +244,22 @@ void termSizes(const Model& model, const Task& task, const Workspace& ws, const 
 QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws, const std::vector<int>& stuck,
                       const FrictionOptions& options, double acc_scale, FrictionScratch& fs) {
   const WorkspaceScratch& sw = scratchOf(ws);
-  const auto k = static_cast<Eigen::Index>(stuck.size());
-  const int iv = dofOfEntry(model, 0);  // the friction entries' rows of q̈
-  auto K = fs.K.topLeftCorner(k, k);
-  for (Eigen::Index a = 0; a < k; ++a) fs.qdd0_stuck[a] = fs.qdd0[iv + stuck[static_cast<std::size_t>(a)]];
-  {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers: k² of them, a pair per store)
+  const auto stuck_count = static_cast<Eigen::Index>(stuck.size());
+  const int base_velocity_size = model.baseVelocitySize();  // the friction entries' rows of q̈ follow
+  auto K = fs.K.topLeftCorner(stuck_count, stuck_count);
+  for (Eigen::Index a = 0; a < stuck_count; ++a)
+    fs.qdd0_stuck[a] = fs.qdd0[base_velocity_size + stuck[static_cast<std::size_t>(a)]];
+  {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers, a pair per store)
     const int* rows = stuck.data();
-    const double* dqdd = fs.dqdd.data() + iv;
+    const double* dqdd = fs.dqdd.data() + base_velocity_size;
     const Eigen::Index dqdd_stride = fs.dqdd.outerStride();
     double* p = K.data();
     const Eigen::Index p_stride = K.outerStride();
-    for (Eigen::Index b = 0; b < k; ++b) {  // symmetric in exact arithmetic (K is): the mean of both halves
+    for (Eigen::Index b = 0; b < stuck_count; ++b) {  // symmetric in exact arithmetic (K is): the mean of both halves
       const double* dqdd_b = dqdd + b * dqdd_stride;
       const int row_b = rows[b];
       p[b + b * p_stride] = dqdd_b[row_b];
-      for (Eigen::Index a = b + 1; a < k; ++a)
+      for (Eigen::Index a = b + 1; a < stuck_count; ++a)
         p[a + b * p_stride] = p[b + a * p_stride] = 0.5 * (dqdd_b[rows[a]] + dqdd[row_b + a * dqdd_stride]);
     }
   }
@@ -266,35 +268,34 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
   // rounding, and a stop the task pushes into must come out unbounded
   // rather than as a 1e16 N·m torque (the maximiser's reach rule).
   double curvature_scale = 0.0;
-  if (k > 0) {
+  if (stuck_count > 0) {
     double min_D = kInf;
-    for (Eigen::Index a = 0; a < k; ++a)
+    for (Eigen::Index a = 0; a < stuck_count; ++a)
       min_D = std::min(min_D, dofInertia(ws, dofOfEntry(model, stuck[static_cast<std::size_t>(a)])));
-    curvature_scale = std::max(1.0 / min_D, fs.dqdd.leftCols(k).cwiseAbs().maxCoeff());
+    curvature_scale = std::max(1.0 / min_D, fs.dqdd.leftCols(stuck_count).cwiseAbs().maxCoeff());
     // The task's part of ∂q̈/∂μ, Sᵀ A δν / D, is a sum of terms of size
     // |SᵀA|·|δν|/D, which an ill-conditioned balance makes large while their
     // sum, where the task pins a stuck joint, is rounding of them (a stop the
-    // task pushes into through relative rows: K_jj ~ 1e-12 of the scale
-    // without this term, 1e-14 with it, found by test_mimic).
+    // task pushes into through relative rows: test_mimic).
     const int m = task.solverColumns();
     if (m > 0)
       curvature_scale = std::max(
-          curvature_scale, fs.dnu.topLeftCorner(m, k).cwiseAbs().maxCoeff() *
+          curvature_scale, fs.dnu.topLeftCorner(m, stuck_count).cwiseAbs().maxCoeff() *
                                sw.SA.block(0, bodyOfDof(dofOfEntry(model, 0)), m, model.dof()).cwiseAbs().maxCoeff() /
                                min_D);  // over the DOFs friction acts on
   }
   termSizes(model, task, ws, stuck, fs);
   const double tolerance = options.kkt_tolerance * acc_scale;
-  auto mu = fs.mu.head(k);
+  auto mu = fs.mu.head(stuck_count);
   mu.setZero();  // feasible: 0 ∈ Λ
-  if (k == 0) return {};
-  const TermSizes terms{curvature_scale, Eigen::Map<const Eigen::VectorXd>(fs.curvature_terms.data(), k),
-                        Eigen::Map<const Eigen::VectorXd>(fs.slope_terms.data(), k)};
+  if (stuck_count == 0) return {};
+  const TermSizes terms{curvature_scale, Eigen::Map<const Eigen::VectorXd>(fs.curvature_terms.data(), stuck_count),
+                        Eigen::Map<const Eigen::VectorXd>(fs.slope_terms.data(), stuck_count)};
   return options.method == FrictionMethod::ActiveSet
-             ? boxQpActiveSet(K, fs.qdd0_stuck.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp, options.max_iterations,
-                              tolerance, terms)
-             : boxQpProjectedGradient(K, fs.qdd0_stuck.head(k), fs.lo.head(k), fs.hi.head(k), mu, fs.qp,
-                                      options.max_iterations, tolerance, terms);
+             ? boxQpActiveSet(K, fs.qdd0_stuck.head(stuck_count), fs.lo.head(stuck_count), fs.hi.head(stuck_count), mu,
+                              fs.qp, options.max_iterations, tolerance, terms)
+             : boxQpProjectedGradient(K, fs.qdd0_stuck.head(stuck_count), fs.lo.head(stuck_count),
+                                      fs.hi.head(stuck_count), mu, fs.qp, options.max_iterations, tolerance, terms);
 }
 
 // ---- When μ* is not unique: what each stuck joint's motor would carry at the
@@ -303,13 +304,13 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
                             const std::vector<int>& stuck, const FrictionOptions& options, Workspace& ws,
                             FrictionScratch& fs) {
   const int m = task.solverColumns();
-  const auto k = static_cast<Eigen::Index>(stuck.size());
+  const auto stuck_count = static_cast<Eigen::Index>(stuck.size());
   fs.nu_first.head(m) = fs.nu0.head(m);  // ν(μ*) by superposition
-  fs.nu_first.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * fs.mu.head(k);
+  fs.nu_first.head(m).noalias() -= fs.dnu.topLeftCorner(m, stuck_count) * fs.mu.head(stuck_count);
   constraintTorques(model, task, ws, fs.nu_first.head(m), fs.tau_constraint_first);
   fs.tau_control_first = tau + fs.tau_constraint_first;
   carryMimicTorques(model, fs.tau_control_first);
-  for (Eigen::Index a = 0; a < k; ++a) {
+  for (Eigen::Index a = 0; a < stuck_count; ++a) {
     const int j = stuck[static_cast<std::size_t>(a)];
     fs.effort_offset[a] = fs.tau_control_first[dofOfEntry(model, j)] - fs.mu[a];
     fs.margin_limit[a] = options.margin * fs.breakaway[j];
@@ -362,16 +363,17 @@ EffortChange effortAlongFlatDirections(const Model& model, const Task& task, con
 // q̈(μ*) = q̈(0) + (∂q̈/∂τ_Θ)(−μ*) and ν(μ*) likewise (lines 26–30 by
 // superposition), then Ẍ from q̈ (line 29). With nothing stuck, μ* is
 // empty and the μ = 0 sweep already gave it.
-void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index k, Workspace& ws, FrictionScratch& fs) {
+void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index stuck_count, Workspace& ws,
+                       FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.solverColumns();
   Solution& out = ws.solution;
   out.qdd = fs.qdd0;
-  if (k == 0) return;
-  const auto mu = fs.mu.head(k);
-  out.qdd.noalias() -= fs.dqdd.leftCols(k) * mu;
-  sw.nu.head(m) = fs.nu0.head(m);
-  sw.nu.head(m).noalias() -= fs.dnu.topLeftCorner(m, k) * mu;
+  if (stuck_count == 0) return;
+  const auto mu = fs.mu.head(stuck_count);
+  out.qdd.noalias() -= fs.dqdd.leftCols(stuck_count) * mu;
+  sw.nu_columns.head(m) = fs.nu0.head(m);
+  sw.nu_columns.head(m).noalias() -= fs.dnu.topLeftCorner(m, stuck_count) * mu;
   bodyAccelerations(model, task, ws, out.qdd);
 }
 
@@ -379,7 +381,7 @@ void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index k, Wor
 // joints feel; returns Σ μ*_j q̈*_j (the dual's term beyond Z).
 double frictionStates(const Model& model, const Eigen::VectorXd& qdd_all, double acc_tolerance, FrictionScratch& fs,
                       FrictionResult& fr) {
-  const int iv = dofOfEntry(model, 0);
+  const int base_velocity_size = model.baseVelocitySize();
   const auto qdd = qdd_all.tail(model.dof());
   fr.mu.setZero();
   fs.tau_joint = fs.tau_effective;  // the torques the joints feel: τ − kinetic − Wᵀμ
@@ -389,7 +391,7 @@ double frictionStates(const Model& model, const Eigen::VectorXd& qdd_all, double
     const double mu = fs.mu[static_cast<Eigen::Index>(a)], f = fs.breakaway[j];
     fr.mu[j] = mu;
     fr.tau_friction[j] = -mu;
-    fs.tau_joint[iv + j] -= mu;
+    fs.tau_joint[base_velocity_size + j] -= mu;
     mu_dot_qdd += mu * qdd[j];
     JointState& state = fr.state[static_cast<std::size_t>(j)];
     // Beyond what friction can give (to rounding of f): the stop pushes.
@@ -431,45 +433,47 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
 
   jointsOutsideLimits(model, q, out);  // a warning: solved as given
   stuckSetAndKineticFriction(model, q, qd, tau, options, fs, fr);
-  const auto k = static_cast<Eigen::Index>(fr.stuck.size());
+  const auto stuck_count = static_cast<Eigen::Index>(fr.stuck.size());
   if (Status s = sweepsWithSensitivities(model, task, q, qd, fr.stuck, ws, fs); !s) return s;
-  if (k < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
-  for (Eigen::Index a = 0; a < k; ++a)         // μ_j enters as the torque −μ_j
+  if (stuck_count < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
+  for (Eigen::Index a = 0; a < stuck_count; ++a)         // μ_j enters as the torque −μ_j
     fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);
-  const int iv = dofOfEntry(model, 0);
+  const int base_velocity_size = model.baseVelocitySize();
 
   // The acceleration scale, of the stuck joints only (a light, fast joint
   // elsewhere in the chain must not set it): their accelerations q̈_Θ(0).
   double acc_max = 0.0;
-  for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(fs.qdd0[iv + j]));
+  for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(fs.qdd0[base_velocity_size + j]));
   const double acc_scale = 1.0 + acc_max;
   const double acc_tolerance = 1e-9 * acc_scale;  // what counts as q̈_j = 0 (a sticking joint)
   const QpReport report = maximiseDual(model, task, ws, fr.stuck, options, acc_scale, fs);
   fr.iterations = report.iterations;
-  fr.converged = k == 0 || report.converged;
+  fr.converged = stuck_count == 0 || report.converged;
 
   fr.indeterminate = false;
   Eigen::Index sticking = 0;
   const Eigen::Index nullity =
-      k > 0 && !report.unbounded
-          ? flatDirections(fs.K.topLeftCorner(k, k), fs.qdd0_stuck.head(k), fs.mu.head(k), fs.lo.head(k), fs.hi.head(k),
-                           fs.curvature_terms.head(k), acc_tolerance, fs.choice, sticking)
+      stuck_count > 0 && !report.unbounded
+          ? flatDirections(fs.K.topLeftCorner(stuck_count, stuck_count), fs.qdd0_stuck.head(stuck_count),
+                           fs.mu.head(stuck_count), fs.lo.head(stuck_count), fs.hi.head(stuck_count),
+                           fs.curvature_terms.head(stuck_count), acc_tolerance, fs.choice, sticking)
           : 0;
   if (nullity > 0) {
     effortAtFirstMaximiser(model, task, tau, fr.stuck, options, ws, fs);
     const EffortChange change = effortAlongFlatDirections(model, task, fr.stuck, sticking, nullity, ws, fs);
     const double mu_scale = 1e-9 * (1.0 + fs.breakaway.cwiseAbs().maxCoeff());  // maximisers this close are one
     fr.indeterminate =
-        leastEffortMaximiser(fs.lo.head(k), fs.hi.head(k), fs.margin_limit.head(k), fs.effort_offset.head(k), sticking,
-                             nullity, change, model.dof(), mu_scale, options.max_iterations, fs.mu.head(k), fs.choice);
+        leastEffortMaximiser(fs.lo.head(stuck_count), fs.hi.head(stuck_count), fs.margin_limit.head(stuck_count),
+                             fs.effort_offset.head(stuck_count), sticking, nullity, change, model.dof(), mu_scale,
+                             options.max_iterations, fs.mu.head(stuck_count), fs.choice);
   }
 
-  motionAtMaximiser(model, task, k, ws, fs);
+  motionAtMaximiser(model, task, stuck_count, ws, fs);
   ws.kinematics.stage = KinematicsStage::Accelerations;  // those of q̈* (the sweep's were q̈(0)'s)
   out.base_acceleration_world = baseClassicalAcceleration(model, ws);
   taskResidual(task, ws);
   publishNu(task, ws);
-  constraintTorques(model, task, ws, sw.nu.head(m), out.tau_constraint);
+  constraintTorques(model, task, ws, sw.nu_columns.head(m), out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   const double mu_dot_qdd = frictionStates(model, out.qdd, acc_tolerance, fs, fr);
   for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader
@@ -478,9 +482,10 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   // g(μ*) = Z₀(q̈*) + μ*ᵀ W q̈* = Z with the joint torques τ − kinetic − Wᵀμ (eq. 5.7).
   fr.gauss_dual = gaussFunction(model, task, out.qdd, fs.tau_joint, ws);
   out.gauss = fr.gauss_dual - mu_dot_qdd;
-  fr.kkt_residual = k > 0 ? boxQpKktResidual(fs.K.topLeftCorner(k, k), fs.qdd0_stuck.head(k), fs.lo.head(k),
-                                             fs.hi.head(k), fs.mu.head(k))
-                          : 0.0;
+  fr.kkt_residual =
+      stuck_count > 0 ? boxQpKktResidual(fs.K.topLeftCorner(stuck_count, stuck_count), fs.qdd0_stuck.head(stuck_count),
+                                         fs.lo.head(stuck_count), fs.hi.head(stuck_count), fs.mu.head(stuck_count))
+                      : 0.0;
   if (report.unbounded) return limitInfeasible(model, report, fr.stuck, fs);
   return {};
 }

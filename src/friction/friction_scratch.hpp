@@ -10,7 +10,8 @@
 namespace zwang::internal {
 
 struct FrictionScratch {
-  // dof: joints; nv: velocity coordinates (a floating base's first); capacity: solver columns
+  // dof: Model::dof(), the friction entries; nv: velocity coordinates (a floating base's
+  // first); capacity: solver columns
   FrictionScratch(int dof, int nv, int bodies, int capacity)
       : breakaway(dof),
         kinetic(dof),
@@ -42,7 +43,7 @@ struct FrictionScratch {
 
   // The model of friction, per joint (the options' overrides, else the model's)
   Eigen::VectorXd breakaway, kinetic, viscous;  // f_j, f_c,j, b_j
-  Eigen::VectorXd tau_effective;                // τ − kinetic friction of the moving joints
+  Eigen::VectorXd tau_effective;                // τ − kinetic and viscous friction of the moving joints
   Eigen::VectorXd lo, hi;                       // Λ on Θ₀ (±∞ where a limit stop pushes)
   std::vector<char> is_mimic;                   // per entry: a mimic joint's (its leader carries its friction)
   std::vector<int> stuck_dofs;                  // Θ₀ as entries of v (the sweeps' DOFs)

@@ -89,10 +89,10 @@ bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::Matr
 // columns share each row's reciprocal pivot, and their substitutions run
 // side by side instead of one chain of divisions per column.
 void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::MatrixXd> X) {
-  const Eigen::Index m = C.rows(), k = X.cols();
+  const Eigen::Index m = C.rows(), columns = X.cols();
   for (Eigen::Index i = 0; i < m; ++i) {
     const double inverse = 1.0 / C(i, i);
-    for (Eigen::Index c = 0; c < k; ++c) {
+    for (Eigen::Index c = 0; c < columns; ++c) {
       double s = X(i, c);
       for (Eigen::Index l = 0; l < i; ++l) s -= C(i, l) * X(l, c);
       X(i, c) = s * inverse;
@@ -100,7 +100,7 @@ void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref
   }
   for (Eigen::Index i = m - 1; i >= 0; --i) {
     const double inverse = 1.0 / C(i, i);
-    for (Eigen::Index c = 0; c < k; ++c) {
+    for (Eigen::Index c = 0; c < columns; ++c) {
       double s = X(i, c);
       for (Eigen::Index l = i + 1; l < m; ++l) s -= C(l, i) * X(l, c);
       X(i, c) = s * inverse;

@@ -212,20 +212,16 @@ Eigen::Index nearNullSpace(Eigen::Ref<Eigen::MatrixXd> A, double floor, Eigen::R
   // The near null space is the orthogonal complement of the factored
   // columns L (n × r, pivoted order): for d ⟂ range(L), dᵀAd = d₂ᵀ S d₂ with
   // S the remaining Schur complement. A triangular solve with L₁₁ gives a
-  // basis of it, Gram–Schmidt an orthonormal one: O(r²·(n − r) + n·(n − r)²).
-  // A Householder QR of L costs O(n·r²): on the humanoid with every joint
-  // stuck (n = 29, r = 23) this function took 131,000 instructions per solve
-  // that way, 63,300 this way (callgrind, floating_fric_as_m12_kall/humanoid).
+  // basis of it, Gram–Schmidt an orthonormal one: O(r²·(n − r) + n·(n − r)²),
+  // cheaper than a Householder QR of L, O(n·r²), when most columns are
+  // factored (a humanoid with every joint stuck).
   const Eigen::Index nullity = n - r;
   if (nullity == 0) return 0;
   // Few factored columns and many null directions (a 7-joint arm holding a
   // 6-D pose: r = 1, nullity 6) favour the QR, whose reflectors cost
   // O(n·r²) and give orthonormal columns in O(n·r·nullity); the triangular
-  // solve then Gram–Schmidt costs O(r²·nullity + n·nullity²), which that
-  // case makes 6× dearer (Panda, all 7 joints stuck, 6 rows: nearNullSpace
-  // 1,800 instructions per solve by QR, 4,100 by Gram–Schmidt; callgrind,
-  // fric_as_ee6_kall/panda). Both span the same subspace; the leading terms
-  // decide.
+  // solve then Gram–Schmidt costs O(r²·nullity + n·nullity²), dearer in that
+  // case. Both span the same subspace; the leading terms decide.
   if (n * r * (r + nullity) <= nullity * (r * r + 2 * n * nullity)) {
     householderOfFactor(A, r);
     complementByReflectors(A, r, N);

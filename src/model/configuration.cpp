@@ -47,9 +47,9 @@ int quaternionOffset(JointType type) {
   }
 }
 
-// The name of coordinate k of a multi-DOF joint's q (or v); nullptr for a
-// one-DOF joint, whose name alone names its entry.
-const char* coordinateName(JointType type, int k, bool velocity) {
+// The name of coordinate `index` of a multi-DOF joint's q (or v); nullptr for
+// a one-DOF joint, whose name alone names its entry.
+const char* coordinateName(JointType type, int index, bool velocity) {
   static const char* const kFreeQ[] = {"position x",   "position y",   "position z",  "quaternion w",
                                        "quaternion x", "quaternion y", "quaternion z"};
   static const char* const kFreeV[] = {"linear velocity x",  "linear velocity y",  "linear velocity z",
@@ -57,9 +57,9 @@ const char* coordinateName(JointType type, int k, bool velocity) {
   static const char* const kPlanarQ[] = {"x", "y", "yaw psi"};
   static const char* const kPlanarV[] = {"x rate", "y rate", "yaw rate"};
   switch (type) {
-    case JointType::Spherical: return velocity ? kFreeV[3 + k] : kFreeQ[3 + k];
-    case JointType::Planar: return velocity ? kPlanarV[k] : kPlanarQ[k];
-    case JointType::Free: return velocity ? kFreeV[k] : kFreeQ[k];
+    case JointType::Spherical: return velocity ? kFreeV[3 + index] : kFreeQ[3 + index];
+    case JointType::Planar: return velocity ? kPlanarV[index] : kPlanarQ[index];
+    case JointType::Free: return velocity ? kFreeV[index] : kFreeQ[index];
     default: return nullptr;
   }
 }
@@ -86,17 +86,17 @@ EntryName ownerName(const Model& model, const Joint& joint) {
   return name;
 }
 
-// Entry k of q (or of v) of the model: its joint and that joint's coordinate.
+// Entry `entry` of q (or of v) of the model: its joint and that joint's coordinate.
 // Angular and free-joint linear velocities are in the child's axes: the root
 // joint's child is the base.
-EntryName entryName(const Model& model, Eigen::Index k, bool velocity) {
+EntryName entryName(const Model& model, Eigen::Index entry, bool velocity) {
   const Joint* owner = &model.allJoints().back();
   for (const Joint& joint : model.allJoints())
-    if (k < (velocity ? joint.v_index + joint.nv() : joint.q_index + joint.nq())) {
+    if (entry < (velocity ? joint.v_index + joint.nv() : joint.q_index + joint.nq())) {
       owner = &joint;
       break;
     }
-  const int index = static_cast<int>(k) - (velocity ? owner->v_index : owner->q_index);
+  const int index = static_cast<int>(entry) - (velocity ? owner->v_index : owner->q_index);
   const char* coordinate = coordinateName(owner->type, index, velocity);
   const bool child_axes = velocity && (owner->type == JointType::Free || owner->type == JointType::Spherical);
   EntryName name = ownerName(model, *owner);
@@ -110,8 +110,8 @@ EntryName entryName(const Model& model, Eigen::Index k, bool velocity) {
   return name;
 }
 
-EntryName configurationEntry(const Model& model, Eigen::Index k) { return entryName(model, k, false); }
-EntryName velocityEntry(const Model& model, Eigen::Index k) { return entryName(model, k, true); }
+EntryName configurationEntry(const Model& model, Eigen::Index entry) { return entryName(model, entry, false); }
+EntryName velocityEntry(const Model& model, Eigen::Index entry) { return entryName(model, entry, true); }
 
 // `what` has the wrong size: say what the model's nq (or nv) entries are,
 // worded as the solver's other state vectors are (dynamics/checks.cpp).

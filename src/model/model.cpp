@@ -359,7 +359,7 @@ const char* toString(BaseType type) {
 ModelBuilder& ModelBuilder::addBaseLinkInertia(const RigidInertia& inertia) {
   // Throws on an impossible inertia; its warnings come with build(), when the base floats.
   (void)validate::rigidInertia("link '" + model_.frames_[0].name + "'", inertia);
-  const Transform& link = model_.frames_[0].placement;  // the root link on body 0 (setBase)
+  const Transform& link = model_.frames_[0].placement;  // the root link on its body (setBase)
   const bool same_frame = exactlyIdentity(link);
   model_.link_inertias_[0] += same_frame ? inertia : spatial::inverseTransformInertia(link, inertia);
   return *this;
@@ -377,7 +377,7 @@ ModelBuilder& ModelBuilder::setBase(BaseType type, const Transform& placement, c
   if (!exactlyIdentity(root_link_placement)) {
     if (type != BaseType::Planar)
       throw ModelError(std::string("a ") + toString(type) + " base takes no root link placement (only a planar one)");
-    // What is attached already was placed on the root link's frame as body 0's.
+    // What is attached already was placed on the root link's frame.
     const RigidInertia& own = model_.link_inertias_[0];
     if (model_.frames_.size() > 1 || own.mass != 0.0 || !own.h.isZero(0.0) || !own.Ibar.isZero(0.0))
       throw ModelError("setBase with a root link placement must come before anything is attached to the root link '" +

@@ -21,7 +21,7 @@
 // the root link, walked depth first with each link's children in the order of
 // their joints' names; with a tip, the chain from the root link to the tip
 // link (a tree that does not branch into moving joints is such a chain, to its
-// unique leaf, and is loaded by the same code as before trees). Revolute,
+// unique leaf, and is loaded as one). Revolute,
 // continuous and prismatic joints become the model's joints; fixed joints
 // become frames and their links' inertias are merged into the body they are
 // welded to. Every link connected to a loaded link through fixed joints only
@@ -37,7 +37,7 @@
 // The base (chooseBase): a floating or planar joint that is the URDF root
 // link's only joint becomes a Free or Planar base under its child link (the
 // links above it are the world); UrdfOptions::base adds one under the root
-// link instead. Either way the root link's own inertia is body 0's
+// link instead. Either way the root link's own inertia is the base's
 // (addRootLinkInertia), and every link of a floating base is judged like a
 // moving one.
 #include "zwang/urdf.hpp"
@@ -1132,13 +1132,13 @@ urdf::JointConstSharedPtr floatingRootJoint(const urdf::ModelInterface& model) {
 
 // Where the model starts and how its base is attached. A floating root joint
 // is used when the model starts at the URDF's root link or at the joint's
-// child link; its child becomes body 0, the links above it are the world.
+// child link; its child becomes the base, the links above it are the world.
 struct BaseChoice {
-  LinkPtr root;                     // the model's root link (body 0)
+  LinkPtr root;                     // the model's root link (the base)
   urdf::JointConstSharedPtr joint;  // the file's floating or planar root joint in use, if any
   BaseType type = BaseType::Fixed;  // the model's base
   Transform plane;                  // a planar base's plane, ᴾX_world
-  Transform root_link;              // the root link's frame on body 0, ᶜX_link (a turned plane's: linkPlacementOf)
+  Transform root_link;              // the root link's frame on its body, ᶜX_link (a turned plane's: linkPlacementOf)
 };
 
 // The plane of a planar root joint, ᴾX_world: the joint frame (its <origin>
@@ -1181,7 +1181,7 @@ BaseChoice chooseBase(const Reporter& report, const urdf::ModelInterface& model,
   return choice;
 }
 
-// Body 0's own inertia: the root link's <inertial>. A floating base moves it;
+// The base's own inertia: the root link's <inertial>. A floating base moves it;
 // on a fixed base it is only counted (Model::inertia(0), "base mass"): there
 // an inertia that is not a body's is left out rather than refused, as nothing
 // welded to a fixed base is judged.
@@ -1275,7 +1275,7 @@ void loadTree(const Reporter& report, const urdf::ModelInterface& urdf_model, co
 Model load(const Reporter& report, const std::string& text, const NamedUrdfOptions& options) {
   // TinyXML 2.6 (what urdfdom parses with) trusts a UTF-8 lead byte's length:
   // a text that ends inside a multi-byte name makes it step over the final
-  // NUL and read on into whatever memory follows (found by fuzz_urdf). Both
+  // NUL and read on into whatever memory follows (fuzz_urdf's case). Both
   // parsers stop at the first NUL, so eight more of them (the longest step is
   // four bytes) give the same parse and keep every read inside this string.
   const std::string xml = text + std::string(8, '\0');

@@ -83,12 +83,13 @@ bool independent(const Box& box, double pivot, int j) {
 // g = P x − c (P symmetric), and a bound on each entry's rounding from the
 // absolute row sums of P (computed once).
 void gradient(const Box& box, const VectorRef& x, ActiveSetScratch& s) {
-  const Eigen::Index k = x.size();
-  auto g = s.gradient.head(k);
+  const Eigen::Index variables = x.size();
+  auto g = s.gradient.head(variables);
   g.noalias() = box.P * x;
   g -= box.c;
   const double x_max = x.cwiseAbs().maxCoeff();
-  for (Eigen::Index j = 0; j < k; ++j) s.gradient_noise[j] = kRounding * (s.row_sums[j] * x_max + std::abs(box.c[j]));
+  for (Eigen::Index j = 0; j < variables; ++j)
+    s.gradient_noise[j] = kRounding * (s.row_sums[j] * x_max + std::abs(box.c[j]));
 }
 
 // Room for x_j along the sign of `rate` (per unit of step), +∞ when unbounded.
@@ -150,10 +151,10 @@ bool runAway(const GrowingCholesky& F, const VectorRef& x, double reach, QpRepor
 
 // F ← every non-fixed variable that keeps P_FF positive definite, in order;
 // the dependent ones are fixed where they are.
-void growFree(const Box& box, int k, ActiveSetScratch& s) {
+void growFree(const Box& box, int variables, ActiveSetScratch& s) {
   GrowingCholesky& F = s.free_factor;
   F.clear();
-  for (int j = 0; j < k; ++j) {
+  for (int j = 0; j < variables; ++j) {
     if (s.fixed[j]) continue;
     const double pivot = F.schurPivot(box.P, j);
     if (independent(box, pivot, j))
@@ -168,11 +169,11 @@ void growFree(const Box& box, int k, ActiveSetScratch& s) {
 // the optimal active set, so few iterations follow even for many variables.
 // False when a variable ran away (the report says which).
 bool warmStart(const Box& box, VectorOut x, ActiveSetScratch& s, double reach, QpReport& report) {
-  const auto k = static_cast<int>(x.size());
+  const auto variables = static_cast<int>(x.size());
   GrowingCholesky& F = s.free_factor;
-  for (int j = 0; j < k; ++j) s.fixed[j] = box.lo[j] < box.hi[j] ? 0 : 1;  // a point box never moves
-  s.flat.head(k).setZero();
-  growFree(box, k, s);
+  for (int j = 0; j < variables; ++j) s.fixed[j] = box.lo[j] < box.hi[j] ? 0 : 1;  // a point box never moves
+  s.flat.head(variables).setZero();
+  growFree(box, variables, s);
   if (F.size() == 0) return true;
   gradient(box, x, s);
   newtonDirection(s, s.step);
@@ -186,7 +187,7 @@ bool warmStart(const Box& box, VectorOut x, ActiveSetScratch& s, double reach, Q
     }
   }
   if (runAway(F, x, reach, report)) return false;
-  if (clamped) growFree(box, k, s);
+  if (clamped) growFree(box, variables, s);
   return true;
 }
 
@@ -205,8 +206,8 @@ bool freeNotStationary(const Box& box, const ActiveSetScratch& s) {
 // φ(x + Δ) − φ(x) = gᵀΔ + ½ ΔᵀPΔ, Δ zero off F.
 bool projectedStepIsBetter(const Box& box, const VectorRef& x, double alpha, ActiveSetScratch& s) {
   const GrowingCholesky& F = s.free_factor;
-  const Eigen::Index k = x.size();
-  auto delta = s.delta.head(k);
+  const Eigen::Index variables = x.size();
+  auto delta = s.delta.head(variables);
   delta.setZero();
   double gp = 0.0;
   for (int a = 0; a < F.size(); ++a) {
@@ -215,9 +216,9 @@ bool projectedStepIsBetter(const Box& box, const VectorRef& x, double alpha, Act
     delta[j] = clampTo(box, j, x[j] + s.step[a]) - x[j];
   }
   const double cut = gp * (alpha - 0.5 * alpha * alpha);
-  auto P_delta = s.P_delta.head(k);
+  auto P_delta = s.P_delta.head(variables);
   P_delta.noalias() = box.P * delta;
-  return s.gradient.head(k).dot(delta) + 0.5 * delta.dot(P_delta) < cut;
+  return s.gradient.head(variables).dot(delta) + 0.5 * delta.dot(P_delta) < cut;
 }
 
 // Bertsekas' projected Newton step: x_F ← clamp(x_F + p), and every variable
@@ -361,10 +362,10 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
                         const TermSizes& terms) {
   if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
-  const auto k = static_cast<int>(x.size());
+  const auto variables = static_cast<int>(x.size());
   ActiveSetScratch& s = scratch.active_set;
   const Box box{P, c, lo, hi, tolerance, terms};
-  for (int j = 0; j < k; ++j) s.row_sums[j] = P.col(j).cwiseAbs().sum();
+  for (int j = 0; j < variables; ++j) s.row_sums[j] = P.col(j).cwiseAbs().sum();
   const double reach = kReach * reachScale(lo, hi, c, lambdaMaxBound(P), terms.curvature);
   if (!warmStart(box, x, s, reach, report)) {  // stage 1
     report.kkt_residual = boxQpKktResidual(P, c, lo, hi, x);
@@ -374,7 +375,7 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
     gradient(box, x, s);
     if (freeNotStationary(box, s) && newton_in_a_row < 2) {  // stage 2
-      s.flat.head(k).setZero();  // F moves: the slopes along zero-curvature directions change
+      s.flat.head(variables).setZero();  // F moves: the slopes along zero-curvature directions change
       const NewtonOutcome step = newtonStep(box, x, s);
       newton_in_a_row = step == NewtonOutcome::Full ? newton_in_a_row + 1 : 0;
       if (step != NewtonOutcome::Projected && runAway(s.free_factor, x, reach, report)) break;
@@ -388,13 +389,13 @@ QpReport boxQpActiveSet(const Eigen::Ref<const Eigen::MatrixXd>& P, const Eigen:
     }
     const double pivot = s.free_factor.schurPivot(P, j);
     if (independent(box, pivot, j)) {
-      s.flat.head(k).setZero();  // F grows: so do the directions of zero curvature
+      s.flat.head(variables).setZero();  // F grows: so do the directions of zero curvature
       releaseVariables(box, x, j, pivot, s);
       continue;
     }
     const ZeroCurvature move = zeroCurvatureMove(box, j, reach, x, s, report);
     if (move == ZeroCurvature::Unbounded || runAway(s.free_factor, x, reach, report)) break;
-    if (move == ZeroCurvature::Moved) s.flat.head(k).setZero();
+    if (move == ZeroCurvature::Moved) s.flat.head(variables).setZero();
   }
   report.kkt_residual = boxQpKktResidual(P, c, lo, hi, x);
   return report;

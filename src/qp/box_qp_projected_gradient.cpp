@@ -105,11 +105,12 @@ bool linearVertex(const MatrixRef& P, const VectorRef& c, const VectorRef& lo, c
 // is raised to it (that variable is nearly linear, and 1/rounding would
 // fling it).
 double jacobiMetric(const MatrixRef& P, const TermSizes& terms, ProjectedGradientScratch& s) {
-  const Index k = P.rows();
-  auto inverse_d = s.inverse_diagonal.head(k);
+  const Index variables = P.rows();
+  auto inverse_d = s.inverse_diagonal.head(variables);
   const double d_floor = kDiagonalFloor * P.diagonal().maxCoeff();
-  for (Index j = 0; j < k; ++j) inverse_d[j] = linearVariable(P, terms, j) ? 0.0 : 1.0 / std::max(P(j, j), d_floor);
-  auto root_inverse_d = s.root_inverse_diagonal.head(k);
+  for (Index j = 0; j < variables; ++j)
+    inverse_d[j] = linearVariable(P, terms, j) ? 0.0 : 1.0 / std::max(P(j, j), d_floor);
+  auto root_inverse_d = s.root_inverse_diagonal.head(variables);
   root_inverse_d = inverse_d.cwiseSqrt();
   return 1.0 / lambdaMaxBound(P, root_inverse_d);
 }
@@ -192,14 +193,15 @@ QpReport boxQpProjectedGradient(const Eigen::Ref<const Eigen::MatrixXd>& P, cons
                                 QpScratch& scratch, int max_iterations, double tolerance, const TermSizes& terms) {
   if (x.size() == 0) return QpReport{0, 0.0, true};  // nothing to solve: converged
   QpReport report;
-  const Index k = x.size();
+  const Index variables = x.size();
   // Lipschitz constant of ∇φ: an upper bound of λ_max(P) in O(k²) rather
   // than an O(k³) eigen-decomposition, never below P's largest |entry|.
   const double L = lambdaMaxBound(P);
   const bool all_linear = linear(P, c, L, terms);
   ProjectedGradientScratch& s = scratch.projected_gradient;
-  Iterates v{s.inverse_diagonal.head(k), s.gradient.head(k), s.y.head(k),           s.x_previous.head(k),
-             s.x_change.head(k),         s.Px.head(k),       s.Px_previous.head(k), s.Py.head(k)};
+  Iterates v{s.inverse_diagonal.head(variables), s.gradient.head(variables), s.y.head(variables),
+             s.x_previous.head(variables),       s.x_change.head(variables), s.Px.head(variables),
+             s.Px_previous.head(variables),      s.Py.head(variables)};
   if (!linearVertex(P, c, lo, hi, all_linear, terms, tolerance, x, report) || all_linear) {  // stage 0
     if (!report.unbounded) {  // every variable linear: each follows the others' coupling (stage 3a) until none moves
       v.inverse_d.setZero();

@@ -49,11 +49,11 @@ constexpr double kTouchResidual = 1e-12;
 // is kept as column r of s.rows (contiguous). Returns their number.
 Index constraintRows(const MatrixRef& N, const VectorRef& x0, const VectorRef& lo, const VectorRef& hi,
                      LeastDistanceScratch& s) {
-  const Index q = N.cols(), k = N.rows();
+  const Index q = N.cols(), joints = N.rows();
   Index rows = 0;
   const double* n_data = N.data();  // N_j is strided: gathered element by element
   const Index n_stride = N.outerStride();
-  for (Index j = 0; j < k; ++j) {
+  for (Index j = 0; j < joints; ++j) {
     if (std::isfinite(hi[j])) {
       double* row_r = s.rows.col(rows).data();
       for (Index c = 0; c < q; ++c) row_r[c] = n_data[j + c * n_stride];
@@ -97,10 +97,10 @@ int rowToDrop(const LeastDistanceScratch& s, double tol) {
 // The ratio test along the step (rates s.rate = N·step of the k joints): `alpha`
 // comes in as 1 and goes out cut at the first row outside W that the step
 // reaches; the result is that row, or −1.
-Index blockingRow(Index k, const VectorRef& lo, const VectorRef& hi, double rate_floor, const LeastDistanceScratch& s,
-                  double& alpha) {
+Index blockingRow(Index joints, const VectorRef& lo, const VectorRef& hi, double rate_floor,
+                  const LeastDistanceScratch& s, double& alpha) {
   Index blocking = -1;
-  for (Index j = 0, r = 0; j < k; ++j) {
+  for (Index j = 0, r = 0; j < joints; ++j) {
     const Index r_hi = std::isfinite(hi[j]) ? r++ : -1;  // the rows in the order they were made
     const Index r_lo = std::isfinite(lo[j]) ? r++ : -1;
     const double rate = s.rate[j];
@@ -149,7 +149,7 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
                          int max_iterations) {
   QpReport report;
   LeastDistanceScratch& s = scratch.least_distance;
-  const Index q = N.cols(), k = N.rows();
+  const Index q = N.cols(), joints = N.rows();
   const Index rows = constraintRows(N, x0, lo, hi, s);  // stage 1
   // (No rows at all when every bound is infinite: nothing limits z.)
   const double scale =
@@ -159,8 +159,8 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
   s.working.head(rows).setZero();
   // The point x0 + N z and the rate N·step of every joint: joint j's rows are
   // ±N_j, so one rate serves both, and the slacks are hi_j − y_j, y_j − lo_j.
-  auto y = s.point.head(k);
-  auto rate = s.rate.head(k);
+  auto y = s.point.head(joints);
+  auto rate = s.rate.head(joints);
   y = x0;
   for (Index c = 0; c < q; ++c) y += z[c] * N.col(c);
   for (report.iterations = 0; report.iterations < max_iterations; ++report.iterations) {
@@ -179,7 +179,7 @@ QpReport leastDistanceQp(const Eigen::Ref<const Eigen::MatrixXd>& N, const Eigen
     rate.setZero();  // stage 4: towards it, up to the first row
     for (Index c = 0; c < q; ++c) rate += step[c] * N.col(c);
     double alpha = 1.0;
-    const Index blocking = blockingRow(k, lo, hi, kRateFloor * scale, s, alpha);
+    const Index blocking = blockingRow(joints, lo, hi, kRateFloor * scale, s, alpha);
     z += alpha * step;
     y += alpha * rate;
     if (blocking >= 0 && !addWorkingRow(a, static_cast<int>(blocking), s)) break;

@@ -426,16 +426,16 @@ void baseState(FloatingCase& c) {
   c.q = Eigen::VectorXd::Zero(m.nq());
   c.v = Eigen::VectorXd::Zero(m.nv());
   c.tau = Eigen::VectorXd::Zero(m.nv());
-  const int iq = m.baseConfigurationSize(), iv = m.baseVelocitySize();
+  const int base_configuration_size = m.baseConfigurationSize(), base_velocity_size = m.baseVelocitySize();
   if (m.baseType() == BaseType::Free) {
     const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
     c.q.segment<4>(3) << turn.w(), turn.x(), turn.y(), turn.z();
   }
-  for (int k = 0; k < iv; ++k) c.v[k] = 0.1 * (k + 1);
+  for (int k = 0; k < base_velocity_size; ++k) c.v[k] = 0.1 * (k + 1);
   for (int j = 0; j < m.dof(); ++j) {
-    c.q[iq + j] = std::clamp(0.1 * std::sin(j), m.joint(j).lower, m.joint(j).upper);
-    c.v[iv + j] = j % 3 == 0 ? 0.0 : 0.3;
-    c.tau[iv + j] = std::cos(j);
+    c.q[base_configuration_size + j] = std::clamp(0.1 * std::sin(j), m.joint(j).lower, m.joint(j).upper);
+    c.v[base_velocity_size + j] = j % 3 == 0 ? 0.0 : 0.3;
+    c.tau[base_velocity_size + j] = std::cos(j);
   }
 }
 
@@ -551,10 +551,10 @@ TEST_CASE("floating bases: humanoid, solo12 and random trees allocate nothing (p
 TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the base's errors allocate nothing",
           "[floating]") {
   FloatingCase c = humanoidOnTwoFeet(BaseType::Free);
-  const int iq = c.model.baseConfigurationSize(), iv = c.model.baseVelocitySize();
+  const int base_configuration_size = c.model.baseConfigurationSize(), base_velocity_size = c.model.baseVelocitySize();
   const int knee = c.model.jointIndex("LLEG_KNEE");
-  c.q[iq + knee] = c.model.joint(knee).lower;  // stuck on its lower limit
-  c.v[iv + knee] = 0.0;
+  c.q[base_configuration_size + knee] = c.model.joint(knee).lower;  // stuck on its lower limit
+  c.v[base_velocity_size + knee] = 0.0;
   Workspace ws(c.model, c.task);
   REQUIRE(solveWithFriction(c.model, ws, c.q, c.v, c.tau, c.task, c.options));  // warm
   bool ok = false;
@@ -666,17 +666,17 @@ FloatingCase sphericalTree(zwang::testing::BaseKind kind, std::uint64_t seed) {
   c.v = Eigen::VectorXd::Zero(m.nv());
   c.tau = Eigen::VectorXd::Zero(m.nv());
   const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()));
-  const int iv = m.baseVelocitySize();
+  const int base_velocity_size = m.baseVelocitySize();
   for (const Joint& joint : m.allJoints()) {
     const int q = joint.q_index;
     if (joint.type == JointType::Spherical) c.q.segment<4>(q) << turn.w(), turn.x(), turn.y(), turn.z();
     if (joint.type == JointType::Free) c.q.segment<4>(q + 3) << turn.w(), turn.x(), turn.y(), turn.z();
     if (joint.nv() == 1) c.q[q] = std::clamp(0.1 * std::sin(joint.v_index), joint.lower, joint.upper);
   }
-  for (int k = 0; k < iv; ++k) c.v[k] = 0.1 * (k + 1);
+  for (int k = 0; k < base_velocity_size; ++k) c.v[k] = 0.1 * (k + 1);
   for (int k = 0; k < m.dof(); ++k) {
-    c.v[iv + k] = k % 3 == 0 ? 0.0 : 0.3;
-    c.tau[iv + k] = std::cos(k);
+    c.v[base_velocity_size + k] = k % 3 == 0 ? 0.0 : 0.3;
+    c.tau[base_velocity_size + k] = std::cos(k);
   }
   return c;
 }

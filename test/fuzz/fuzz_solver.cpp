@@ -461,7 +461,7 @@ void assembleState(FuzzedDataProvider& in, const Model& model, const JointStateD
   q.setZero(model.nq());
   qd.setZero(model.nv());
   tau.setZero(model.nv());
-  const int iq = model.baseConfigurationSize(), iv = model.baseVelocitySize();
+  const int base_configuration_size = model.baseConfigurationSize(), base_velocity_size = model.baseVelocitySize();
   q.tail(joints.q.size()) = joints.q;
   qd.tail(joints.qd.size()) = joints.qd;
   tau.tail(joints.tau.size()) = joints.tau;
@@ -469,7 +469,8 @@ void assembleState(FuzzedDataProvider& in, const Model& model, const JointStateD
   if (joints.follow_leaders) model.followLeaders(q, qd);
   if (joints.poison >= 0) {
     Eigen::VectorXd* v[] = {&q, &qd, &tau};
-    (*v[joints.poisoned_vector])[(joints.poisoned_vector == 0 ? iq : iv) + joints.poison] = joints.poison_value;
+    (*v[joints.poisoned_vector])[(joints.poisoned_vector == 0 ? base_configuration_size : base_velocity_size) +
+                                 joints.poison] = joints.poison_value;
   }
 }
 

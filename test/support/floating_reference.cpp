@@ -85,7 +85,8 @@ int FloatingInput::constraintRows() const {
 
 Eigen::Isometry3d basePose(const FloatingBase& base, const Eigen::VectorXd& q) {
   checkBase(base);
-  if (q.size() < base.nqBase()) throw std::invalid_argument("floating reference: q too short for the base");
+  if (q.size() < base.baseConfigurationSize())
+    throw std::invalid_argument("floating reference: q too short for the base");
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (base.kind == BaseKind::Free) {
     T.translation() = q.head<3>();
@@ -99,11 +100,11 @@ Eigen::Isometry3d basePose(const FloatingBase& base, const Eigen::VectorXd& q) {
 }
 
 Eigen::VectorXd configurationRate(const FloatingBase& base, const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
-  const int nb = base.nvBase();
-  if (v.size() - nb != q.size() - base.nqBase())
+  const int base_velocity_size = base.baseVelocitySize();
+  if (v.size() - base_velocity_size != q.size() - base.baseConfigurationSize())
     throw std::invalid_argument("floating reference: q and v sizes do not match the base");
   Eigen::VectorXd qdot(q.size());
-  qdot.tail(v.size() - nb) = v.tail(v.size() - nb);
+  qdot.tail(v.size() - base_velocity_size) = v.tail(v.size() - base_velocity_size);
   if (base.kind == BaseKind::Free) {
     const Eigen::Quaterniond quat(q(3), q(4), q(5), q(6));  // not normalised: the exact field of q̇ at q
     qdot.head<3>() = quat.normalized().toRotationMatrix() * v.head<3>();
@@ -134,7 +135,7 @@ Eigen::VectorXd integrateConfiguration(const FloatingBase& base, const Eigen::Ve
 FloatingKinematics floatingKinematics(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q,
                                       const Eigen::VectorXd& v) {
   checkSizes(spec, base, q, v);
-  const int nb = base.nvBase(), nqb = base.nqBase();
+  const int base_velocity_size = base.baseVelocitySize(), base_configuration_size = base.baseConfigurationSize();
   const int nv = base.nv(spec);
   const std::size_t links = spec.links.size();
   FloatingKinematics kin;
@@ -172,8 +173,8 @@ FloatingKinematics floatingKinematics(const ChainSpec& spec, const FloatingBase&
     kin.bias[0] = stack(v(2) * pdot.cross(uz), Eigen::Vector3d::Zero());
   }
 
-  int dof = nb;
-  Eigen::Index qi = nqb;
+  int dof = base_velocity_size;
+  Eigen::Index qi = base_configuration_size;
   for (std::size_t k = 0; k < spec.joints.size(); ++k) {
     const JointSpec& joint = spec.joints[k];
     const auto parent = static_cast<std::size_t>(spec.parentLink(k));
@@ -273,7 +274,7 @@ double floatingGaussFunction(const ChainSpec& spec, const FloatingBase& base, co
 
 FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base, const FloatingInput& input) {
   const FloatingKinematics kin = floatingKinematics(spec, base, input.q, input.v);
-  const int nb = base.nvBase();
+  const int base_velocity_size = base.baseVelocitySize();
   const int n = base.nv(spec);
   if (input.tau.size() != n) throw std::invalid_argument("floating reference: tau must have nv entries");
   const int m_user = input.constraintRows();
@@ -303,7 +304,7 @@ FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base,
     if (c.joint >= 0) {  // q̈_joint = b: its force is the joint's own generalized force
       if (c.A.cols() != 1 || c.joint >= spec.dof())
         throw std::invalid_argument("floating reference: a joint row has one column and a joint of the spec");
-      out.G(row, nb + c.joint) = 1.0;
+      out.G(row, base_velocity_size + c.joint) = 1.0;
       out.gamma(row) = c.b(0);
       ++row;
       continue;
@@ -329,8 +330,8 @@ FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base,
   for (std::size_t j = 0; j < leaders.size(); ++j) {
     if (leaders[j] < 0) continue;
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[j])];
-    out.G(row, nb + static_cast<int>(j)) += 1.0;
-    out.G(row, nb + leaders[j]) -= joint.mimic_multiplier;
+    out.G(row, base_velocity_size + static_cast<int>(j)) += 1.0;
+    out.G(row, base_velocity_size + leaders[j]) -= joint.mimic_multiplier;
     ++row;
   }
 
@@ -349,8 +350,9 @@ FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base,
   out.tau_c = out.G.transpose() * motorRows(input, m).cwiseProduct(out.nu);  // the contacts' force is not the motors'
   out.tau_control = input.tau + out.tau_c;
   for (const MimicLaw& law : spec.mimicLaws()) {
-    out.tau_control(nb + law.leader) += law.multiplier * out.tau_control(nb + law.joint);
-    out.tau_control(nb + law.joint) = 0.0;
+    out.tau_control(base_velocity_size + law.leader) +=
+        law.multiplier * out.tau_control(base_velocity_size + law.joint);
+    out.tau_control(base_velocity_size + law.joint) = 0.0;
   }
 
   out.acc_world.resize(spec.links.size());
@@ -441,11 +443,12 @@ FloatingInput randomFloatingInput(std::mt19937_64& rng, const ChainSpec& spec, c
     if (uniform01(rng) < options.base_link_probability && c.relative_to != spec.links[0].name)
       c.link = spec.links[0].name;
 
-  const int nqb = base.nqBase(), nb = base.nvBase(), n = spec.dof();
+  const int base_configuration_size = base.baseConfigurationSize(), base_velocity_size = base.baseVelocitySize(),
+            n = spec.dof();
   FloatingInput in;
-  in.q.resize(nqb + n);
-  in.v.resize(nb + n);
-  in.tau = Eigen::VectorXd::Zero(nb + n);
+  in.q.resize(base_configuration_size + n);
+  in.v.resize(base_velocity_size + n);
+  in.tau = Eigen::VectorXd::Zero(base_velocity_size + n);
   if (base.kind == BaseKind::Free) {
     const Eigen::Vector3d p = randomVector(rng, 3, options.base_position_scale);
     const Eigen::Quaterniond quat(randomRotation(rng));
@@ -456,8 +459,9 @@ FloatingInput randomFloatingInput(std::mt19937_64& rng, const ChainSpec& spec, c
     const double psi = uniform(rng, -3.14159265358979, 3.14159265358979);
     in.q.head<3>() << xy(0), xy(1), psi;
   }
-  in.v.head(nb) = randomVector(rng, nb, options.base_speed_scale);
-  if (uniform01(rng) < options.base_tau_probability) in.tau.head(nb) = randomVector(rng, nb, 10.0);
+  in.v.head(base_velocity_size) = randomVector(rng, base_velocity_size, options.base_speed_scale);
+  if (uniform01(rng) < options.base_tau_probability)
+    in.tau.head(base_velocity_size) = randomVector(rng, base_velocity_size, 10.0);
   in.q.tail(n) = joints.q;
   in.v.tail(n) = joints.qd;
   in.tau.tail(n) = joints.tau;

@@ -66,10 +66,10 @@ struct FloatingBase {
   // world to plane coordinates: Transform::fromPose(plane.linear(), plane.translation()).)
   Eigen::Isometry3d plane = Eigen::Isometry3d::Identity();
 
-  int nqBase() const { return kind == BaseKind::Free ? 7 : kind == BaseKind::Planar ? 3 : 0; }
-  int nvBase() const { return kind == BaseKind::Free ? 6 : kind == BaseKind::Planar ? 3 : 0; }
-  int nq(const ChainSpec& spec) const { return nqBase() + spec.nq(); }
-  int nv(const ChainSpec& spec) const { return nvBase() + spec.dof(); }
+  int baseConfigurationSize() const { return kind == BaseKind::Free ? 7 : kind == BaseKind::Planar ? 3 : 0; }
+  int baseVelocitySize() const { return kind == BaseKind::Free ? 6 : kind == BaseKind::Planar ? 3 : 0; }
+  int nq(const ChainSpec& spec) const { return baseConfigurationSize() + spec.nq(); }
+  int nv(const ChainSpec& spec) const { return baseVelocitySize() + spec.dof(); }
 };
 
 struct FloatingInput {

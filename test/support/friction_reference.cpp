@@ -326,8 +326,8 @@ FrictionReference bruteForceFriction(const ChainSpec& spec, const DynamicsInput&
 FrictionReference bruteForceFloatingFriction(const ChainSpec& spec, const FloatingBase& base,
                                              const FloatingInput& input, const FrictionSetup& setup,
                                              const BruteForceOptions& options) {
-  const int n = spec.dof(), nb = base.nvBase();
-  if (input.v.size() != nb + n || input.tau.size() != nb + n)
+  const int n = spec.dof(), base_velocity_size = base.baseVelocitySize();
+  if (input.v.size() != base_velocity_size + n || input.tau.size() != base_velocity_size + n)
     throw std::invalid_argument("friction reference: v and tau must have nv entries");
   if (setup.breakaway.size() != n || setup.kinetic.size() != n || setup.viscous.size() != n ||
       (setup.limit_side.size() != 0 && setup.limit_side.size() != n))
@@ -338,19 +338,19 @@ FrictionReference bruteForceFloatingFriction(const ChainSpec& spec, const Floati
   const FloatingResult dense = floatingDynamics(spec, base, in);
   FrictionSystem system = dynamicsOf(dense);
   system.tau = in.tau;
-  system.gauss_at_rest = floatingGaussFunction(spec, base, in, Eigen::VectorXd::Zero(nb + n));
-  for (const int j : setup.stuck) system.stuck.push_back(nb + j);  // the base is never stuck
-  system.breakaway = Eigen::VectorXd::Zero(nb + n);
+  system.gauss_at_rest = floatingGaussFunction(spec, base, in, Eigen::VectorXd::Zero(base_velocity_size + n));
+  for (const int j : setup.stuck) system.stuck.push_back(base_velocity_size + j);  // the base is never stuck
+  system.breakaway = Eigen::VectorXd::Zero(base_velocity_size + n);
   system.breakaway.tail(n) = setup.breakaway;
   if (setup.limit_side.size() != 0) {
-    system.limit_side = Eigen::VectorXi::Zero(nb + n);
+    system.limit_side = Eigen::VectorXi::Zero(base_velocity_size + n);
     system.limit_side.tail(n) = setup.limit_side;
   }
   system.tau_motor = input.tau;
   system.motor = motorRows(input, static_cast<int>(dense.G.rows()));
   for (MimicLaw law : spec.mimicLaws()) {
-    law.joint += nb;
-    law.leader += nb;
+    law.joint += base_velocity_size;
+    law.leader += base_velocity_size;
     system.mimic_laws.push_back(law);
   }
   FrictionReference out = bruteForceFriction(system, options);

@@ -85,7 +85,7 @@ struct FreeBlock {
 std::vector<FreeBlock> freeBlocks(const ChainSpec& spec, const FloatingBase& base, const Eigen::VectorXd& q) {
   std::vector<FreeBlock> blocks;
   if (base.kind == BaseKind::Free) blocks.push_back({0, basePose(base, q).linear()});
-  Eigen::Index qi = base.nqBase(), vi = base.nvBase();
+  Eigen::Index qi = base.baseConfigurationSize(), vi = base.baseVelocitySize();
   for (const int k : spec.movingJoints()) {
     const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
     if (joint.isFree()) {

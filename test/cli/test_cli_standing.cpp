@@ -255,7 +255,7 @@ TEST_CASE("energy: a models directory without solo12.urdf writes nothing", "[ene
   const std::string models = cli_test::scratchDir() + "/no-solo-models";
   const std::string out = cli_test::scratchDir() + "/en-no-solo";
   std::filesystem::create_directories(models);
-  for (const char* file : {"panda.urdf", "dual_panda.urdf", "simple_humanoid.urdf"})
+  for (const char* file : {"panda.urdf", "dual_panda.urdf", "dual_panda_postures.json", "simple_humanoid.urdf"})
     std::filesystem::copy_file(std::string(ZWANG_MODELS_DIR) + "/" + file, models + "/" + file,
                                std::filesystem::copy_options::overwrite_existing);
   const cli_test::Run r = cli_test::run({"energy", "--models", models, "--out", out, "--no-plots"});

@@ -22,9 +22,10 @@
 //     box's wrenches;
 //   friction-aware (solveWithFriction, all joints stuck): the least-effort
 //     maximiser, |τ_control,j| = max(0, |G'_j| − margin·f_j).
-// The postures are solved at startup by damped least squares on each arm
-// (dual_arm_ik.hpp, from the grasp pose of make_dual_panda.py --check): every
-// one is checked (hand error, joint-limit distance) before anything is solved.
+// The postures are data: models/dual_panda_postures.json, solved once by damped
+// least squares (test/cli/dual_panda_postures.cpp, ctest dual_panda_postures);
+// every one read is checked (hands on the box, joint-limit distance) before
+// anything is solved, so a bad file is refused, naming the file and the field.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -36,8 +37,9 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "dual_arm_ik.hpp"
+#include "dual_arm_box.hpp"
 #include "energy_report.hpp"
+#include "json_reader.hpp"
 #include "zwang/zwang.hpp"
 
 namespace zwang::cli {
@@ -46,31 +48,22 @@ namespace {
 
 constexpr int kDof = 15;
 constexpr double kBoxMass = 3.0;             // [kg]
-constexpr double kGrip = 0.15;               // half the box's width: the hands at ±kGrip [m]
 constexpr double kLimitDistance = 0.2;       // every joint at least this far inside its limits [rad]
 constexpr double kCheckTolerance = 1e-9;     // the checks: torques [N·m], accelerations [rad/s²]
-constexpr double kPostureTolerance = 1e-10;  // hand position [m] and orientation [rad] after the IK
+constexpr double kPostureTolerance = 1e-10;  // hand position [m] and orientation [rad] of a stored posture
+constexpr const char* kPosturesFile = "dual_panda_postures.json";
 
+// One posture of the postures file: where the box is and the joints' q.
 struct Posture {
-  const char* name;
-  const char* what;
-  double torso;   // torso angle [rad]
-  double box[3];  // the box's centre in the torso frame [m]
+  std::string name, what;
+  dual_arm::BoxPlacement box;  // torso angle [rad], the box's centre in the torso frame [m]
+  Eigen::VectorXd q;           // torso, left arm 1-7, right arm 1-7 [rad]
 };
 
-// The box's centre in the torso frame (x forward, y left, z up) and the torso angle.
-const Posture kPostures[] = {
-    {"grasp", "make_dual_panda.py --check: box 0.5 m in front, 0.35 m up", 0.0, {0.5, 0.0, 0.35}},
-    {"box_high", "box raised to 0.55 m", 0.0, {0.5, 0.0, 0.55}},
-    {"box_low_close", "box lower and closer: 0.4 m in front, 0.2 m up", 0.0, {0.4, 0.0, 0.2}},
-    {"box_left", "box shifted 0.15 m to the left, 0.45 m in front", 0.0, {0.45, 0.15, 0.35}},
-    {"torso_turned", "the grasp with the torso turned 0.6 rad to the left", 0.6, {0.5, 0.0, 0.35}},
-};
-
-// What the dual arm's report adds to a posture's solves: the IK's result,
+// What the dual arm's report adds to a posture's solves: the input check's result,
 // the loop's force and the worst of each check.
 struct PostureDetail {
-  double ik_error = 0, limit_distance = 0;
+  double hand_error = 0, limit_distance = 0;
   // ν of the relative rows per variant: the wrench on the left hand, right_tool0's axes
   std::array<Vec6, energy::kVariantCount> loop;
   double worst_qdd = 0, worst_closed_form = 0, worst_closure = 0, worst_torso_internal = 0;
@@ -78,19 +71,71 @@ struct PostureDetail {
 
 using energy::small;
 
-// The posture's q from the IK (dual_arm_ik.hpp), checked: the hands on the box, every joint inside its limits.
-Eigen::VectorXd solvePosture(const Model& model, const Posture& posture, PostureDetail& r) {
-  const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
-  const dual_arm::BoxPlacement box{posture.torso, Eigen::Vector3d(posture.box[0], posture.box[1], posture.box[2]),
-                                   kGrip};
-  const Eigen::VectorXd q = dual_arm::reachBox(model, box, r.ik_error, where);
-  r.limit_distance = std::numeric_limits<double>::infinity();
+// A posture's fields from the postures file, then the input check: the hands
+// on the box, every joint inside its limits (CliError naming file and field).
+Posture readPosture(const Model& model, const JsonReader& in, const Json& value, const std::string& path,
+                    PostureDetail& d) {
+  const Json& object = in.object(value, path, {"name", "what", "torso", "box", "q"});
+  for (const char* key : {"name", "what", "torso", "box", "q"})
+    if (!object.contains(key)) in.fail(childPath(path, key), "missing");
+  Posture p;
+  p.name = in.string(object["name"], childPath(path, "name"));
+  p.what = in.string(object["what"], childPath(path, "what"));
+  p.box.torso = in.number(object["torso"], childPath(path, "torso"));
+  p.box.centre = in.numbers(object["box"], childPath(path, "box"), 3, "x, y, z");
+  p.q = in.numbers(object["q"], childPath(path, "q"), kDof, "one per joint");
+  Workspace ws(model);
+  if (const Status s = dual_arm::boxError(model, ws, p.q, p.box, d.hand_error); !s)
+    in.fail(childPath(path, "q"), s.message);
+  d.limit_distance = std::numeric_limits<double>::infinity();
   for (int j = 0; j < kDof; ++j)
-    r.limit_distance = std::min({r.limit_distance, q[j] - model.joint(j).lower, model.joint(j).upper - q[j]});
-  if (!(r.ik_error < kPostureTolerance) || !(r.limit_distance > kLimitDistance))
-    throw CliError(kExitError, where + "the hands do not reach the box within the joint limits (error " +
-                                   fmt(r.ik_error) + ", closest limit " + fmt(r.limit_distance) + " rad)");
-  return q;
+    d.limit_distance = std::min({d.limit_distance, p.q[j] - model.joint(j).lower, model.joint(j).upper - p.q[j]});
+  if (!(d.hand_error < kPostureTolerance))
+    in.fail(childPath(path, "q"),
+            "the hands are " + fmt(d.hand_error) + " from the box (at most " + fmt(kPostureTolerance) + " m or rad)");
+  if (!(d.limit_distance > kLimitDistance))
+    in.fail(childPath(path, "q"),
+            "a joint is " + fmt(d.limit_distance) + " rad from its limit (at least " + fmt(kLimitDistance) + ")");
+  return p;
+}
+
+// The postures of models/dual_panda_postures.json (next to the URDF), each checked.
+std::vector<Posture> readPostures(const ReportCommand& report, const Model& model,
+                                  std::vector<PostureDetail>& details) {
+  const std::string file =
+      (std::filesystem::path(modelsDirectory(report.args, kPosturesFile)) / kPosturesFile).string();
+  const JsonReader in(file);
+  std::string text;
+  try {
+    text = readFile(file, kMaxInputBytes);
+  } catch (const CliError& e) {
+    throw CliError(kExitError, report.name + ": " + e.what() + " (use --models DIR)");
+  }
+  const Json root = parseJson(text, file);
+  const Json& object = in.object(root, "", {"about", "model", "postures"});
+  for (const char* key : {"model", "postures"})
+    if (!object.contains(key)) in.fail(key, "missing");
+  if (in.string(object["model"], "model") != "dual_panda.urdf") in.fail("model", "not dual_panda.urdf");
+  const Json& postures = in.array(object["postures"], "postures");
+  if (postures.empty()) in.fail("postures", "no postures");
+  std::vector<Posture> result;
+  for (std::size_t k = 0; k < postures.size(); ++k) {
+    details.emplace_back();
+    result.push_back(readPosture(model, in, postures[k], childPath("postures", k), details.back()));
+  }
+  return result;
+}
+
+// readPostures with its errors as the report's ("energy: FILE: FIELD: what").
+std::vector<Posture> checkedPostures(const ReportCommand& report, const Model& model,
+                                     std::vector<PostureDetail>& details) {
+  try {
+    return readPostures(report, model, details);
+  } catch (const CliError& e) {
+    const std::string message = e.what();
+    if (message.rfind(report.name + ": ", 0) == 0) throw;
+    throw CliError(e.exitCode(), report.name + ": " + message);
+  }
 }
 
 // τ_c = Σ Jᵀ A ν from the frames' Jacobians, independently of the solver's sweeps.
@@ -169,7 +214,7 @@ void checkVariant(const Model& model, Workspace& check_ws, const Eigen::VectorXd
 energy::PostureResult run(const Model& model, const Posture& posture, PostureDetail& d) {
   energy::PostureResult r;
   r.name = posture.name;
-  r.q = solvePosture(model, posture, d);
+  r.q = posture.q;
   const std::string where = std::string("energy: dual arm, posture ") + posture.name + ": ";
   int loop_row = 0;
   const Task task = holdBoxTask(model, loop_row);
@@ -219,14 +264,12 @@ Model loadDualPanda(const ReportCommand& report, std::filesystem::path& urdf) {
   return model;
 }
 
-// The dual arm holding the box still in each posture of kPostures.
+// The dual arm holding the box still in each posture of the postures file.
 class DualArmScenario final : public Scenario {
  public:
-  explicit DualArmScenario(const ReportCommand& report) : model_(loadDualPanda(report, urdf_)) {
-    for (const Posture& posture : kPostures) {
-      details_.emplace_back();
-      postures_.push_back(run(model_, posture, details_.back()));
-    }
+  explicit DualArmScenario(const ReportCommand& report)
+      : model_(loadDualPanda(report, urdf_)), placements_(checkedPostures(report, model_, details_)) {
+    for (std::size_t p = 0; p < placements_.size(); ++p) postures_.push_back(run(model_, placements_[p], details_[p]));
   }
   ScenarioFiles files() const override {
     return {{"dual_energy.csv"},
@@ -254,8 +297,9 @@ class DualArmScenario final : public Scenario {
 
   std::filesystem::path urdf_;
   Model model_;
+  std::vector<PostureDetail> details_;  // before placements_: readPostures fills it
+  std::vector<Posture> placements_;
   std::vector<energy::PostureResult> postures_;
-  std::vector<PostureDetail> details_;
 };
 
 // The same two charts as the Panda's (energy.gp), in the same style.
@@ -296,9 +340,10 @@ void DualArmScenario::printPostures() const {
   std::vector<std::vector<std::string>> postures{
       {"posture", "what", "torso", "box x", "y", "z", "hand error", "closest limit"}};
   for (std::size_t p = 0; p < postures_.size(); ++p) {
-    const Posture& posture = kPostures[p];
-    postures.push_back({posture.name, posture.what, fmt(posture.torso), fmt(posture.box[0]), fmt(posture.box[1]),
-                        fmt(posture.box[2]), small(details_[p].ik_error), fmt(details_[p].limit_distance, "%.3f")});
+    const Posture& posture = placements_[p];
+    postures.push_back({posture.name, posture.what, fmt(posture.box.torso), fmt(posture.box.centre.x()),
+                        fmt(posture.box.centre.y()), fmt(posture.box.centre.z()), small(details_[p].hand_error),
+                        fmt(details_[p].limit_distance, "%.3f")});
   }
   printColumns(postures, 2);
 

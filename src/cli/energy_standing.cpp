@@ -21,15 +21,12 @@
 //     the maximiser with the least ‖τ_control‖² within margin·f_j. The split
 //     moves with μ, so this is not max(0, |τ_j| − margin·f_j) joint by joint
 //     as on the Panda.
-// Checked before anything is written, per posture and variant, within 1e-9:
-// rank nv and |q̈|; RNEA with the ground wrenches (ν of the contacts) on the
-// feet gives 0 on the base and τ_control − μ on the joints; ν is the
-// least-norm solution of the dense balance Gᵀν = RNEA(q, 0, 0) + [0; μ]
-// (G from frameJacobian, Eigen's complete orthogonal decomposition: the
-// dense balance of standing_reference.hpp); with friction, |μ_j| ≤
-// margin·f_j and ‖τ_control‖² is not above the plain one. That the pick is
-// the least ‖τ_control‖² over the margin box is the tests' to show
-// (test_cli_standing rechecks its optimality conditions), not the tool's.
+// Checked before anything is written: rank nv in every solve (else q̈ is not
+// determined and the report means nothing), and ‖τ_control‖² with friction
+// not above the plain one (the effort table's "check"). That the solver's
+// answer is right (q̈ = 0, RNEA with the ground's wrenches, the least-norm
+// split, |μ_j| ≤ margin·f_j, the least ‖τ_control‖² over the margin box) is
+// the tests' to show (test_cli_standing), not the tool's.
 //
 // The postures are chosen (kHumanoidPostures, kSoloPostures). The base is
 // placed from the legs' kinematics (framePose): the feet on z = 0 (the
@@ -62,7 +59,6 @@ namespace {
 
 using energy::small;
 
-constexpr double kCheckTolerance = 1e-9;       // the checks: torques [N·m], forces [N], accelerations [rad/s², m/s²]
 constexpr double kPlacementTolerance = 1e-12;  // feet off z = 0 or off level after placing the base [m, rad]:
                                                // a few transforms of numbers below 1 round to ~1e-16
 constexpr double kLimitDistance = 0.05;        // every joint at least this far inside its limits [rad]
@@ -180,7 +176,7 @@ struct PostureDetail {
   double mass = 0;                                // [kg], from RNEA's base force
   std::array<VariantDetail, energy::kVariantCount> variant;
   int rank = 0;
-  double worst_qdd = 0, worst_rnea = 0, worst_split = 0, worst_bound = 0, split_shift = 0;
+  double split_shift = 0;
   standing::BestSplit best_split;  // plain: the least ‖τ_control‖² over every split of the ground's force
 };
 
@@ -293,26 +289,6 @@ Task standingTask(const Model& model, const StandingRobot& robot) {
   return task;
 }
 
-void checkVariant(const Model& model, Workspace& ws, const StandingRobot& robot, const Eigen::VectorXd& q,
-                  const standing::DenseBalance& dense, const Eigen::VectorXd& breakaway, int v,
-                  const Solution& solution, const energy::VariantResult& e, PostureDetail& r) {
-  const int n = model.dof(), kb = model.baseVelocitySize();
-  const energy::Variant& variant = energy::kVariants[v];
-  VariantDetail& g = r.variant[static_cast<std::size_t>(v)];
-  // The ground's wrenches hold the robot; the joints feel τ_control − μ.
-  const Eigen::VectorXd needed = standing::torquesWithGround(model, ws, robot.feet, robot.contact_rows, q, g.ground);
-  r.worst_rnea = std::max({r.worst_rnea, needed.head(kb).cwiseAbs().maxCoeff(),
-                           (needed.tail(n) - (e.tau - e.mu)).cwiseAbs().maxCoeff(),
-                           solution.tau_control.head(kb).cwiseAbs().maxCoeff()});
-  // ν is the least-norm solution of the dense balance.
-  Eigen::VectorXd rhs = dense.gravity;
-  rhs.tail(n) += e.mu;
-  r.worst_split = std::max(r.worst_split, (dense.Gt.solve(rhs) - solution.nu).cwiseAbs().maxCoeff());
-  if (variant.margin < 0) return;
-  // Friction: inside the margin box.
-  r.worst_bound = std::max(r.worst_bound, (e.mu.cwiseAbs() - variant.margin * breakaway).maxCoeff());
-}
-
 // Whether the friction-aware picks' ‖τ_control‖² are not above plain's (μ = 0 is in the box).
 bool effortsOrdered(const energy::PostureResult& s) {
   bool ordered = true;
@@ -345,13 +321,10 @@ energy::PostureResult runPosture(const Model& model, const StandingRobot& robot,
     s.variant[k] = energy::variantResult(variant, ws.solution.tau_control.tail(n), ws);
     r.variant[k].ground = ws.solution.nu.head(contacts);
     r.rank = ws.solution.balance.rank;
-    r.worst_qdd = std::max(r.worst_qdd, ws.solution.qdd.cwiseAbs().maxCoeff());
-    checkVariant(model, check_ws, robot, s.q, dense, breakaway, v, ws.solution, s.variant[k], r);
   }
   // How far the split moved with friction: the joints' τ_control − μ at margin 1 against plain (0 for a fixed split).
   r.split_shift = ((s.variant[2].tau - s.variant[2].mu) - s.variant[0].tau).cwiseAbs().maxCoeff();
-  s.ok = r.rank == model.nv() && r.worst_qdd < kCheckTolerance && r.worst_rnea < kCheckTolerance &&
-         r.worst_split < kCheckTolerance && r.worst_bound < kCheckTolerance && effortsOrdered(s);
+  s.ok = r.rank == model.nv() && effortsOrdered(s);
   return s;
 }
 
@@ -573,18 +546,12 @@ void printLeastEffort(const RobotResult& robot) {
 }
 
 void printChecks(const RobotResult& robot) {
-  double worst[5] = {0, 0, 0, 0, 0};
-  for (const PostureDetail& p : robot.details) {
-    const double values[5] = {p.worst_qdd, p.worst_rnea, p.worst_split, p.worst_bound, p.split_shift};
-    for (int k = 0; k < 5; ++k) worst[k] = std::max(worst[k], values[k]);
-  }
+  double shift = 0;
+  for (const PostureDetail& p : robot.details) shift = std::max(shift, p.split_shift);
   std::printf(
-      "check: rank %d in every solve; within 1e-9: |qdd| (worst %s), RNEA with the ground's wrenches on the feet\n"
-      "gives 0 on the base and tau_control - mu on the joints (worst %s), nu = the least-norm solution of the\n"
-      "dense balance G^T nu = RNEA + [0; mu] (worst %s), |mu| <= margin*f (worst excess %s); |tau|^2 not above\n"
-      "plain's. The split moves with friction: tau_control - mu at margin 1 differs from plain by up to %s N·m\n",
-      robot.model.nv(), small(worst[0]).c_str(), small(worst[1]).c_str(), small(worst[2]).c_str(),
-      small(worst[3]).c_str(), fmt(worst[4], "%.3g").c_str());
+      "check: rank %d in every solve; |tau|^2 not above plain's. The split moves with friction: tau_control - mu\n"
+      "at margin 1 differs from plain by up to %s N·m\n",
+      robot.model.nv(), fmt(shift, "%.3g").c_str());
 }
 
 void printRobot(const RobotResult& robot) {

@@ -33,19 +33,6 @@ Eigen::MatrixXd balanceTranspose(const Model& model, Workspace& ws, const std::v
 
 }  // namespace
 
-Eigen::VectorXd torquesWithGround(const Model& model, Workspace& ws, const std::vector<std::string>& feet,
-                                  int contact_rows, const Eigen::VectorXd& q, const Eigen::VectorXd& ground) {
-  Task loaded(model);
-  for (std::size_t k = 0; k < feet.size(); ++k) {
-    Vec6 w = Vec6::Zero();
-    w.head(contact_rows) = ground.segment(contact_rows * static_cast<Eigen::Index>(k), contact_rows);
-    loaded.wrench(loaded.addWrench(feet[k], Expressed::World)) = w;
-  }
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
-  require(inverseDynamics(model, ws, q, zero, zero, loaded), "energy: RNEA: ");
-  return ws.tau;
-}
-
 DenseBalance denseBalance(const Model& model, Workspace& ws, const std::vector<std::string>& feet, int contact_rows,
                           const Eigen::VectorXd& q, const std::string& context) {
   const int n = model.dof();

@@ -1,7 +1,6 @@
-// The dense reference the standing report compares the solver against
-// (energy_standing.cpp): the standing balance written densely from the feet's
-// Jacobians and RNEA, independently of the solver's sweeps, with what the
-// report prints from it: the best split of the ground's force.
+// The standing balance written densely from the feet's Jacobians and RNEA,
+// independently of the solver's sweeps, for what the standing report
+// (energy_standing.cpp) prints from it: the best split of the ground's force.
 #pragma once
 
 #include <string>
@@ -29,11 +28,6 @@ struct DenseBalance {
   Eigen::VectorXd tau0;     // τ_control(0)
 };
 
-// RNEA with the ground wrenches on the feet: the generalized force the
-// motors and friction must supply for q̈ = 0 (0 on the base when the ground
-// carries the robot).
-Eigen::VectorXd torquesWithGround(const Model& model, Workspace& ws, const std::vector<std::string>& feet,
-                                  int contact_rows, const Eigen::VectorXd& q, const Eigen::VectorXd& ground);
 // The balance at q for `feet` with contact_rows rows each (6: force and
 // moment, 3: force), every joint with a joint row.
 DenseBalance denseBalance(const Model& model, Workspace& ws, const std::vector<std::string>& feet, int contact_rows,

@@ -1419,6 +1419,50 @@ TEST_CASE("energy: a models directory without dual_panda.urdf writes nothing", "
   CHECK_FALSE(cli_test::fileExists(out + "/dual_energy.csv"));
 }
 
+// The dual arm's postures are data (models/dual_panda_postures.json): a posture
+// whose hands miss the box, or a file without them, is refused naming file and field.
+TEST_CASE("energy: a bad dual-arm postures file is refused, naming the file and the field", "[energy]") {
+  const std::string models = cli_test::scratchDir() + "/bad-postures-models";
+  const std::string out = cli_test::scratchDir() + "/en-bad-postures";
+  std::filesystem::create_directories(models);
+  for (const char* file : {"panda.urdf", "dual_panda.urdf"})
+    std::filesystem::copy_file(std::string(ZWANG_MODELS_DIR) + "/" + file, models + "/" + file,
+                               std::filesystem::copy_options::overwrite_existing);
+  const std::string postures = models + "/dual_panda_postures.json";
+  Json file = Json::parse(cli_test::readText(std::string(ZWANG_MODELS_DIR) + "/dual_panda_postures.json"));
+  SECTION("a hand off the box") {
+    file["postures"][2]["q"][4] = file["postures"][2]["q"][4].get<double>() + 1e-3;
+    cli_test::writeText(postures, file.dump());
+    const Run r = run({"energy", "--models", models, "--out", out, "--no-plots"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "zwang: energy: " + postures + ": postures[2].q: the hands are "));
+  }
+  SECTION("a joint near its limit") {
+    file["postures"][0]["q"][0] = -1.5;  // torso at -1.5 rad of ±π/2, the box turned with it
+    file["postures"][0]["torso"] = -1.5;
+    cli_test::writeText(postures, file.dump());
+    const Run r = run({"energy", "--models", models, "--out", out, "--no-plots"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "zwang: energy: " + postures + ": postures[0].q: a joint is "));
+  }
+  SECTION("a q of the wrong length") {
+    file["postures"][1]["q"].erase(0);
+    cli_test::writeText(postures, file.dump());
+    const Run r = run({"energy", "--models", models, "--out", out, "--no-plots"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "zwang: energy: " + postures + ": postures[1].q: "));
+  }
+  SECTION("no file") {
+    std::filesystem::remove(postures);
+    const Run r = run({"energy", "--models", models, "--out", out, "--no-plots"});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, "zwang: energy: " + postures + ": cannot read the file"));
+    CHECK(contains(r.err, "(use --models DIR)"));
+  }
+  CHECK_FALSE(cli_test::fileExists(out + "/panda_energy.csv"));
+  CHECK_FALSE(cli_test::fileExists(out + "/dual_energy.csv"));
+}
+
 TEST_CASE("energy without gnuplot keeps the CSV and says so", "[energy]") {
   const std::string out = cli_test::scratchDir() + "/energy-nognuplot";
   const std::string empty_bin = cli_test::scratchDir() + "/empty-bin-energy";

@@ -143,6 +143,26 @@ double kktResidual(const EffortMap& map, const Eigen::VectorXd& mu, const Eigen:
   return (mu - (mu - gradient).cwiseMax(-bound).cwiseMin(bound)).cwiseAbs().maxCoeff();
 }
 
+// The worst |q̈| of the solver's answer to the standing task (the feet's contact
+// rows, one row per joint) at rest: the rows make it 0, as the tool takes it.
+double worstQdd(const zwang::Model& model, const Robot& robot, const Eigen::VectorXd& q, double margin,
+                const Eigen::VectorXd& breakaway) {
+  zwang::Task task(model);
+  const zwang::ConstraintMatrix rows = zwang::ConstraintMatrix::Identity(6, 6).leftCols(robot.contact_rows);
+  for (const std::string& foot : robot.feet) task.addContact(foot, rows, zwang::Expressed::World);
+  for (int j = 0; j < model.dof(); ++j) task.addJointConstraint(j);
+  zwang::Workspace ws(model, task);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  zwang::FrictionOptions options;
+  options.margin = margin;
+  options.breakaway = breakaway;
+  const zwang::Status s = margin == 0.0 ? zwang::solveHybridDynamics(model, ws, q, zero, zero, task)
+                                        : zwang::solveWithFriction(model, ws, q, zero, zero, task, options);
+  REQUIRE(s.ok());
+  CHECK(ws.solution.balance.rank == model.nv());
+  return ws.solution.qdd.cwiseAbs().maxCoeff();
+}
+
 }  // namespace
 
 TEST_CASE("energy: the humanoid and Solo 12 standing regenerate the committed CSV within 1e-12", "[energy]") {
@@ -207,6 +227,7 @@ TEST_CASE("energy: the humanoid and Solo 12 standing regenerate the committed CS
         const Eigen::VectorXd tau = fresh.at(key + "tau").vector(), mu = fresh.at(key + "mu").vector();
         const Eigen::VectorXd ground = fresh.at(key + "ground").vector();
         REQUIRE(ground.size() == contacts);
+        CHECK(worstQdd(model, robot, q, margins[v], breakaway.vector()) < 1e-9);  // [rad/s², m/s²]
         // The ground holds the robot up, the joints feel τ_control − μ.
         const Eigen::VectorXd needed = torquesWithGround(model, ws, robot, q, ground);
         CHECK(needed.head(kb).cwiseAbs().maxCoeff() < 1e-9);                // [N, N·m]: rounding of sums of ~1e3 N
@@ -255,7 +276,7 @@ TEST_CASE("energy: a models directory without solo12.urdf writes nothing", "[ene
   const std::string models = cli_test::scratchDir() + "/no-solo-models";
   const std::string out = cli_test::scratchDir() + "/en-no-solo";
   std::filesystem::create_directories(models);
-  for (const char* file : {"panda.urdf", "dual_panda.urdf", "simple_humanoid.urdf"})
+  for (const char* file : {"panda.urdf", "dual_panda.urdf", "dual_panda_postures.json", "simple_humanoid.urdf"})
     std::filesystem::copy_file(std::string(ZWANG_MODELS_DIR) + "/" + file, models + "/" + file,
                                std::filesystem::copy_options::overwrite_existing);
   const cli_test::Run r = cli_test::run({"energy", "--models", models, "--out", out, "--no-plots"});

@@ -68,16 +68,16 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
     dofs.push_back(model.dofs()[k].name);
   out["dofs"] = std::move(dofs);
   // Per DOF; a floating base's entries (they come first) go to "base".
-  const int n = model.dof(), nb = model.baseVelocitySize();
+  const int n = model.dof(), base_velocity_size = model.baseVelocitySize();
   out["qdd"] = array(s.qdd.tail(n));
   out["tau_constraint"] = array(s.tau_constraint.tail(n));
   out["tau_control"] = array(s.tau_control.tail(n));
   if (model.hasFloatingBase())
     out["base"] = {{"type", toString(model.baseType())},
-                   {"acceleration", array(s.qdd.head(nb))},
+                   {"acceleration", array(s.qdd.head(base_velocity_size))},
                    {"acceleration_world", array(s.base_acceleration_world)},
-                   {"tau_constraint", array(s.tau_constraint.head(nb))},
-                   {"tau_control", array(s.tau_control.head(nb))}};
+                   {"tau_constraint", array(s.tau_constraint.head(base_velocity_size))},
+                   {"tau_control", array(s.tau_control.head(base_velocity_size))}};
   out["nu"] = array(s.nu);
   out["gauss"] = s.gauss;
   if (with_friction) {

@@ -1404,6 +1404,92 @@ TEST_CASE("energy: the dual arm holding a box regenerates the committed CSV with
   }
 }
 
+namespace {
+
+// The dual arm's hold-still task as docs/evaluation.md states it: the loop
+// (left_tool0 relative to right_tool0, its axes), right_tool0 fixed (world
+// axes), the torso's and each arm's first joint locked (angular z, own axes),
+// half the box's weight on each hand.
+zwang::Task dualHoldTask(const zwang::Model& model) {
+  zwang::Task task(model);
+  const zwang::ConstraintMatrix all = zwang::ConstraintMatrix::Identity(6, 6);
+  REQUIRE(task.addRelativeConstraint("left_tool0", "right_tool0", all, zwang::Expressed::Reference) == 0);
+  task.addConstraint("right_tool0", all, zwang::Expressed::World);
+  for (const char* body : {"torso_link", "left_panda_link1", "right_panda_link1"})
+    task.addConstraint(body, all.rightCols(1), zwang::Expressed::Local);
+  for (const char* hand : {"left_tool0", "right_tool0"})
+    task.wrench(task.addWrench(hand, zwang::Expressed::World)) << 0.0, 0.0, -1.5 * 9.81, 0.0, 0.0, 0.0;
+  return task;
+}
+
+// τ_c = Σ Jᵀ A ν of dualHoldTask's rows from the frames' Jacobians alone: the
+// loop's wrench ν[0..6) (right_tool0's axes) acts on the left hand and, moved
+// to right_tool0's origin, oppositely on the right arm; ν[6..12) on right_tool0
+// (world axes); ν[12..15) are torques about the locked bodies' own z.
+Eigen::VectorXd dualConstraintTorques(const zwang::Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& nu) {
+  zwang::Workspace ws(model, 0);
+  Eigen::MatrixXd left(6, 15), right(6, 15), local(6, 15);
+  Eigen::Isometry3d at_left, at_right;
+  REQUIRE(zwang::frameJacobian(model, ws, q, model.frameIndex("left_tool0"), zwang::Expressed::World, left));
+  REQUIRE(zwang::frameJacobian(model, ws, q, model.frameIndex("right_tool0"), zwang::Expressed::World, right));
+  REQUIRE(zwang::framePose(model, ws, q, model.frameIndex("left_tool0"), at_left));
+  REQUIRE(zwang::framePose(model, ws, q, model.frameIndex("right_tool0"), at_right));
+  const Eigen::Vector3d force = at_right.linear() * nu.head<3>(), moment = at_right.linear() * nu.segment<3>(3);
+  const Eigen::Vector3d lever = at_left.translation() - at_right.translation();
+  zwang::Vec6 on_left, on_right;
+  on_left << force, moment;
+  on_right << -force, -moment - lever.cross(force);
+  Eigen::VectorXd tau = left.transpose() * on_left + right.transpose() * (on_right + nu.segment<6>(6));
+  const char* locked[] = {"torso_link", "left_panda_link1", "right_panda_link1"};
+  for (int k = 0; k < 3; ++k) {
+    REQUIRE(zwang::frameJacobian(model, ws, q, model.frameIndex(locked[k]), zwang::Expressed::Local, local));
+    tau += nu[12 + k] * local.row(5).transpose();
+  }
+  return tau;
+}
+
+}  // namespace
+
+// What the tool no longer checks itself: the hybrid solver's answer to the
+// dual arm's task in each committed posture has q̈ = 0, its τ_control is
+// Σ Jᵀ A ν from the frames' Jacobians (not the solver's tau_constraint) and
+// the committed CSV's, its loop force is the CSV's, and that loop force puts no
+// torque on the torso joint both arms hang from.
+TEST_CASE("energy: the dual arm's solves hold still, tau_c = sum J^T A nu, the loop spares the torso", "[energy]") {
+  std::string header;
+  const auto rows = readEnergyCsv(std::string(ZWANG_ENERGY_DIR) + "/dual_energy.csv", header);
+  REQUIRE(rows.size() == 15);
+  const zwang::Model model = zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/dual_panda.urdf");
+  REQUIRE(model.dof() == 15);
+  const zwang::Task task = dualHoldTask(model);
+  zwang::Workspace ws(model, task);
+  Eigen::VectorXd breakaway(15);
+  for (int j = 0; j < 15; ++j) breakaway[j] = model.joint(j).breakaway_friction;
+  const double margins[3] = {0.0, 0.5, 1.0};
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    INFO(rows[i].pose << ", " << rows[i].variant);
+    const std::vector<double>& w = rows[i].values;
+    const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(w.data(), 15), zero = Eigen::VectorXd::Zero(15);
+    const Eigen::VectorXd tau = Eigen::Map<const Eigen::VectorXd>(w.data() + 15, 15);
+    const Eigen::VectorXd loop = Eigen::Map<const Eigen::VectorXd>(w.data() + 48, 6);
+    zwang::FrictionOptions options;
+    options.margin = margins[i % 3];
+    options.breakaway = breakaway;
+    REQUIRE((i % 3 == 0 ? zwang::solveHybridDynamics(model, ws, q, zero, zero, task)
+                        : zwang::solveWithFriction(model, ws, q, zero, zero, task, options)));
+    REQUIRE(ws.solution.balance.rank == 15);
+    CHECK(ws.solution.qdd.cwiseAbs().maxCoeff() < 1e-9);  // [rad/s²]
+    const Eigen::VectorXd tau_c = dualConstraintTorques(model, q, ws.solution.nu);
+    CHECK((tau_c - tau).cwiseAbs().maxCoeff() < 1e-9);  // [N·m]: τ_control = 0 + τ_c, as in the CSV
+    CHECK((ws.solution.tau_control - tau).cwiseAbs().maxCoeff() < 1e-9);
+    CHECK((ws.solution.nu.head<6>() - loop).cwiseAbs().maxCoeff() < 1e-9);  // [N, N·m]
+    // The loop's force alone: internal, no torque on the torso joint.
+    Eigen::VectorXd loop_only = Eigen::VectorXd::Zero(15);
+    loop_only.head<6>() = loop;
+    CHECK(std::abs(dualConstraintTorques(model, q, loop_only)[0]) < 1e-9);  // [N·m]
+  }
+}
+
 TEST_CASE("energy: a models directory without dual_panda.urdf writes nothing", "[energy]") {
   const std::string models = cli_test::scratchDir() + "/panda-only-models";
   const std::string out = cli_test::scratchDir() + "/en-panda-only";

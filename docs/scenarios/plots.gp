@@ -33,7 +33,7 @@ plot "scenario1.csv" skip 1 using 1:5 with lines linewidth 2 linecolor rgb "#006
 
 # scenario 2: tip force -11 N
 $star_scenario2 << EOD
--10,-0.22222222222222143,-0.44444444444444442,0,-1
+-10,-0.22222222222222143,-0.44444444444444375,0,-0.99999999999999845
 EOD
 set arrow 1 from -10, graph 0 to -10, graph 1 nohead dashtype 2 linecolor rgb "#c00000"
 set output "scenario2_g.png"

@@ -84,16 +84,30 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
     const FrictionResult& f = ws.friction;
     Json states = Json::array();
     for (const JointState state : f.state) states.push_back(toString(state));
+    Json stuck = Json::array();  // DOF indices below the root, as names
+    for (const int j : f.stuck) stuck.push_back(model.dofs()[static_cast<std::size_t>(base_velocity_size + j)].name);
+    const std::string impact = problem::impactDofName(model, f);
     out["friction"] = {{"mu", array(f.mu)},
                        {"state", std::move(states)},
+                       {"tau_friction", array(f.tau_friction)},
+                       {"stuck", std::move(stuck)},
+                       {"gauss_dual", f.gauss_dual},
+                       {"converged", f.converged},
                        {"indeterminate", f.indeterminate},
                        {"iterations", f.iterations},
-                       {"kkt_residual", f.kkt_residual}};
+                       {"kkt_residual", f.kkt_residual},
+                       {"limit_impact", f.limit_impact},
+                       {"impact_joint", impact.empty() ? Json() : Json(impact)}};
   }
+  Json beyond = Json::array();
+  for (const std::string& name : problem::beyondEffortLimit(model, s.tau_control)) beyond.push_back(name);
+  out["effort_exceeded"] = std::move(beyond);
   out["status"] = {{"singular", s.balance.singular},
                    {"rows", s.balance.rows},
                    {"rank", s.balance.rank},
                    {"nu_unique", s.balance.nu_unique},
+                   {"condition", s.balance.condition},
+                   {"damping", s.balance.damping},
                    {"residual", s.balance.residual},
                    {"consistent", s.balance.consistent},
                    {"infeasible", status.code == StatusCode::Infeasible}};

@@ -55,6 +55,9 @@ int runProblem(const char* command, Solver solver, int argc, char** argv) {
 
   const Json solution = solutionJson(bound.model, ws, bound.with_friction, status, bound.reported_frames);
   writeOutput(output, (args.has("--pretty") ? prettyDump(solution) : solution.dump()) + "\n");
+  if (bound.with_friction)
+    if (const std::string impact = problem::limitImpactMessage(bound.model, ws.friction); !impact.empty())
+      std::fprintf(stderr, "zwang: warning: %s: %s\n", problem.file.c_str(), impact.c_str());
   if (!ws.solution.balance.consistent)  // met only in the least-squares sense, or a damped direction gave
     std::fprintf(stderr, "zwang: warning: %s: the task is not met: |A^T Xdd - b| = %.3g (status.consistent = false)\n",
                  problem.file.c_str(), ws.solution.balance.residual);

@@ -275,4 +275,28 @@ std::string outsideLimitsMessage(const Joint& joint, double q, int index) {
          "' outside its limits [" + number(joint.lower) + ", " + number(joint.upper) + "]";
 }
 
+std::vector<std::string> beyondEffortLimit(const Model& model, const Eigen::VectorXd& tau_control) {
+  std::vector<std::string> names;
+  for (std::size_t v = 0; v < model.dofs().size(); ++v) {
+    const Dof& dof = model.dofs()[v];
+    if (dof.joint < 0) continue;  // the floating root is unactuated
+    if (std::abs(tau_control[static_cast<Eigen::Index>(v)]) > model.joint(dof.joint).effort_limit)
+      names.push_back(dof.name);
+  }
+  return names;
+}
+
+std::string impactDofName(const Model& model, const FrictionResult& friction) {
+  if (!friction.limit_impact || friction.impact_joint < 0) return {};
+  return model.dofs()[static_cast<std::size_t>(model.baseVelocitySize() + friction.impact_joint)].name;
+}
+
+std::string limitImpactMessage(const Model& model, const FrictionResult& friction) {
+  const std::string name = impactDofName(model, friction);
+  if (name.empty()) return {};
+  return "joint '" + printable(name, 4000) +
+         "' moves into its limit: stopping it needs an impulse, which the solve does not model "
+         "(friction.limit_impact)";
+}
+
 }  // namespace zwang::problem

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "zwang/zwang.hpp"
 
@@ -135,6 +136,16 @@ inline Status solve(const Model& model, Workspace& ws, const Eigen::Ref<const Ei
 template <class Say>
 void forEachOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q, int q_offset, Say say);
 std::string outsideLimitsMessage(const Joint& joint, double q, int index);
+
+// The DOFs (Model::dofs() names) whose |τ_control| exceeds their joint's
+// effort limit (URDF <limit effort>): reported, not enforced.
+std::vector<std::string> beyondEffortLimit(const Model& model, const Eigen::VectorXd& tau_control);
+
+// The name of the DOF a friction solve found moving into its limit
+// (FrictionResult::impact_joint, an index below the root), and the warning
+// that says so; empty when there is none.
+std::string impactDofName(const Model& model, const FrictionResult& friction);
+std::string limitImpactMessage(const Model& model, const FrictionResult& friction);
 
 template <class Say>
 void forEachOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q, int q_offset, Say say) {

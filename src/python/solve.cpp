@@ -20,6 +20,7 @@ const Vec3 kDefaultGravity(0.0, 0.0, -9.81);
 // The code of a solve's q outside a joint's limits in Result.warnings (the
 // task's warnings have their WarningCode's name).
 const char* const kOutsideLimits = "outside_limits";
+const char* const kLimitImpact = "limit_impact";
 
 PyWorkspace& workspaceArg(const std::shared_ptr<Model>& model, py::handle ws_obj) {
   if (!py::isinstance<PyWorkspace>(ws_obj))
@@ -663,6 +664,9 @@ void addFrictionProperties(py::class_<Result>& cls) {
                              [](const Result& r) { return r.with_friction && r.friction().indeterminate; })
       .def_property_readonly("limit_impact",
                              [](const Result& r) { return r.with_friction && r.friction().limit_impact; })
+      .def_property_readonly(
+          "effort_exceeded",
+          [](const Result& r) { return problem::beyondEffortLimit(*r.model, r.solution().tau_control); })
       .def_property_readonly("impact_joint",
                              [](const Result& r) { return r.with_friction ? r.friction().impact_joint : -1; });
 }
@@ -743,6 +747,9 @@ Result solvePython(std::shared_ptr<Model> model, py::object ws_obj, py::handle q
   Result r;
   for (const ModelWarning& w : a.task.warnings()) warnOnce(model, r, toString(w.code), -1, w.message);
   warnOutsideLimits(model, a.q, r);
+  if (a.friction)
+    if (const std::string impact = problem::limitImpactMessage(*model, a.pw.ws->friction); !impact.empty())
+      warnOnce(model, r, kLimitImpact, a.pw.ws->friction.impact_joint, impact);
   r.model = std::move(model);
   r.owner = std::move(ws_obj);
   r.live = &a.pw;

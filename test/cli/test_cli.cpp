@@ -142,6 +142,22 @@ TEST_CASE("Panda holds its tool still: the tool does not move; the tool and the 
     CHECK(s["friction"]["state"][static_cast<std::size_t>(j)] ==
           zwang::toString(ws.friction.state[static_cast<std::size_t>(j)]));
   CHECK(s["friction"]["indeterminate"] == ws.friction.indeterminate);
+  // Every result the library holds (issue #27 item 3), and what each means.
+  same(s["friction"]["tau_friction"], ws.friction.tau_friction);
+  std::vector<std::string> stuck;
+  for (const int j : ws.friction.stuck) stuck.push_back(model.joint(j).name);  // fixed base: DOF j is joint j
+  CHECK(s["friction"]["stuck"].get<std::vector<std::string>>() == stuck);
+  CHECK(stuck.size() == 7);  // at rest every joint is stuck
+  CHECK(s["friction"]["gauss_dual"].get<double>() == Approx(ws.friction.gauss_dual).margin(1e-12));
+  CHECK(s["friction"]["converged"] == true);
+  CHECK(s["friction"]["limit_impact"] == false);
+  CHECK(s["friction"]["impact_joint"].is_null());
+  CHECK(s["status"]["condition"].get<double>() == Approx(ws.solution.balance.condition).epsilon(1e-12));
+  CHECK(s["status"]["damping"].get<double>() == ws.solution.balance.damping);
+  std::vector<std::string> beyond;  // |τ_control| over the URDF's <limit effort>, recomputed here
+  for (int j = 0; j < 7; ++j)
+    if (std::abs(ws.solution.tau_control[j]) > model.joint(j).effort_limit) beyond.push_back(model.joint(j).name);
+  CHECK(s["effort_exceeded"].get<std::vector<std::string>>() == beyond);
   // friction within its bounds
   for (int j = 0; j < 7; ++j)
     CHECK(std::abs(s["friction"]["mu"][static_cast<std::size_t>(j)].get<double>()) <=
@@ -156,7 +172,7 @@ TEST_CASE("No friction section: the plain solver, no friction key", "[golden]") 
   std::vector<std::string> keys;
   for (const auto& item : s.items()) keys.push_back(item.key());
   CHECK(keys == std::vector<std::string>{"joints", "dofs", "qdd", "tau_constraint", "tau_control", "nu", "gauss",
-                                         "status", "frames"});
+                                         "effort_exceeded", "status", "frames"});
   CHECK(s["dofs"] == s["joints"]);  // one-DOF joints: a DOF is named as its joint
   // friction disabled explicitly: the same
   const Json d = solve(problem("arm_friction_disabled.json"));
@@ -585,6 +601,35 @@ TEST_CASE("A planar root joint (planar_cart.urdf, \"base\" type planar): the too
   const Json s2 = solve(file);
   CHECK(s2["base"]["tau_control"][0].get<double>() == 5.0);
   CHECK(s2["base"]["acceleration"][0].get<double>() > s["base"]["acceleration"][0].get<double>());
+}
+
+TEST_CASE("A joint driven into its limit, and torques beyond the effort limit: reported, with a warning", "[golden]") {
+  // The one-DOF arm at its upper limit (pi), turning into it: friction cannot hold it, a stop would need an
+  // impulse. tau = 150 N·m is beyond the URDF's effort = 100.
+  Json p = parse(cli_test::readText(problem("arm_stick.json")));
+  p["model"] = std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf";
+  p["q"] = Json::array({3.141592653589793});
+  p["qd"] = Json::array({0.5});
+  p["tau"] = Json::array({150});
+  const std::string file = cli_test::scratchDir() + "/arm_into_limit.json";
+  cli_test::writeText(file, p.dump());
+  const Run r = run({"solve", file});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err == "zwang: warning: " + file +
+                     ": joint 'joint1' moves into its limit: stopping it needs an impulse, which the solve does not "
+                     "model (friction.limit_impact)\n");
+  const Json s = parse(r.out);
+  CHECK(s["friction"]["limit_impact"] == true);
+  CHECK(s["friction"]["impact_joint"] == "joint1");
+  CHECK(s["friction"]["stuck"].empty());  // moving: kinetic friction only
+  CHECK(s["effort_exceeded"] == Json::array({"joint1"}));
+  // Moving away from the limit: no impact, no warning.
+  p["qd"] = Json::array({-0.5});
+  cli_test::writeText(file, p.dump());
+  const Json away = solve(file);
+  CHECK(away["friction"]["limit_impact"] == false);
+  CHECK(away["friction"]["impact_joint"].is_null());
 }
 
 TEST_CASE("--pretty and -o give the same numbers", "[golden]") {

@@ -156,3 +156,20 @@ def test_contacts_on_a_bolted_down_humanoid_warn_once_naming_the_free_base():
         warnings.simplefilter("error")
         res = zwang.solve(free, free.workspace(12), qf, constraints=feet)
     assert res.warnings == []
+
+
+def test_a_joint_driven_into_its_limit_warns_and_effort_beyond_the_limit_is_listed():
+    # j1 at its upper limit (1) turning into it: a stop would need an impulse (reported, not modelled).
+    # tau = 8 N·m is beyond the URDF's effort = 5.
+    model = zwang.load_urdf_string(arm())
+    ws = model.workspace()
+    with pytest.warns(zwang.ModelWarning, match=r"joint 'j1' moves into its limit: stopping it needs an impulse"):
+        res = zwang.solve(model, ws, np.array([1.0]), np.array([0.5]), np.array([8.0]), friction=zwang.Friction())
+    assert res.limit_impact and res.impact_joint == 0
+    assert ("limit_impact", "joint 'j1' moves into its limit: stopping it needs an impulse, which the solve does "
+            "not model (friction.limit_impact)") in res.warnings
+    assert res.effort_exceeded == ["j1"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        away = zwang.solve(model, ws, np.array([1.0]), np.array([-0.5]), np.array([1.0]), friction=zwang.Friction())
+    assert not away.limit_impact and away.effort_exceeded == []

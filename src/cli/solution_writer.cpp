@@ -64,8 +64,7 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
   out["joints"] = std::move(joints);
   // The entries of the per-DOF arrays below: a one-DOF joint's name, "<joint>.<coordinate>" for a multi-DOF one.
   Json dofs = Json::array();
-  for (std::size_t k = static_cast<std::size_t>(model.baseVelocitySize()); k < model.dofs().size(); ++k)
-    dofs.push_back(model.dofs()[k].name);
+  for (int k = 0; k < model.dof(); ++k) dofs.push_back(problem::dofName(model, k));
   out["dofs"] = std::move(dofs);
   // Per DOF; a floating base's entries (they come first) go to "base".
   const int n = model.dof(), base_velocity_size = model.baseVelocitySize();
@@ -85,7 +84,7 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
     Json states = Json::array();
     for (const JointState state : f.state) states.push_back(toString(state));
     Json stuck = Json::array();  // DOF indices below the root, as names
-    for (const int j : f.stuck) stuck.push_back(model.dofs()[static_cast<std::size_t>(base_velocity_size + j)].name);
+    for (const int j : f.stuck) stuck.push_back(problem::dofName(model, j));
     const std::string impact = problem::impactDofName(model, f);
     out["friction"] = {{"mu", array(f.mu)},
                        {"state", std::move(states)},

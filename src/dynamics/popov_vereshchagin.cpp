@@ -605,8 +605,8 @@ void columnRuns(const Model& model, const std::vector<int>& dofs, UnitTorqueScra
   Eigen::Index c_begin = unit_torque_count;  // the first column with its DOF's body ≥ i: falls with i
   for (int i = model.nv(); i >= 1; --i) {
     while (c_begin > 0 && bodyOfDof(dofs[at(static_cast<int>(c_begin) - 1)]) >= i) --c_begin;
-    const int end =
-        model.subtreeEnd(i);  // the run ends at the first column beyond the subtree (a chain's: past the last column)
+    // The run ends at the first column beyond the subtree (a chain's: past the last column).
+    const int end = model.subtreeEnd(i);
     s.run_begin[i] = c_begin;
     s.run_end[i] = unit_torque_count == 0 || end > bodyOfDof(dofs.back())
                        ? unit_torque_count

@@ -204,11 +204,14 @@ int addWrench(const Model& model, Task& task, const std::string& frame, Expresse
   return keyed("", [&] { return task.addWrench(f, expressed); });
 }
 
+const std::string& dofName(const Model& model, int dof) {
+  return model.dofs()[static_cast<std::size_t>(model.baseVelocitySize() + dof)].name;
+}
+
 std::string dofLayout(const Model& model) {
   if (model.dof() == static_cast<int>(model.joints().size())) return "one per moving joint: " + jointNames(model);
   std::string list;
-  for (std::size_t k = static_cast<std::size_t>(model.baseVelocitySize()); k < model.dofs().size(); ++k)
-    list += (list.empty() ? "" : ", ") + model.dofs()[k].name;
+  for (int k = 0; k < model.dof(); ++k) list += (list.empty() ? "" : ", ") + dofName(model, k);
   return "one per DOF: " + list;
 }
 
@@ -288,7 +291,7 @@ std::vector<std::string> beyondEffortLimit(const Model& model, const Eigen::Vect
 
 std::string impactDofName(const Model& model, const FrictionResult& friction) {
   if (!friction.limit_impact || friction.impact_joint < 0) return {};
-  return model.dofs()[static_cast<std::size_t>(model.baseVelocitySize() + friction.impact_joint)].name;
+  return dofName(model, friction.impact_joint);
 }
 
 std::string limitImpactMessage(const Model& model, const FrictionResult& friction) {

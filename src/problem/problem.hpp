@@ -100,6 +100,10 @@ int addConstraint(const Spelling& spelling, const Model& model, Task& task, cons
 // A wrench on a frame into `task`; its index. ProblemError keyed "frame".
 int addWrench(const Model& model, Task& task, const std::string& frame, Expressed expressed);
 
+// The name of DOF `dof` counted below the root (an index into q̈'s entries after a floating base's; the
+// friction result's `stuck` and `impact_joint`): a one-DOF joint's name, "<joint>.<coordinate>" for a multi-DOF one.
+const std::string& dofName(const Model& model, int dof);
+
 // What an array of one entry per DOF below the root holds, for messages:
 // "one per moving joint: a, b" (every joint one DOF) or "one per DOF: a, b.x, b.y".
 std::string dofLayout(const Model& model);

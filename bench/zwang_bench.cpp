@@ -530,6 +530,27 @@ void benchOursHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
   setCounters(state, *p, task.constraintRows(), 0);
 }
 
+// Every other joint prescribed at the plain solve's q̈ (the same motion), or the same as joint rows (as_rows):
+// what a prescribed joint costs against the plain solve and against a row.
+void benchHalfPrescribed(benchmark::State& state, const Problem* p, TaskKind kind, bool as_rows) {
+  Task task = taskFromInput(p->model, makeInput(*p, kind, p->qd));
+  Workspace plain(p->model, task);
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, plain, p->q, p->qd, p->tau, task))) return;
+  for (int j = 1; j < p->n; j += 2) {
+    if (as_rows) {
+      task.targets()[task.addJointConstraint(j)] = plain.solution.qdd[j];
+    } else {
+      task.prescribe(j);
+      task.prescribedAccelerations()[j] = plain.solution.qdd[j];
+    }
+  }
+  Workspace ws(p->model, task);
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, ws, p->q, p->qd, p->tau, task))) return;
+  timeHybridSolves(state, *p, task, p->qd, ws);
+  setCounters(state, *p, task.constraintRows(), 0);
+  state.counters["prescribed"] = task.prescribedCount();
+}
+
 // The same on a tree (or its chain, b = 1), with the tree's counters.
 void benchTreeHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
   const Task task = taskFromInput(p->model, makeInput(*p, kind, p->qd));
@@ -941,6 +962,12 @@ int main(int argc, char** argv) {
     for (const auto& p : problems)
       reg(std::string("ours_hd_") + name, *p,
           [q = p.get(), kind = kind](benchmark::State& s) { benchOursHybrid(s, q, kind); });
+  for (const auto& [kind, name] : {std::pair{TaskKind::None, "m0"}, std::pair{TaskKind::Ee1, "m1"}})
+    for (const bool as_rows : {false, true})
+      for (const auto& p : problems)
+        if (p->n > 1)
+          reg(std::string("ours_hd_") + name + (as_rows ? "_halfrows" : "_halfprescribed"), *p,
+              [q = p.get(), kind = kind, as_rows](benchmark::State& s) { benchHalfPrescribed(s, q, kind, as_rows); });
   for (const auto& p : problems) reg("ours_rnea", *p, [q = p.get()](benchmark::State& s) { benchOursRnea(s, q); });
   for (const auto& p : problems) reg("ours_crba", *p, [q = p.get()](benchmark::State& s) { benchOursCrba(s, q); });
   for (const auto& [kind, name] : hd_tasks) {

@@ -18,17 +18,7 @@
 using namespace zwang;
 using namespace zwang::testing;
 
-namespace {
-
-// Kept draws: the KKT system well conditioned and every row reachable (the
-// smallest singular value of G at least 1e-6, as for the fixed base).
-bool wellPosed(const FloatingResult& dense) {
-  const auto rows = static_cast<int>(dense.G.rows());
-  if (!dense.wellConditioned(1e6) || dense.constraint_rank < rows) return false;
-  return rows == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("floating trees: solveHybridDynamics against the dense floating-base reference", "[floating]") {
   std::mt19937_64 rng(20261124);

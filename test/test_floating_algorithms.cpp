@@ -55,15 +55,6 @@ Vector6d atPoint(const Vector6d& s, const Eigen::Vector3d& p, const Eigen::Matri
   return out;
 }
 
-// Kept for the closure with rows (as test_floating): the KKT system well
-// conditioned and every row reachable (G's smallest singular value ≥ 1e-6).
-// Elsewhere the solver's least-squares answer is not the dense one's.
-bool wellPosed(const FloatingResult& dense) {
-  const auto rows = static_cast<int>(dense.G.rows());
-  if (!dense.wellConditioned(1e6) || dense.constraint_rank < rows) return false;
-  return rows == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
-}
-
 // One draw of the comparison below: a random floating problem with three
 // random frames, and a random q̈ (the draws in that order, so the hidden
 // reproduction at the end can replay them).

@@ -152,15 +152,6 @@ FloatingFrictionDraw randomFloatingFrictionDraw(std::mt19937_64& rng) {
   return d;
 }
 
-// As test_floating keeps draws: the KKT system well conditioned (H and the
-// coupling matrix below 1e6) and every row reachable (G of full row rank, its
-// smallest singular value at least 1e-6).
-bool wellPosed(const FloatingResult& dense) {
-  const auto rows = static_cast<int>(dense.G.rows());
-  if (!dense.wellConditioned(1e6) || dense.constraint_rank < rows) return false;
-  return rows == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
-}
-
 // The state a stuck joint must have, from the reference's q̈* (unique) and μ*
 // (when unique); -1 when the reference itself sits within rounding of a
 // boundary between two states (not compared).

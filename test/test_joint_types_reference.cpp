@@ -20,6 +20,7 @@
 
 #include "support/floating_reference.hpp"
 #include "support/friction_reference.hpp"
+#include "support/joint_types_problem.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"
 #include "zwang/zwang.hpp"
@@ -28,14 +29,6 @@ using namespace zwang;
 using namespace zwang::testing;
 
 namespace {
-
-// A random unit quaternion (w x y z), uniform on the sphere.
-Eigen::Vector4d randomQuaternion(std::mt19937_64& rng) {
-  for (;;) {
-    const Eigen::Vector4d quat(gaussian(rng), gaussian(rng), gaussian(rng), gaussian(rng));
-    if (quat.norm() > 1e-6) return quat.normalized();
-  }
-}
 
 // True when some moving joint lies below links[link].
 bool hasMovingDescendant(const ChainSpec& spec, int link) {
@@ -70,81 +63,6 @@ struct Census {
   }
 };
 
-// A random tree (randomTree) whose moving joints become spherical (probability `spherical`), planar (0.1) or free
-// (0.05), anywhere below the root; the rest stay one-DOF. Multi-DOF joints have no limits.
-ChainSpec randomJointTypesTree(std::mt19937_64& rng, int min_moving, int max_moving, double spherical) {
-  RandomTreeOptions options;
-  options.min_moving_joints = min_moving;
-  options.max_moving_joints = max_moving;
-  ChainSpec spec = randomTree(rng, options);
-  spec.name = "joint_types_tree";
-  for (JointSpec& joint : spec.joints) {
-    if (joint.isFixed()) continue;
-    const double u = uniform01(rng);
-    if (u < spherical)
-      joint.type = "spherical";
-    else if (u < spherical + 0.1)
-      joint.type = "planar";
-    else if (u < spherical + 0.15)
-      joint.type = "free";
-    else
-      continue;
-    joint.lower = joint.upper = 0.0;
-  }
-  spec.check();
-  return spec;
-}
-
-FloatingBase randomBase(std::mt19937_64& rng) {
-  FloatingBase base;
-  const double u = uniform01(rng);
-  base.kind = u < 0.4 ? BaseKind::Fixed : u < 0.7 ? BaseKind::Free : BaseKind::Planar;
-  return base;
-}
-
-// q: the base's pose, one-DOF joints inside their limits (±π without), unit quaternions, planar x, y in ±0.5 m
-// and ψ in ±π, free positions in ±1 m. v, τ: entries in ±2 and ±5 (τ 0 on the base).
-void drawState(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& base, FloatingInput& in) {
-  in.q.resize(base.nq(spec));
-  Eigen::Index qi = 0;
-  if (base.kind == BaseKind::Free) {
-    in.q.head<3>() = randomVector(rng, 3, 2.0);
-    in.q.segment<4>(3) = randomQuaternion(rng);
-  } else if (base.kind == BaseKind::Planar) {
-    in.q.head<3>() << uniform(rng, -2.0, 2.0), uniform(rng, -2.0, 2.0), uniform(rng, -3.14159, 3.14159);
-  }
-  qi = base.baseConfigurationSize();
-  for (const int k : spec.movingJoints()) {
-    const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
-    if (joint.isSpherical()) {
-      in.q.segment<4>(qi) = randomQuaternion(rng);
-    } else if (joint.isFree()) {
-      in.q.segment<3>(qi) = randomVector(rng, 3, 1.0);
-      in.q.segment<4>(qi + 3) = randomQuaternion(rng);
-    } else if (joint.isPlanar()) {
-      in.q.segment<3>(qi) << uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5), uniform(rng, -3.14159, 3.14159);
-    } else if (joint.upper > joint.lower && joint.type != "continuous") {
-      const double margin = 0.05 * (joint.upper - joint.lower);
-      in.q(qi) = uniform(rng, joint.lower + margin, joint.upper - margin);
-    } else {
-      in.q(qi) = uniform(rng, -3.14159, 3.14159);
-    }
-    qi += joint.nq();
-  }
-  const int nv = base.nv(spec);
-  in.v = randomVector(rng, nv, 2.0);
-  in.tau = randomVector(rng, nv, 5.0);
-  in.tau.head(base.baseVelocitySize()).setZero();
-}
-
-// The task's rows well posed (the KKT system conditioned below 1e6, G of full row rank, smallest singular value at
-// least 1e-6), as test_floating keeps its draws.
-bool wellPosed(const FloatingResult& dense) {
-  const auto rows = static_cast<int>(dense.G.rows());
-  if (!dense.wellConditioned(1e6) || dense.constraint_rank < rows) return false;
-  return rows == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
-}
-
 // One joint row per DOF of a random moving joint (Task::addJointConstraint on a multi-DOF joint adds one per DOF):
 // the reference's rows (a joint row per DOF index) and the joint's name, for the task.
 struct JointRows {
@@ -152,34 +70,6 @@ struct JointRows {
   int first_dof = 0, dofs = 0;
   Eigen::VectorXd b;
 };
-
-// Friction data for n DOFs, to be filled.
-FrictionSetup sizedFrictionSetup(int n) {
-  FrictionSetup setup;
-  setup.breakaway.resize(n);
-  setup.kinetic.resize(n);
-  setup.viscous.resize(n);
-  return setup;
-}
-
-// Every joint DOF (after the base's) moving at 0.1–2 either way.
-void moveEveryDof(std::mt19937_64& rng, int base_velocity_size, int n, FloatingInput& in) {
-  for (int k = 0; k < n; ++k)
-    in.v(base_velocity_size + k) = (uniform01(rng) < 0.5 ? -1.0 : 1.0) * uniform(rng, 0.1, 2.0);
-}
-
-// A random state of the tree on `base` with the loads and frame rows of randomProblem (its q unused), in that
-// order of draws.
-FloatingInput loadedInput(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& base,
-                          const RandomProblemOptions& options) {
-  const DynamicsInput loads = randomProblem(rng, spec, options);
-  FloatingInput in;
-  drawState(rng, spec, base, in);
-  in.gravity = loads.gravity;
-  in.wrenches = loads.wrenches;
-  in.constraints = loads.constraints;
-  return in;
-}
 
 JointRows randomJointRows(std::mt19937_64& rng, const ChainSpec& spec) {
   const std::vector<int> moving = spec.movingJoints();

@@ -54,6 +54,7 @@
 #include <catch2/catch.hpp>
 
 #include "support/floating_reference.hpp"
+#include "support/joint_types_problem.hpp"
 #include "support/mjcf_writer.hpp"
 #include "support/mujoco_bridge.hpp"
 #include "support/random_chain.hpp"
@@ -78,15 +79,6 @@ enum class Conversion {
   FreeJointLinearInBody,  // a free spec joint's linear qvel taken as body axes (T = 1 on it)
   FreeArmatureAsOurs,     // MuJoCo's armature on a free joint's translations taken as zwang's (no correction)
 };
-
-// A random unit quaternion (w x y z), uniform on the sphere: a normalised Gaussian 4-vector.
-Eigen::Vector4d randomQuaternion(std::mt19937_64& rng) {
-  for (;;) {
-    const double w = gaussian(rng), x = gaussian(rng), y = gaussian(rng), z = gaussian(rng);
-    const Eigen::Vector4d quat(w, x, y, z);
-    if (quat.norm() > 1e-6) return quat.normalized();
-  }
-}
 
 // The joint types of a draw, in the order of the summary.
 struct Census {

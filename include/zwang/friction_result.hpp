@@ -14,8 +14,9 @@ enum class JointState {
   SlipPositive,  ///< stuck, breaks away positively: q̈ > 0, μ = +f
   SlipNegative,  ///< stuck, breaks away negatively: q̈ < 0, μ = −f
   AtLimit,       ///< stuck on a position limit that pushes back beyond friction
+  Prescribed,    ///< its q̈ is the task's (Task::prescribe): no friction unknown; kinetic friction when moving
 };
-/// The name used in JSON and tables: "moving", "stick", "slip+", "slip-" or "at-limit".
+/// The name used in JSON and tables: "moving", "stick", "slip+", "slip-", "at-limit" or "prescribed".
 const char* toString(JointState state);
 
 /// What solveWithFriction reports besides the motion (Workspace::friction).

@@ -6,6 +6,7 @@
 /// every control cycle (this does not).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
@@ -58,6 +59,13 @@ struct BalanceOptions {
 /// BadOption naming the field when an option is out of range (every solve
 /// checks the task's options this way).
 Status checkBalanceOptions(const BalanceOptions& options);
+
+/// How a DOF moves in a solve: joint-level hybrid dynamics (docs/solver.md,
+/// "Prescribed and locked joints").
+enum class DofMode : std::uint8_t {
+  Torque,      ///< driven by its entry of τ (the default): the solve finds its q̈
+  Prescribed,  ///< its q̈ is given (Task::prescribedAccelerations): the solve finds the torque it takes
+};
 
 /// What a solve is asked to do besides the joint state: see the file comment.
 class Task {
@@ -122,6 +130,45 @@ class Task {
   int addWrench(int frame, Expressed expressed = Expressed::Local);
   /// The same, with the frame given by name (ModelError for an unknown name).
   int addWrench(const std::string& frame, Expressed expressed = Expressed::Local);
+
+  /// Prescribe the acceleration of moving joint `joint` (an index in
+  /// Model::joints()): each of its DOFs moves with the q̈ its entries of
+  /// prescribedAccelerations() hold (set them every cycle, as the set points),
+  /// and the solve returns the torque that takes, in Solution::tau_control
+  /// (tau_constraint: that torque less the given τ, which a prescribed DOF
+  /// does not read). The sweeps pass such a joint rigidly: no row, no growth
+  /// of the balance. A prescribed DOF has no friction unknown (its torque is
+  /// what its motor must give; a moving one's kinetic friction is in it).
+  /// ModelError for an index out of range or a mimic joint (prescribe its
+  /// leader). Changing modes allocates nothing.
+  void prescribe(int joint);
+  /// The same, with the joint given by name (ModelError for an unknown name).
+  void prescribe(const std::string& joint);
+  /// Prescribe q̈ = 0 on every DOF of `joint` (its entries of
+  /// prescribedAccelerations() are set to 0): the joint is held where it is.
+  void lock(int joint);
+  /// The same, with the joint given by name (ModelError for an unknown name).
+  void lock(const std::string& joint);
+  /// Make `joint` torque-driven again (the default).
+  void release(int joint);
+  /// The same, with the joint given by name (ModelError for an unknown name).
+  void release(const std::string& joint);
+  /// The mode of one DOF, an entry of v (a floating base's come first: a
+  /// base DOF may be prescribed too, a robot on a moving platform). ModelError
+  /// for an index out of range or a mimic joint's DOF.
+  void setDofMode(int dof, DofMode mode);
+  /// The mode of DOF `dof` (an entry of v).
+  DofMode dofMode(int dof) const { return dof_modes_.at(static_cast<std::size_t>(dof)); }
+  /// The modes of all DOFs, entries of v in order.
+  const std::vector<DofMode>& dofModes() const { return dof_modes_; }
+  /// How many DOFs are prescribed.
+  int prescribedCount() const { return prescribed_count_; }
+  /// q̈ of the prescribed DOFs, one entry per entry of v (nv; the entries of
+  /// torque-driven DOFs are not read). Starts at zero. Its size is the
+  /// model's: a solve refuses any other (SizeMismatch).
+  Eigen::VectorXd& prescribedAccelerations() { return prescribed_qdd_; }
+  /// q̈ of the prescribed DOFs, read-only.
+  const Eigen::VectorXd& prescribedAccelerations() const { return prescribed_qdd_; }
 
   /// Set points b (true accelerations, gravity is handled inside), one per
   /// constraint row. Set their values freely (`targets() << …`, `setZero()`,
@@ -211,9 +258,15 @@ class Task {
   std::vector<Mimic> mimic_laws_;                // the law of each mimic row (its mimic joint below)
   std::vector<int> mimic_joint_of_row_;
   std::vector<AppliedWrench> wrenches_;
+  std::vector<DofMode> dof_modes_;  // per entry of v
+  std::vector<char> mimic_dof_;     // per entry of v: a mimic joint's (never prescribed)
+  int prescribed_count_ = 0;
+  Eigen::VectorXd prescribed_qdd_;  // per entry of v
   Eigen::VectorXd b_;
   int rows_ = 0;  // the constraint rows added; b_ must keep this size
   void growTargets(int rows);
+  int jointIndex(const std::string& joint) const;
+  std::pair<int, int> jointDofs(int joint) const;
   void addMimicRows(const Model& model);
   void reorder();
 };

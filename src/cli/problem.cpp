@@ -102,6 +102,33 @@ ConstraintSpec parseConstraint(const JsonReader& in, const Json& value, const st
   return c;
 }
 
+// "joint_modes": {"<joint or DOF>": "torque" | "locked" | {"acceleration": q̈ or [one per DOF]}, …}.
+std::vector<JointModeSpec> parseJointModes(const JsonReader& in, const Json& value, const std::string& path) {
+  if (!value.is_object())
+    in.fail(path, "must be an object of joint names to modes (\"locked\", \"torque\" or {\"acceleration\": …}), got " +
+                      describe(value));
+  std::vector<JointModeSpec> modes;
+  for (const auto& [name, mode] : value.items()) {
+    JointModeSpec m;
+    m.path = childPath(path, name);
+    m.desc.name = name;
+    if (mode.is_string()) {
+      m.desc.kind = atPath(in, m.path, [&] { return problem::parseModeKind(kJson, mode.get<std::string>()); });
+    } else if (mode.is_object()) {
+      in.object(mode, m.path, {"acceleration"});
+      if (!mode.contains("acceleration")) in.fail(m.path, "needs \"acceleration\" (q̈, or one per DOF)");
+      const Json& a = mode["acceleration"];
+      const std::string a_path = childPath(m.path, "acceleration");
+      m.desc.kind = problem::ModeKind::Acceleration;
+      m.desc.acceleration = a.is_array() ? in.numbers(a, a_path) : Eigen::VectorXd::Constant(1, in.number(a, a_path));
+    } else {
+      in.fail(m.path, "must be \"torque\", \"locked\" or {\"acceleration\": …}, got " + describe(mode));
+    }
+    modes.push_back(std::move(m));
+  }
+  return modes;
+}
+
 FrictionSpec parseFriction(const JsonReader& in, const Json& value, const std::string& path) {
   in.object(value, path, {"enabled", "velocity_tolerance", "margin", "limits"});
   FrictionSpec f;
@@ -362,6 +389,8 @@ void buildTask(const JsonReader& in, const Problem& p, BoundProblem& b) {
     if (c.desc.joint.empty()) reportFrame(b, c.desc.frame);
     if (!c.desc.relative_to.empty()) reportFrame(b, c.desc.relative_to);
   }
+  for (const JointModeSpec& mode : p.joint_modes)
+    atPath(in, mode.path, [&] { problem::setJointMode(kJson, m, task, mode.desc); });
   for (const WrenchSpec& w : p.wrenches) {
     const int k = atPath(in, w.path, [&] { return problem::addWrench(m, task, w.frame, w.expressed); });
     task.wrench(k) = w.value;
@@ -378,7 +407,8 @@ Problem readProblem(const std::string& file) {
   if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
   in.object(doc, "",
             {"model", "root", "tip", "strict", "attach_beyond_tip", "lock_mimic", "follow_leaders", "gravity", "q",
-             "qd", "tau", "rotor_inertia", "breakaway", "wrenches", "constraints", "friction", "balance", "base"});
+             "qd", "tau", "rotor_inertia", "breakaway", "wrenches", "constraints", "joint_modes", "friction", "balance",
+             "base"});
 
   Problem p;
   p.file = file;
@@ -411,6 +441,7 @@ Problem readProblem(const std::string& file) {
     for (std::size_t k = 0; k < list.size(); ++k)
       p.constraints.push_back(parseConstraint(in, list[k], childPath("constraints", k)));
   }
+  if (doc.contains("joint_modes")) p.joint_modes = parseJointModes(in, doc["joint_modes"], "joint_modes");
   if (doc.contains("friction")) p.friction = parseFriction(in, doc["friction"], "friction");
   if (doc.contains("balance")) p.balance = parseBalance(in, doc["balance"], "balance");
   if (doc.contains("base")) p.base = parseBase(in, doc["base"], "base");

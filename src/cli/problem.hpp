@@ -51,6 +51,12 @@ struct JointValues {
   bool present() const { return array.has_value() || !named.empty(); }
 };
 
+// One entry of "joint_modes": "<joint or DOF>": "torque" | "locked" | {"acceleration": q̈ or [q̈, …]}.
+struct JointModeSpec {
+  std::string path;  // "joint_modes.<name>"
+  problem::JointModeDesc desc;
+};
+
 // The problem as written, checked for everything that does not need the model.
 struct Problem {
   std::string file;        // the problem file, as given on the command line
@@ -66,6 +72,7 @@ struct Problem {
   std::optional<Eigen::VectorXd> rotor_inertia, breakaway;
   std::vector<WrenchSpec> wrenches;
   std::vector<ConstraintSpec> constraints;
+  std::vector<JointModeSpec> joint_modes;  // "joint_modes", in file order (joints not named: torque-driven)
   FrictionSpec friction;
   BalanceOptions balance;  // "balance" (defaults when absent)
   BaseSpec base;           // "base" (a fixed base when absent, unless the URDF floats: then an error)

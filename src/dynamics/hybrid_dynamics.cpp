@@ -24,6 +24,7 @@ Status solveHybridDynamics(const Model& model, Workspace& ws, const Eigen::Ref<c
   taskResidual(task, ws);  // how well Aᵀ Ẍ = b is met
   publishNu(task, ws);
   constraintTorques(model, task, ws, sw.nu_columns.head(task.solverColumns()), out.tau_constraint);
+  prescribedTorques(model, task, ws, sw.nu_columns.head(task.solverColumns()), out.qdd, tau, out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   out.gauss = gaussFunction(model, task, out.qdd, tau, ws);
   return {};

@@ -79,6 +79,22 @@ Status checkMimicState(const Model& model, const VectorRef& q_all, const VectorR
   return {};
 }
 
+// The prescribed accelerations: a resizable public VectorXd, read only on the prescribed DOFs.
+Status checkPrescribed(const Model& model, const Task& task) {
+  const Eigen::VectorXd& qdd = task.prescribedAccelerations();
+  if (qdd.size() != model.nv())
+    return Status::error(StatusCode::SizeMismatch,
+                         "prescribed accelerations have %ld entries, expected nv = %d "
+                         "(Task::prescribedAccelerations() must keep its size)",
+                         static_cast<long>(qdd.size()), model.nv());
+  if (task.prescribedCount() == 0) return {};
+  for (int v = 0; v < model.nv(); ++v)
+    if (task.dofMode(v) == DofMode::Prescribed && !std::isfinite(qdd[v]))
+      return Status::error(StatusCode::NonFinite, "the prescribed acceleration of '%s' is %g",
+                           model.dofs()[at(v)].name.c_str(), qdd[v]);
+  return {};
+}
+
 // The results a solve writes in place: public vectors a user could resize
 // (or swap out), which the solve would then write past.
 Status checkSolutionSizes(const Model& model, const Solution& out) {
@@ -131,6 +147,7 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
                          "must keep its size)",
                          static_cast<long>(task.targets().size()), task.constraintRows());
   if (Status s = checkFinite("constraint targets b", task.targets()); !s) return s;
+  if (Status s = checkPrescribed(model, task); !s) return s;
   for (int w = 0; w < task.wrenchCount(); ++w)
     if (!task.wrench(w).allFinite())
       return Status::error(StatusCode::NonFinite, "wrench %d (on frame '%s') is not finite", w,
@@ -391,20 +408,78 @@ inline Status jointPivots(const Model& model, int first, int last, const Mat6& I
 
 }  // namespace
 
-Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
-  WorkspaceScratch& sw = scratchOf(ws);
-  const int N = model.nv();
-  const int m = task.solverColumns();
-  sw.U.head(m).setZero();  // U_N = 0
-  sw.L_scale.head(m).setZero();
-  sw.L.topLeftCorner(m, m).setZero();           // 𝓛_N = 0 (only the lower triangle is kept)
-  sw.Ahat.leftCols(m) = sw.A_body.leftCols(m);  // A_i, each column updated in place on its way to the base
-  // Joint by joint from the leaves; body i is a joint's last DOF body.
-  for (int i = N; i >= 1;) {
+namespace {
+
+// Line 20 for a prescribed DOF body i (q̈_i = y given): Aᵀ Ẍ_i = Aᵀ Ẍ_parent + Aᵀ(Ẍ_bias + S y), so U takes
+// Aᵀ(Ẍ_bias + S y), and A_i reaches the parent as it is: no projection (line 19), no term of 𝓛 (line 21).
+inline void prescribedColumnsStep(const Task& task, int i, double y, WorkspaceScratch& sw) {
+  const Vec6 motion = sw.c[at(i)] + sw.S[at(i)] * y;
+  const int first = solverOrder(task).firstColumn(i), columns_end = solverOrder(task).columnsEnd(i);
+  for (int col = first; col < columns_end; ++col) sw.U[col] += sw.Ahat.col(col).dot(motion);
+}
+
+// Lines 16–18 for a prescribed DOF body i: the joint is rigid for the sweep, so the parent takes I^A whole and
+// F^A + I^A(Ẍ_bias + S y) (= p^A + I^A S y). The first child to arrive starts p's sums, as in passToParent.
+inline void passRigidly(const Model& model, int i, const Mat6& IA, const Vec6& pA, double y, WorkspaceScratch& sw) {
+  const int p = model.parent(i);
+  if (p == 0) return;  // the world takes nothing
+  Mat6& IA_parent = sw.IA[at(p)];
+  Vec6& FA_parent = sw.FA[at(p)];
+  if (model.subtreeEnd(i) == model.subtreeEnd(p)) {
+    IA_parent = IA;
+    sw.I[at(p)].addTo(IA_parent);
+    FA_parent = sw.Fbias[at(p)] + pA;
+  } else {
+    IA_parent += IA;
+    FA_parent += pA;
+  }
+  FA_parent.noalias() += IA * (sw.S[at(i)] * y);
+}
+
+// A joint some of whose DOFs are prescribed (bodies [first, last]): its DOF steps one at a time, from the last —
+// each the report's one-DOF step or the rigid pass (the other DOF bodies carry no inertia and no bias, so the
+// steps in a row are the joint's).
+Status mixedJointSteps(const Model& model, const Task& task, int first, int last, const VectorRef& tau,
+                       WorkspaceScratch& sw) {
+  for (int k = last; k >= first; --k) {
+    const Mat6& IA = sw.IA[at(k)];
+    Vec6 pA = sw.FA[at(k)];
+    pA.noalias() += IA * sw.c[at(k)];
+    if (task.dofMode(k - 1) == DofMode::Prescribed) {
+      const double y = task.prescribedAccelerations()[k - 1];
+      prescribedColumnsStep(task, k, y, sw);
+      passRigidly(model, k, IA, pA, y, sw);
+      continue;
+    }
+    sw.IAS[at(k)].noalias() = IA * sw.S[at(k)];
+    if (Status s = pivot(model, k, sw); !s) return s;
+    sw.u[at(k)] = tau[k - 1] - sw.S[at(k)].dot(pA);
+    constraintColumnsStep<true, true>(task, k, sw.u[at(k)] * sw.inverse_D[at(k)], sw);
+    passToParent(model, k, k, IA, pA, sw);
+  }
+  return {};
+}
+
+bool anyPrescribed(const Task& task, int first, int last) {
+  for (int k = first; k <= last; ++k)
+    if (task.dofMode(k - 1) == DofMode::Prescribed) return true;
+  return false;
+}
+
+// The inward sweep joint by joint from the leaves (body i a joint's last DOF body). Without kPrescribed no
+// DOF is prescribed, and the loop has no test for it.
+template <bool kPrescribed>
+Status inwardJoints(const Model& model, const Task& task, const VectorRef& tau, WorkspaceScratch& sw) {
+  for (int i = model.nv(); i >= 1;) {
     const int first = model.jointStart(i);
     if (model.subtreeEnd(i) == i + 1) {  // a leaf: lines 8–9, I^A = I, F^A = F_bias
       sw.IA[at(i)] = sw.I[at(i)].matrix();
       sw.FA[at(i)] = sw.Fbias[at(i)];
+    }
+    if (kPrescribed && anyPrescribed(task, first, i)) {
+      if (Status s = mixedJointSteps(model, task, first, i, tau, sw); !s) return s;
+      i = first - 1;
+      continue;
     }
     const Mat6& IA = sw.IA[at(i)];
     Vec6 pA = sw.FA[at(i)];
@@ -429,6 +504,19 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
     i = first - 1;
   }
   return {};
+}
+
+}  // namespace
+
+Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, Workspace& ws) {
+  WorkspaceScratch& sw = scratchOf(ws);
+  const int m = task.solverColumns();
+  sw.U.head(m).setZero();  // U_N = 0
+  sw.L_scale.head(m).setZero();
+  sw.L.topLeftCorner(m, m).setZero();           // 𝓛_N = 0 (only the lower triangle is kept)
+  sw.Ahat.leftCols(m) = sw.A_body.leftCols(m);  // A_i, each column updated in place on its way to the base
+  return task.prescribedCount() > 0 ? inwardJoints<true>(model, task, tau, sw)
+                                    : inwardJoints<false>(model, task, tau, sw);
 }
 
 namespace {
@@ -506,9 +594,10 @@ void balance(const Task& task, Workspace& ws) {
   report.rank = std::max(0, report.rank - task.mimicRows());  // ≥ 0 even should rounding lose a mimic row
 }
 
-void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
-  WorkspaceScratch& sw = scratchOf(ws);
-  sw.a_world = sw.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+namespace {
+// Lines 26–30; without kPrescribed no DOF is prescribed, and the loop has no test for it.
+template <bool kPrescribed>
+void outwardBodies(const Model& model, const Task& task, WorkspaceScratch& sw, Eigen::Ref<Eigen::VectorXd> qdd) {
   // Each body's q̈ waits on its parent's Ẍ: that chain sets the time. So the
   // parent's Ẍ comes from a register when it is the body before (a chain, a
   // joint's DOFs), and line 28 multiplies by the 1/D the inward sweep formed.
@@ -516,12 +605,26 @@ void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, E
   for (int i = 1; i <= model.nv(); ++i) {
     const int p = model.parent(i);
     const Vec6 a_parent = p == i - 1 ? a_previous : sw.a[at(p)];
-    const int first = solverOrder(task).firstColumn(i), column_count = solverOrder(task).columnsEnd(i) - first;
-    const double constraint =
-        sw.SA.col(i).segment(first, column_count).dot(sw.nu_columns.segment(first, column_count));  // Sᵀ A_i ν
-    qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];    // line 28
-    a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];                   // line 29
+    if (kPrescribed && task.dofMode(i - 1) == DofMode::Prescribed) {
+      qdd[i - 1] = task.prescribedAccelerations()[i - 1];
+    } else {
+      const int first = solverOrder(task).firstColumn(i), column_count = solverOrder(task).columnsEnd(i) - first;
+      const double constraint =
+          sw.SA.col(i).segment(first, column_count).dot(sw.nu_columns.segment(first, column_count));  // Sᵀ A_i ν
+      qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];    // line 28
+    }
+    a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];  // line 29
   }
+}
+}  // namespace
+
+void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
+  WorkspaceScratch& sw = scratchOf(ws);
+  sw.a_world = sw.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
+  if (task.prescribedCount() > 0)
+    outwardBodies<true>(model, task, sw, qdd);
+  else
+    outwardBodies<false>(model, task, sw, qdd);
 }
 
 void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, const VectorRef& qdd) {
@@ -578,8 +681,14 @@ void outwardLanes(const Model& model, const Task& task, const WorkspaceScratch& 
   }
   double* da = s.da.data();
   const Eigen::Index da_stride = s.da.outerStride();
+  const bool prescribed = task.prescribedCount() > 0;
   for (int e = 0; e < 6 * W; ++e) da[e] = 0.0;  // the world: δẌ₀ = 0
   for (int i = 1; i <= N; ++i) {
+    if (prescribed && task.dofMode(i - 1) == DofMode::Prescribed) {  // δq̈_i = 0: the child moves with its parent
+      dqdd.template block<1, W>(i - 1, c0).setZero();
+      for (int e = 0; e < 6 * W; ++e) da[i * da_stride + e] = da[model.parent(i) * da_stride + e];
+      continue;
+    }
     Lanes dq = Lanes::Zero();  // δu_i: non-zero on the columns whose path runs through i
     const Eigen::Index from = std::max(c0, s.run_begin[i]), to = std::min(c0 + W, s.run_end[i]);
     for (Eigen::Index c = from; c < to; ++c) dq[c - c0] = s.du(i, c);
@@ -714,6 +823,15 @@ void multiDofColumns(const Model& model, const Task& task, const WorkspaceScratc
     if (!to_world) dF.noalias() += IAS_D * du;
   }
 }
+
+// A joint with prescribed DOFs (bodies first..last), its DOF steps one at a time as mixedJointSteps took them: a
+// torque-driven DOF's as oneDofColumns, a prescribed one's nothing — its q̈ is fixed, so a unit torque elsewhere
+// changes neither its δq̈ nor its term of δU₀, and δF^a reaches the parent whole (the rigid pass).
+void mixedJointColumns(const Model& model, const Task& task, const WorkspaceScratch& sw, const std::vector<int>& dofs,
+                       int first, int last, UnitTorqueScratch& s) {
+  for (int k = last; k >= first; --k)
+    if (task.dofMode(k - 1) != DofMode::Prescribed) oneDofColumns(model, task, sw, dofs, k, s);
+}
 }  // namespace
 
 void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, const std::vector<int>& dofs,
@@ -732,7 +850,9 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   columnRuns(model, dofs, s);
   for (int i = model.nv(); i >= 1;) {  // joint by joint from the leaves; body i is a joint's last DOF body
     const int first = model.jointStart(i);
-    if (first == i)
+    if (task.prescribedCount() > 0 && anyPrescribed(task, first, i))
+      mixedJointColumns(model, task, sw, dofs, first, i, s);
+    else if (first == i)
       oneDofColumns(model, task, sw, dofs, i, s);
     else
       multiDofColumns(model, task, sw, dofs, first, i, s);
@@ -894,6 +1014,43 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
     tau_c[i - 1] = sw.S[at(i)].dot(carried[at(i)]);
     if (model.parent(i) > 0) carried[at(model.parent(i))] += carried[at(i)];  // the world takes the rest
   }
+}
+
+namespace {
+// prescribedTorques and prescribedContactTorques: with kMotion the whole torque, without it the contacts' part.
+template <bool kMotion>
+void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                          const double* qdd, const double* tau, Eigen::Ref<Eigen::VectorXd> tau_c) {
+  if (task.prescribedCount() == 0) return;
+  WorkspaceScratch& sw = scratchOf(ws);
+  const int N = model.nv();
+  // The bodies before the first prescribed DOF's lie in no prescribed DOF's subtree (depth-first order).
+  int lowest = 1;
+  while (task.dofMode(lowest - 1) != DofMode::Prescribed) ++lowest;
+  for (int i = lowest; i <= N; ++i) sw.f[at(i)].setZero();
+  const std::vector<char>& contact = solverOrder(task).contactColumns();
+  const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
+  for (int i = N; i >= lowest; --i) {
+    Vec6& f = sw.f[at(i)];  // what the joint of body i transmits to its subtree
+    if (kMotion) f += sw.I[at(i)] * sw.a[at(i)] + sw.Fbias[at(i)];
+    const int own_first = solverOrder(task).columnsEnd(i + 1), own_end = solverOrder(task).columnsEnd(i);
+    for (int col = own_first; col < own_end; ++col)
+      if (contact[at(col)]) f.noalias() -= sw.A_body.col(col) * nu_solver[col];
+    if (task.dofMode(i - 1) == DofMode::Prescribed)
+      tau_c[i - 1] = sw.S[at(i)].dot(f) + (kMotion ? rotor_inertia[i - 1] * qdd[i - 1] - tau[i - 1] : 0.0);
+    if (model.parent(i) >= lowest) sw.f[at(model.parent(i))] += f;
+  }
+}
+}  // namespace
+
+void prescribedTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                       const VectorRef& qdd, const VectorRef& tau, Eigen::Ref<Eigen::VectorXd> tau_c) {
+  prescribedDofTorques<true>(model, task, ws, nu_solver, qdd.data(), tau.data(), tau_c);
+}
+
+void prescribedContactTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                              Eigen::Ref<Eigen::VectorXd> tau_c) {
+  prescribedDofTorques<false>(model, task, ws, nu_solver, nullptr, nullptr, tau_c);
 }
 
 double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,

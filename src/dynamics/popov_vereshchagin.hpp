@@ -99,6 +99,16 @@ void taskResidual(const Task& task, Workspace& ws);
 void constraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                        Eigen::Ref<Eigen::VectorXd> tau_c);
 
+// The prescribed DOFs' entries of τ_c (after constraintTorques): the torque each takes, d q̈ + Sᵀ f with f what
+// its joint transmits to its subtree (RNEA's inward pass on the solved motion sw.a, the contacts' forces acting on
+// the bodies), less its τ — so that τ + τ_c is what its motor gives, the task's other constraint forces included
+// as for every joint. Nothing when no DOF is prescribed.
+void prescribedTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                       const VectorRef& qdd, const VectorRef& tau, Eigen::Ref<Eigen::VectorXd> tau_c);
+// Their contacts' part alone, −Sᵀ Σ A ν over the subtree's contact columns: how those entries move with ν at a
+// fixed motion (the friction's flat directions).
+void prescribedContactTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                              Eigen::Ref<Eigen::VectorXd> tau_c);
 // Mimic joints' torques onto their leaders' motors: τ_l += a·τ_m, τ_m = 0.
 void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control);
 

@@ -35,6 +35,7 @@ const char* toString(JointState state) {
     case JointState::SlipPositive: return "slip+";
     case JointState::SlipNegative: return "slip-";
     case JointState::AtLimit: return "at-limit";
+    case JointState::Prescribed: return "prescribed";
   }
   return "unknown";
 }
@@ -112,7 +113,7 @@ Status checkFrictionResultSizes(const Model& model, const FrictionResult& fr) {
 // ---- The model of friction: f, f_c, b per joint; the stuck set Θ₀ and its
 // box Λ (a joint on a position limit gets an unbounded side: the stop pushes);
 // kinetic and viscous friction of the moving joints folded into τ.
-void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+void stuckSetAndKineticFriction(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
                                 const Eigen::Ref<const Eigen::VectorXd>& qd,
                                 const Eigen::Ref<const Eigen::VectorXd>& tau, const FrictionOptions& options,
                                 FrictionScratch& fs, FrictionResult& fr) {
@@ -157,16 +158,19 @@ void stuckSetAndKineticFriction(const Model& model, const Eigen::Ref<const Eigen
     const double qj = limited ? q[model.joint(dof.joint).q_index] : 0.0, qdj = qd[v];
     const bool at_lower = limited && qj <= dof.lower + options.limit_tolerance;
     const bool at_upper = limited && qj >= dof.upper - options.limit_tolerance;
-    if (std::abs(qdj) <= options.velocity_tolerance) {
+    const bool prescribed = task.dofMode(v) == DofMode::Prescribed;
+    if (std::abs(qdj) <= options.velocity_tolerance && !prescribed) {
       const auto a = static_cast<Eigen::Index>(fr.stuck.size());
       fr.stuck.push_back(j);
       fs.lo[a] = at_lower ? -kInf : -fs.breakaway[j];  // the stop pushes positively without bound
       fs.hi[a] = at_upper ? kInf : fs.breakaway[j];
       fr.state[static_cast<std::size_t>(j)] = JointState::Stick;
+    } else if (prescribed && std::abs(qdj) <= options.velocity_tolerance) {  // its motor gives all it takes
+      fr.state[static_cast<std::size_t>(j)] = JointState::Prescribed;
     } else {
       fr.tau_friction[j] = -fs.kinetic[j] * (qdj > 0 ? 1.0 : -1.0) - fs.viscous[j] * qdj;
       fs.tau_effective[v] += fr.tau_friction[j];
-      fr.state[static_cast<std::size_t>(j)] = JointState::Moving;
+      fr.state[static_cast<std::size_t>(j)] = prescribed ? JointState::Prescribed : JointState::Moving;
       if ((at_lower && qdj < 0) || (at_upper && qdj > 0)) {
         fr.limit_impact = true;  // it needs an impulse to stop: reported, not modelled
         if (fr.impact_joint < 0) fr.impact_joint = j;
@@ -298,6 +302,24 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
                                       fs.hi.head(stuck_count), mu, fs.qp, options.max_iterations, tolerance, terms);
 }
 
+// ---- The motion at μ*: the sweeps are linear in the torques, so
+// q̈(μ*) = q̈(0) + (∂q̈/∂τ_Θ)(−μ*) and ν(μ*) likewise (lines 26–30 by
+// superposition), then Ẍ from q̈ (line 29). With nothing stuck, μ* is
+// empty and the μ = 0 sweep already gave it.
+void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index stuck_count, Workspace& ws,
+                       FrictionScratch& fs) {
+  WorkspaceScratch& sw = scratchOf(ws);
+  const int m = task.solverColumns();
+  Solution& out = ws.solution;
+  out.qdd = fs.qdd0;
+  if (stuck_count == 0) return;
+  const auto mu = fs.mu.head(stuck_count);
+  out.qdd.noalias() -= fs.dqdd.leftCols(stuck_count) * mu;
+  sw.nu_columns.head(m) = fs.nu0.head(m);
+  sw.nu_columns.head(m).noalias() -= fs.dnu.topLeftCorner(m, stuck_count) * mu;
+  bodyAccelerations(model, task, ws, out.qdd);
+}
+
 // ---- When μ* is not unique: what each stuck joint's motor would carry at the
 // QP's maximiser without friction, h = τ + τ_c(μ*) − μ*, and the margin box.
 void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& tau,
@@ -308,6 +330,10 @@ void effortAtFirstMaximiser(const Model& model, const Task& task, const Eigen::R
   fs.nu_first.head(m) = fs.nu0.head(m);  // ν(μ*) by superposition
   fs.nu_first.head(m).noalias() -= fs.dnu.topLeftCorner(m, stuck_count) * fs.mu.head(stuck_count);
   constraintTorques(model, task, ws, fs.nu_first.head(m), fs.tau_constraint_first);
+  if (task.prescribedCount() > 0) {  // their torques need the motion: that of every maximiser (q̈* is unique)
+    motionAtMaximiser(model, task, stuck_count, ws, fs);
+    prescribedTorques(model, task, ws, fs.nu_first.head(m), ws.solution.qdd, fs.tau_effective, fs.tau_constraint_first);
+  }
   fs.tau_control_first = tau + fs.tau_constraint_first;
   carryMimicTorques(model, fs.tau_control_first);
   for (Eigen::Index a = 0; a < stuck_count; ++a) {
@@ -348,6 +374,7 @@ EffortChange effortAlongFlatDirections(const Model& model, const Task& task, con
     nu_direction.setZero();  // −δν_Σ N_e
     for (Eigen::Index t = 0; t < ns; ++t) nu_direction.noalias() -= N(t, e) * fs.dnu.col(sticking[t]).head(m);
     constraintTorques(model, task, ws, nu_direction, s.tau_direction);
+    prescribedContactTorques(model, task, ws, nu_direction, s.tau_direction);
     carryMimicTorques(model, s.tau_direction);
     B.col(e) = tau_direction;
     largest = std::max(largest, tau_direction.cwiseAbs().maxCoeff());
@@ -357,24 +384,6 @@ EffortChange effortAlongFlatDirections(const Model& model, const Task& task, con
   s.effort_first.head(n) = fs.tau_control_first.tail(n);
   if (!(largest > kSameChange)) return EffortChange::Fixed;
   return off_own <= kSameChange ? EffortChange::Own : EffortChange::Shared;
-}
-
-// ---- The motion at μ*: the sweeps are linear in the torques, so
-// q̈(μ*) = q̈(0) + (∂q̈/∂τ_Θ)(−μ*) and ν(μ*) likewise (lines 26–30 by
-// superposition), then Ẍ from q̈ (line 29). With nothing stuck, μ* is
-// empty and the μ = 0 sweep already gave it.
-void motionAtMaximiser(const Model& model, const Task& task, Eigen::Index stuck_count, Workspace& ws,
-                       FrictionScratch& fs) {
-  WorkspaceScratch& sw = scratchOf(ws);
-  const int m = task.solverColumns();
-  Solution& out = ws.solution;
-  out.qdd = fs.qdd0;
-  if (stuck_count == 0) return;
-  const auto mu = fs.mu.head(stuck_count);
-  out.qdd.noalias() -= fs.dqdd.leftCols(stuck_count) * mu;
-  sw.nu_columns.head(m) = fs.nu0.head(m);
-  sw.nu_columns.head(m).noalias() -= fs.dnu.topLeftCorner(m, stuck_count) * mu;
-  bodyAccelerations(model, task, ws, out.qdd);
 }
 
 // ---- Outputs: μ* per joint, the state of each stuck joint, the torques the
@@ -432,7 +441,7 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   Solution& out = ws.solution;
 
   jointsOutsideLimits(model, q, out);  // a warning: solved as given
-  stuckSetAndKineticFriction(model, q, qd, tau, options, fs, fr);
+  stuckSetAndKineticFriction(model, task, q, qd, tau, options, fs, fr);
   const auto stuck_count = static_cast<Eigen::Index>(fr.stuck.size());
   if (Status s = sweepsWithSensitivities(model, task, q, qd, fr.stuck, ws, fs); !s) return s;
   if (stuck_count < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
@@ -474,6 +483,7 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   taskResidual(task, ws);
   publishNu(task, ws);
   constraintTorques(model, task, ws, sw.nu_columns.head(m), out.tau_constraint);
+  prescribedTorques(model, task, ws, sw.nu_columns.head(m), out.qdd, fs.tau_effective, out.tau_constraint);
   controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
   const double mu_dot_qdd = frictionStates(model, out.qdd, acc_tolerance, fs, fr);
   for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader

@@ -26,6 +26,10 @@ Task::Task(const Model& model)
     joint_names_.push_back(joint.name);
   }
   for (int v = 0; v < model.nv(); ++v) dof_parent_bodies_.push_back(model.parent(v + 1));
+  dof_modes_.assign(static_cast<std::size_t>(model.nv()), DofMode::Torque);
+  mimic_dof_.assign(static_cast<std::size_t>(model.nv()), 0);
+  for (const int m : model.mimicJoints()) mimic_dof_[static_cast<std::size_t>(model.joint(m).v_index)] = 1;
+  prescribed_qdd_ = Eigen::VectorXd::Zero(model.nv());
   addMimicRows(model);
   reorder();
 }
@@ -143,13 +147,23 @@ int Task::addRelativeConstraint(const std::string& frame, const std::string& ref
   return addRelativeConstraint(lookup(frame_names_, frame), lookup(frame_names_, reference), A, expressed);
 }
 
-int Task::addJointConstraint(int joint) {
+std::pair<int, int> Task::jointDofs(int joint) const {
   const auto joints = static_cast<int>(joint_dofs_.size());
   if (joint < 0 || joint >= joints)
     throw ModelError("task: joint index " + std::to_string(joint) + " out of range (the model has " +
                      std::to_string(joints) + " joints)");
+  return joint_dofs_[static_cast<std::size_t>(joint)];
+}
+
+int Task::jointIndex(const std::string& joint) const {
+  const auto it = std::find(joint_names_.begin(), joint_names_.end(), joint);
+  if (it == joint_names_.end()) throw ModelError("task: the model has no moving joint '" + joint + "'");
+  return static_cast<int>(it - joint_names_.begin());
+}
+
+int Task::addJointConstraint(int joint) {
+  const auto [v_index, nv] = jointDofs(joint);
   const int first_row = constraintRows();
-  const auto [v_index, nv] = joint_dofs_[static_cast<std::size_t>(joint)];
   growTargets(nv);                // first: it may refuse, and the task stays as it was
   for (int k = 0; k < nv; ++k) {  // one row per DOF, in order
     const int dof = v_index + k;
@@ -167,11 +181,47 @@ int Task::addJointConstraint(int joint) {
   return first_row;
 }
 
-int Task::addJointConstraint(const std::string& joint) {
-  const auto it = std::find(joint_names_.begin(), joint_names_.end(), joint);
-  if (it == joint_names_.end()) throw ModelError("task: the model has no moving joint '" + joint + "'");
-  return addJointConstraint(static_cast<int>(it - joint_names_.begin()));
+int Task::addJointConstraint(const std::string& joint) { return addJointConstraint(jointIndex(joint)); }
+
+void Task::setDofMode(int dof, DofMode mode) {
+  const auto nv = static_cast<int>(dof_modes_.size());
+  if (dof < 0 || dof >= nv)
+    throw ModelError("task: DOF index " + std::to_string(dof) + " out of range (the model has " + std::to_string(nv) +
+                     " entries of v)");
+  const auto d = static_cast<std::size_t>(dof);
+  // A mimic joint moves as its leader's law says: prescribing it would prescribe the leader through the coupling.
+  if (mode == DofMode::Prescribed && mimic_dof_[d]) {
+    std::size_t j = 0;  // a mimic joint has one DOF: the joint whose v_index it is
+    while (joint_dofs_[j].first != dof) ++j;
+    throw ModelError("task: joint '" + joint_names_[j] +
+                     "' is a mimic joint, which follows its leader: prescribe the leader instead");
+  }
+  if (dof_modes_[d] == mode) return;
+  prescribed_count_ += mode == DofMode::Prescribed ? 1 : -1;
+  dof_modes_[d] = mode;
 }
+
+void Task::prescribe(int joint) {
+  const auto [v_index, nv] = jointDofs(joint);
+  for (int k = 0; k < nv; ++k) setDofMode(v_index + k, DofMode::Prescribed);
+}
+
+void Task::prescribe(const std::string& joint) { prescribe(jointIndex(joint)); }
+
+void Task::lock(int joint) {
+  prescribe(joint);
+  const auto [v_index, nv] = jointDofs(joint);
+  prescribed_qdd_.segment(v_index, nv).setZero();
+}
+
+void Task::lock(const std::string& joint) { lock(jointIndex(joint)); }
+
+void Task::release(int joint) {
+  const auto [v_index, nv] = jointDofs(joint);
+  for (int k = 0; k < nv; ++k) setDofMode(v_index + k, DofMode::Torque);
+}
+
+void Task::release(const std::string& joint) { release(jointIndex(joint)); }
 
 namespace {
 // A contact on a bolted-down base with mass: the humanoid or the quadruped

@@ -199,6 +199,47 @@ int addConstraint(const Spelling& spelling, const Model& model, Task& task, cons
   return keyed("", [&] { return task.addRelativeConstraint(f, reference, c.A, c.expressed); });
 }
 
+ModeKind parseModeKind(const Spelling& spelling, const std::string& text) {
+  if (text == "torque") return ModeKind::Torque;
+  if (text == "locked") return ModeKind::Locked;
+  const char q = spelling.quote;
+  throw ProblemError(Fault::Value, "",
+                     "unknown mode " + quoted(spelling, text) + " (use " + q + "torque" + q + ", " + q + "locked" + q +
+                         " or {" + q + "acceleration" + q + ": q̈} for a prescribed acceleration)");
+}
+
+namespace {
+// The DOFs a mode's name covers: a joint's [v_index, v_index + nv), or one DOF of a multi-DOF joint by its name.
+std::pair<int, int> modeDofs(const Spelling& spelling, const Model& model, const std::string& name) {
+  for (const Joint& joint : model.joints())
+    if (joint.name == name) return {joint.v_index, joint.nv()};
+  for (int k = 0; k < model.dof(); ++k)
+    if (dofName(model, k) == name) return {model.baseVelocitySize() + k, 1};
+  return {model.joint(jointIndex(spelling, model, name)).v_index, 0};  // throws, naming the joints
+}
+}  // namespace
+
+void setJointMode(const Spelling& spelling, const Model& model, Task& task, const JointModeDesc& mode) {
+  const auto [first, dofs] = modeDofs(spelling, model, mode.name);
+  if (mode.kind == ModeKind::Acceleration) {
+    if (mode.acceleration.size() != dofs)
+      throw ProblemError(Fault::Value, "acceleration",
+                         "has " + entries(mode.acceleration.size()) + ", expected " + std::to_string(dofs) +
+                             " (one per DOF of " + quoted(spelling, mode.name) + ")");
+    for (Eigen::Index k = 0; k < dofs; ++k)
+      if (!std::isfinite(mode.acceleration[k]))
+        throw ProblemError(Fault::Value, "acceleration[" + std::to_string(k) + "]",
+                           "must be finite, got " + number(mode.acceleration[k]));
+  }
+  const DofMode dof_mode = mode.kind == ModeKind::Torque ? DofMode::Torque : DofMode::Prescribed;
+  keyed("", [&] {
+    for (int k = 0; k < dofs; ++k) task.setDofMode(first + k, dof_mode);
+    return 0;
+  });
+  if (mode.kind == ModeKind::Locked) task.prescribedAccelerations().segment(first, dofs).setZero();
+  if (mode.kind == ModeKind::Acceleration) task.prescribedAccelerations().segment(first, dofs) = mode.acceleration;
+}
+
 int addWrench(const Model& model, Task& task, const std::string& frame, Expressed expressed) {
   const int f = keyed("frame", [&] { return frameIndex(model, frame); });
   return keyed("", [&] { return task.addWrench(f, expressed); });

@@ -97,6 +97,22 @@ int jointIndex(const Spelling& spelling, const Model& model, const std::string& 
 // the model does not have.
 int addConstraint(const Spelling& spelling, const Model& model, Task& task, const ConstraintDesc& c);
 
+// How a front end sets one joint's (or one DOF's) mode: torque-driven, locked, or its accelerations prescribed.
+enum class ModeKind { Torque, Locked, Acceleration };
+struct JointModeDesc {
+  std::string name;  // a joint below the root, or one DOF of a multi-DOF joint ("<joint>.<coordinate>")
+  ModeKind kind = ModeKind::Torque;
+  Eigen::VectorXd acceleration;  // Acceleration: one per DOF named (the joint's nv, or 1 for a DOF)
+};
+
+// "torque", "locked"; ProblemError(Value) naming the allowed ones (and the acceleration form).
+ModeKind parseModeKind(const Spelling& spelling, const std::string& text);
+
+// The mode into `task` (Task::prescribe / lock / release, or setDofMode for one DOF), with its accelerations.
+// ProblemError(Model, "") for a name the model does not have (naming its joints) or a mimic joint,
+// (Value, "acceleration") for a count that is not the DOFs' or an entry that is not finite.
+void setJointMode(const Spelling& spelling, const Model& model, Task& task, const JointModeDesc& mode);
+
 // A wrench on a frame into `task`; its index. ProblemError keyed "frame".
 int addWrench(const Model& model, Task& task, const std::string& frame, Expressed expressed);
 

@@ -633,7 +633,7 @@ void addFrictionProperties(py::class_<Result>& cls) {
             for (const JointState s : r.friction().state) states.append(py::str(toString(s)));
             return std::move(states);
           },
-          "per joint: 'moving', 'stick', 'slip+', 'slip-', 'at-limit'. None without friction")
+          "per joint: 'moving', 'stick', 'slip+', 'slip-', 'at-limit', 'prescribed'. None without friction")
       .def_property_readonly("tau_friction",
                              [](const Result& r) -> py::object {
                                if (!r.with_friction) return py::none();
@@ -710,6 +710,42 @@ void bindResult(py::module_& m) {
       .def("__repr__", &resultRepr);
 }
 
+// modes={"joint or DOF": "locked" | "torque" | q̈ | [q̈, …] | {"acceleration": …}}: every DOF torque-driven first
+// (the workspace's task keeps the last call's modes otherwise), then these, through the problem layer.
+void applyModes(const Model& model, Task& task, py::handle modes) {
+  if (modes.is_none() && task.prescribedCount() == 0) return;
+  for (int v = 0; v < model.nv(); ++v) task.setDofMode(v, DofMode::Torque);
+  if (modes.is_none()) return;
+  if (!py::isinstance<py::dict>(modes))
+    raise(PyExc_TypeError,
+          "modes: expected a dict of joint names to modes ('locked', 'torque' or an acceleration), "
+          "got " +
+              std::string(py::str(py::type::handle_of(modes).attr("__name__"))));
+  for (const auto& [key, value] : modes.cast<py::dict>()) {
+    if (!py::isinstance<py::str>(key)) raise(PyExc_TypeError, "modes: keys are joint names (str)");
+    problem::JointModeDesc mode;
+    mode.name = key.cast<std::string>();
+    const std::string where = "modes['" + problem::printable(mode.name) + "']";
+    if (py::isinstance<py::str>(value)) {
+      mode.kind = checked(where, [&] { return problem::parseModeKind(kPython, value.cast<std::string>()); });
+    } else {
+      py::handle acceleration = value;
+      if (py::isinstance<py::dict>(value)) {
+        const py::dict d = value.cast<py::dict>();
+        if (d.size() != 1 || !d.contains("acceleration"))
+          raise(PyExc_ValueError, where + ": a dict mode is {'acceleration': qdd} (one per DOF)");
+        acceleration = d["acceleration"];
+      }
+      mode.kind = problem::ModeKind::Acceleration;
+      Eigen::VectorXd buffer;
+      mode.acceleration = py::isinstance<py::float_>(acceleration) || py::isinstance<py::int_>(acceleration)
+                              ? Eigen::VectorXd::Constant(1, acceleration.cast<double>())
+                              : Eigen::VectorXd(vectorArg((where + " acceleration").c_str(), acceleration, buffer));
+    }
+    checked(where, [&] { problem::setJointMode(kPython, model, task, mode); });
+  }
+}
+
 // The arguments of solve() and _time_cpp_solve() as the C++ solve takes them.
 struct SolveArgs {
   PyWorkspace& pw;
@@ -720,7 +756,7 @@ struct SolveArgs {
 
 SolveArgs solveArgs(const std::shared_ptr<Model>& model, py::handle ws_obj, py::handle q, py::handle qd, py::handle tau,
                     py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
-                    py::handle balance) {
+                    py::handle balance, py::handle modes) {
   PyWorkspace& pw = workspaceArg(model, ws_obj);
   const FrictionOptions* options = frictionArg(friction);
   if (options)
@@ -728,6 +764,7 @@ SolveArgs solveArgs(const std::shared_ptr<Model>& model, py::handle ws_obj, py::
   const BalanceOptions& balance_options = balanceArg(balance);
   Task& task = solveTask(pw, constraints, wrenches, gravity);
   task.balance = balance_options;
+  applyModes(*model, task, modes);
   return {pw,
           options,
           task,
@@ -738,8 +775,8 @@ SolveArgs solveArgs(const std::shared_ptr<Model>& model, py::handle ws_obj, py::
 
 Result solvePython(std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
                    py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
-                   py::handle balance) {
-  SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance);
+                   py::handle balance, py::handle modes) {
+  SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance, modes);
   ++a.pw.generation;
   const Status status = problem::solve(*model, *a.pw.ws, a.q, a.qd, a.tau, a.task, a.friction);
   const bool infeasible = status.code == StatusCode::Infeasible;
@@ -766,8 +803,8 @@ Result solvePython(std::shared_ptr<Model> model, py::object ws_obj, py::handle q
 // Seconds per C++ solve of these arguments, looped in C++.
 double timeCppSolve(std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle tau,
                     py::handle constraints, py::handle wrenches, py::handle friction, py::handle gravity,
-                    py::handle balance, int repeat) {
-  const SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance);
+                    py::handle balance, py::handle modes, int repeat) {
+  const SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance, modes);
   ++a.pw.generation;
   Status status;
   const auto start = std::chrono::steady_clock::now();
@@ -782,13 +819,15 @@ void bindSolveFunctions(py::module_& m) {
   m.def("solve", &solvePython, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
         py::arg("tau") = py::none(), py::kw_only(), py::arg("constraints") = py::none(),
         py::arg("wrenches") = py::none(), py::arg("friction") = py::none(), py::arg("gravity") = py::none(),
-        py::arg("balance") = py::none(),
+        py::arg("balance") = py::none(), py::arg("modes") = py::none(),
         "Constrained hybrid dynamics (Popov-Vereshchagin), with exact static friction when `friction` is given.\n\n"
         "q: model.nq entries, qd, tau: model.nv (one per joint on a fixed base; a floating base's coordinates\n"
         "first: docs/python.md); qd, tau default to zeros; float64 arrays are read in place.\n"
         "constraints: list of Constraint; wrenches: list of Wrench; friction: Friction(...), True or None;\n"
         "gravity: 3-vector, default (0, 0, -9.81); balance: Balance(...) or None (the defaults), how a\n"
-        "singular task is solved. The task is rebuilt only when the constraint or wrench\n"
+        "singular task is solved; modes: {joint or DOF name: 'locked' | 'torque' | qdd | [qdd per DOF] |\n"
+        "{'acceleration': ...}}, the joints' modes for this solve (unnamed: torque-driven; a prescribed joint's\n"
+        "torque comes back in tau_control). The task is rebuilt only when the constraint or wrench\n"
         "objects change. Returns a Result (views on ws). Raises SolveError (C++ Status), InfeasibleError\n"
         "(with .result), ModelError (unknown frame), TypeError/ValueError (dtype, dimensions). A q outside a\n"
         "joint's limits, or contacts on a fixed base with mass, give a zwang.ModelWarning once per model, code and\n"
@@ -797,7 +836,7 @@ void bindSolveFunctions(py::module_& m) {
   m.def("_time_cpp_solve", &timeCppSolve, py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd") = py::none(),
         py::arg("tau") = py::none(), py::kw_only(), py::arg("constraints") = py::none(),
         py::arg("wrenches") = py::none(), py::arg("friction") = py::none(), py::arg("gravity") = py::none(),
-        py::arg("balance") = py::none(), py::arg("repeat") = 1000,
+        py::arg("balance") = py::none(), py::arg("modes") = py::none(), py::arg("repeat") = 1000,
         "Seconds per call of the C++ solve alone (same arguments as solve), looped in C++: the baseline for\n"
         "the Python-call overhead in docs/python.md. Not part of the API.");
 }

@@ -698,3 +698,32 @@ TEST_CASE("trees with spherical, planar and free joints allocate nothing (plain,
       CHECK(counts.stuck > 0);
     }
 }
+
+TEST_CASE("prescribed and locked joints allocate nothing: modes changed between solves, plain and friction",
+          "[prescribed]") {
+  const Model model = panda();
+  Task task(model);
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 6).leftCols(3), Expressed::World);
+  Workspace ws(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), tau = Eigen::VectorXd::Constant(7, 1.0);
+  Eigen::VectorXd qd = Eigen::VectorXd::Constant(7, 0.3);
+  qd[2] = qd[4] = 0.0;  // two joints at rest: one stuck, one prescribed below
+  FrictionOptions friction;
+  task.lock(1);
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, tau, task));  // warm
+  REQUIRE(solveWithFriction(model, ws, q, qd, tau, task, friction));
+  bool all_ok = true;
+  const long count = allocationsDuring([&] {
+    for (int k = 0; k < 10; ++k) {
+      task.prescribe(4);
+      task.prescribedAccelerations()[4] = 0.1 * k;
+      task.setDofMode(6, k % 2 ? DofMode::Prescribed : DofMode::Torque);
+      all_ok = solveHybridDynamics(model, ws, q, qd, tau, task).ok() && all_ok;
+      all_ok = solveWithFriction(model, ws, q, qd, tau, task, friction).ok() && all_ok;
+      task.release(4);
+      all_ok = solveWithFriction(model, ws, q, qd, tau, task, friction).ok() && all_ok;
+    }
+  });
+  CHECK(all_ok);
+  CHECK(count == 0);
+}

@@ -633,6 +633,40 @@ TEST_CASE("A joint driven into its limit, and torques beyond the effort limit: r
   CHECK(away["friction"]["impact_joint"].is_null());
 }
 
+TEST_CASE("joint_modes: Fig. 5.5's motion prescribed, at rest and moving, in closed form", "[golden]") {
+  // The arm of Fig. 5.5 told to accelerate at 5 rad/s² by its joint's mode instead of a row: no row, no friction
+  // unknown (its motor gives all), so tau_control = I q̈ = 2.25·5; moving at 1 rad/s its motor also overcomes the
+  // kinetic friction, 10 N·m.
+  Json p = parse(cli_test::readText(problem("arm_fig55.json")));
+  p["model"] = std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf";
+  p.erase("constraints");
+  p["joint_modes"] = {{"joint1", {{"acceleration", 5}}}};
+  const std::string file = cli_test::scratchDir() + "/arm_prescribed.json";
+  cli_test::writeText(file, p.dump());
+  const Json s = solve(file);
+  CHECK(s["qdd"][0].get<double>() == 5.0);  // copied, not solved for
+  CHECK(s["tau_control"][0].get<double>() == Approx(2.25 * 5).margin(1e-12));
+  CHECK(s["tau_constraint"][0].get<double>() == Approx(2.25 * 5).margin(1e-12));  // τ = 0: all of it
+  CHECK(s["nu"].empty());
+  CHECK(s["friction"]["state"][0] == "prescribed");
+  CHECK(s["friction"]["mu"][0].get<double>() == 0.0);
+  CHECK(s["friction"]["stuck"].empty());
+  p["qd"] = Json::array({1.0});
+  cli_test::writeText(file, p.dump());
+  const Json moving = solve(file);
+  CHECK(moving["tau_control"][0].get<double>() == Approx(2.25 * 5 + 10).margin(1e-12));
+  CHECK(moving["friction"]["tau_friction"][0].get<double>() == Approx(-10).margin(1e-12));
+  // Locked: held where it is against the 5 N at the tip of arm_stick (1 m: −5 N·m about z), by its motor alone.
+  Json held = parse(cli_test::readText(problem("arm_stick.json")));
+  held["model"] = std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf";
+  held["joint_modes"] = {{"joint1", "locked"}};
+  cli_test::writeText(file, held.dump());
+  const Json h = solve(file);
+  CHECK(h["qdd"][0].get<double>() == 0.0);
+  CHECK(h["tau_control"][0].get<double>() == Approx(5.0).margin(1e-12));
+  CHECK(h["friction"]["mu"][0].get<double>() == 0.0);
+}
+
 TEST_CASE("--pretty and -o give the same numbers", "[golden]") {
   const Json compact = solve(problem("panda_hold.json"));
   const Json pretty = solve(problem("panda_hold.json"), {"--pretty"});
@@ -784,7 +818,7 @@ TEST_CASE("Errors in the problem file: the problem layer's shared table", "[erro
       Json p = {{"model", ZWANG_MODELS_DIR "/panda.urdf"}, {"root", "panda_link0"}, {"tip", "tool0"}};
       if (row.contains("constraint")) p["constraints"] = Json::array({row["constraint"]});
       if (row.contains("wrench")) p["wrenches"] = Json::array({row["wrench"]});
-      for (const char* key : {"balance", "friction", "rotor_inertia", "breakaway"})
+      for (const char* key : {"balance", "friction", "rotor_inertia", "breakaway", "joint_modes"})
         if (row.contains(key)) p[key] = row[key];
       if (row.contains("breakaway") && !p.contains("friction")) p["friction"] = Json::object();  // else refused
       const std::string file = cli_test::scratchDir() + "/shared_table.json";

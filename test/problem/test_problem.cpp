@@ -87,6 +87,20 @@ std::string messageOf(const zwang::Model& model, const Json& row, problem::Fault
       o.velocity_tolerance = row["friction"].value("velocity_tolerance", o.velocity_tolerance);
       problem::checkFriction(o);
     }
+    if (row.contains("joint_modes")) {
+      for (const auto& [name, value] : row["joint_modes"].items()) {
+        where = "joint_modes." + name;
+        problem::JointModeDesc mode;
+        mode.name = name;
+        if (value.is_string()) {
+          mode.kind = problem::parseModeKind(kSpelling, value.get<std::string>());
+        } else {
+          mode.kind = problem::ModeKind::Acceleration;
+          mode.acceleration = vectorOf(value["acceleration"]);
+        }
+        problem::setJointMode(kSpelling, model, task, mode);
+      }
+    }
     if (row.contains("rotor_inertia")) {  // the per-joint arrays: their own name is the path
       where = "";
       problem::withRotorInertia(model, "rotor_inertia", vectorOf(row["rotor_inertia"]));

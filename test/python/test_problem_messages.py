@@ -37,6 +37,8 @@ def solve_row(panda, ws, row):
     if "friction" in row or "breakaway" in row:
         breakaway = {"breakaway": row["breakaway"]} if "breakaway" in row else {}
         kwargs["friction"] = zwang.Friction(**row.get("friction", {}), **breakaway)
+    if "joint_modes" in row:
+        kwargs["modes"] = row["joint_modes"]
     if "rotor_inertia" in row:
         panda = panda.with_rotor_inertia(row["rotor_inertia"])
         ws = panda.workspace()

@@ -78,6 +78,7 @@ struct ConstraintInput {
   Axes axes = Axes::Local;
   std::string relative_to;  // empty: absolute (relative to the world)
   int joint = -1;           // ≥ 0: a joint row (see above)
+  int base_dof = -1;        // ≥ 0: the same on entry base_dof of a floating base's velocity (floatingDynamics only)
   bool contact = false;     // the environment's force (see above)
 };
 

@@ -299,12 +299,12 @@ FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base,
   for (const ConstraintInput& c : input.constraints) {
     if (c.b.size() != c.A.cols())
       throw std::invalid_argument("floating reference: constraint b must have A.cols() entries");
-    if (c.contact && (c.joint >= 0 || !c.relative_to.empty()))
+    if (c.contact && (c.joint >= 0 || c.base_dof >= 0 || !c.relative_to.empty()))
       throw std::invalid_argument("floating reference: a contact is an absolute frame constraint");
-    if (c.joint >= 0) {  // q̈_joint = b: its force is the joint's own generalized force
-      if (c.A.cols() != 1 || c.joint >= spec.dof())
+    if (c.joint >= 0 || c.base_dof >= 0) {  // q̈_joint = b: its force is the joint's own generalized force
+      if (c.A.cols() != 1 || c.joint >= spec.dof() || c.base_dof >= base_velocity_size)
         throw std::invalid_argument("floating reference: a joint row has one column and a joint of the spec");
-      out.G(row, base_velocity_size + c.joint) = 1.0;
+      out.G(row, c.base_dof >= 0 ? c.base_dof : base_velocity_size + c.joint) = 1.0;
       out.gamma(row) = c.b(0);
       ++row;
       continue;
@@ -478,6 +478,12 @@ FloatingProblem randomFloatingProblem(std::mt19937_64& rng, const RandomFloating
   problem.base = randomFloatingBase(rng, options);
   problem.input = randomFloatingInput(rng, problem.spec, problem.base, options);
   return problem;
+}
+
+bool wellPosed(const FloatingResult& dense) {
+  const auto rows = static_cast<int>(dense.G.rows());
+  if (!dense.wellConditioned(1e6) || dense.constraint_rank < rows) return false;
+  return rows == 0 || Eigen::JacobiSVD<Eigen::MatrixXd>(dense.G).singularValues().minCoeff() >= 1e-6;
 }
 
 }  // namespace zwang::testing

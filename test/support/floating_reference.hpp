@@ -136,6 +136,10 @@ struct FloatingResult {
 // ν like any row, and out of tau_c and tau_control (τ_c = Gᵀ diag(motorRows) ν).
 FloatingResult floatingDynamics(const ChainSpec& spec, const FloatingBase& base, const FloatingInput& input);
 
+// A draw the tests keep: the KKT system well conditioned (H and the coupling matrix below 1e6) and every row
+// reachable (G of full row rank, its smallest singular value at least 1e-6).
+bool wellPosed(const FloatingResult& dense);
+
 // Per row of G (the input's rows, then `rows` − constraintRows() mimic rows):
 // 1 when the motors carry its force, 0 for a contact's.
 Eigen::VectorXd motorRows(const FloatingInput& input, int rows);

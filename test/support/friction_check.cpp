@@ -94,6 +94,7 @@ std::string checkMaximumDissipation(const FrictionResult& r, const Solution& s, 
     if (side > 0 && qdd > a_tol) return why.str() + "accelerates into its upper limit";
     switch (state) {
       case JointState::Moving: return why.str() + "stuck joint in state Moving";
+      case JointState::Prescribed: return why.str() + "stuck joint in state Prescribed";
       case JointState::Stick:
         if (std::abs(qdd) > a_tol) return why.str() + "sticks but qdd != 0";
         if (std::abs(mu) > f + t_tol) return why.str() + "sticks but |mu| > f";

@@ -6,7 +6,8 @@
 //    Σ m_l c_l / M from the links' poses and the spec's inertias; J_com = Σ m_l (J_lin − [c_l]× J_ang) / M; ċ =
 //    J_com q̇; c̈ from each link's spatial acceleration J q̈ + J̇ q̇ of the solve's q̈, taken to its centre of mass;
 //    h = Σ I_l J_l q̇ moved from the world origin to c; for the whole robot and for the subtree of every joint;
-//  * J_com once more by central finite differences of c along each velocity coordinate (integrate);
+//  * J_com once more by central finite differences of c along each velocity coordinate (integrate), and c̈ by central
+//    differences of ċ along the solver's motion;
 //  * physics: a free-floating robot's centre of mass falls with exactly g whatever its joint torques, and without
 //    gravity its centroidal momentum does not change: dh/dt by central differences along the solver's motion is 0.
 // MuJoCo's subtree_com, subtree_linvel, subtree_angmom and the bodies' accelerations are compared in
@@ -257,6 +258,48 @@ TEST_CASE("centre of mass: the Jacobian is the derivative of the position along 
   }
   std::printf("centre-of-mass Jacobian vs central differences: 40 trees, max rel. error %.2e\n", worst);
   CHECK(worst < 1e-8);
+}
+
+TEST_CASE("centre of mass: the acceleration is the derivative of the velocity along the solver's motion", "[com]") {
+  // Central differences of ċ over the states (q ⊕ (±ε v + ε²/2 v̇), v ± ε v̇), the solve's v̇ = q̈: the difference
+  // quotient is c̈ + O(ε²) (the same reasoning as the free-flight case below), far below 1e-6 of max(1, |c̈|) at ε =
+  // 1e-5, for every subtree's and the whole robot's c̈, gravity and joint torques on.
+  std::mt19937_64 rng(2708);
+  double worst = 0.0;
+  int subtrees = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const ChainSpec spec = randomJointTypesTree(rng);
+    const FloatingBase base = randomBase(rng);
+    const FloatingInput in = randomState(rng, spec, base);
+    const Model model = floatingModelFromSpec(spec, base);
+    Workspace ws(model);
+    const Task task(model);
+    REQUIRE(solveHybridDynamics(model, ws, in.q, in.v, in.tau, task));
+    const Eigen::VectorXd vdot = ws.solution.qdd;
+    for (int joint = kWholeRobot; joint < static_cast<int>(model.joints().size()); ++joint, ++subtrees) {
+      double mass = 0.0;
+      REQUIRE(subtreeMass(model, joint, mass));
+      if (mass <= 0.0) continue;
+      Vec3 cdd;
+      REQUIRE(solveHybridDynamics(model, ws, in.q, in.v, in.tau, task));
+      REQUIRE(centerOfMassAcceleration(model, ws, in.q, in.v, joint, cdd));
+      const double eps = 1e-5;
+      Vec3 cd_at[2];
+      for (int side = 0; side < 2; ++side) {
+        const double s = side == 0 ? eps : -eps;
+        Eigen::VectorXd q(model.nq());
+        const Eigen::VectorXd v = in.v + s * vdot;
+        REQUIRE(integrate(model, in.q, in.v * s + vdot * (0.5 * s * s), 1.0, q));
+        REQUIRE(forwardKinematics(model, ws, q, v));
+        REQUIRE(centerOfMassVelocity(model, ws, q, v, joint, cd_at[side]));
+      }
+      const Vec3 difference = (cd_at[0] - cd_at[1]) / (2 * eps);
+      worst = std::max(worst, (difference - cdd).cwiseAbs().maxCoeff() / std::max(1.0, cdd.cwiseAbs().maxCoeff()));
+    }
+  }
+  std::printf("centre-of-mass acceleration vs central differences of its velocity: %d subtrees, max rel. error %.2e\n",
+              subtrees, worst);
+  CHECK(worst < 1e-6);
 }
 
 TEST_CASE("centre of mass: in free flight it falls with g and the centroidal momentum is conserved", "[com]") {

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "support/bad_inputs.hpp"
 #include "support/floating_reference.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"

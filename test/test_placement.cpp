@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "support/bad_inputs.hpp"
 #include "support/floating_reference.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"

@@ -371,4 +371,19 @@ TEST_CASE("centre of mass: bad inputs come back as a Status", "[com]") {
   double mass = 0.0;
   REQUIRE(subtreeMass(model, kWholeRobot, mass));
   CHECK(mass > 0.0);
+
+  // A disc that only spins (rotational inertia, no mass) has no centre of mass.
+  Joint spin;
+  spin.name = "spin";
+  const Model disc = ModelBuilder().addJoint(spin, "disc", RigidInertia{0.0, Vec3::Zero(), Mat3::Identity()}).build();
+  Workspace ws_disc(disc);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(1);
+  REQUIRE(forwardKinematics(disc, ws_disc, zero, zero));
+  s = centerOfMass(disc, ws_disc, zero, kWholeRobot, c);
+  CHECK(s.code == StatusCode::BadConfiguration);
+  CHECK(std::string(s.message) == "the robot has no moving mass: its centre of mass is undefined");
+  s = centerOfMass(disc, ws_disc, zero, 0, c);
+  CHECK(std::string(s.message) == "the subtree of joint 'spin' has no mass: its centre of mass is undefined");
+  Vec6 h;
+  CHECK(centroidalMomentum(disc, ws_disc, zero, zero, kWholeRobot, h).code == StatusCode::BadConfiguration);
 }

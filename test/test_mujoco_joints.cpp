@@ -38,10 +38,11 @@
 //    τ before handing τ to mj_forward and takes it out of mj_inverse's answer (armatureCorrection). Rotations (ball
 //    joints, a free joint's ω) have the same coordinates on both sides: no correction.
 //
-// So that the comparison can fail, the last test case makes three plausible convention mistakes (a ball's ω read in
-// the joint frame instead of the child's; a free spec joint's linear qvel read in body axes; MuJoCo's armature on a
-// free joint taken as ours) and requires each to be seen far above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world
-// is MuJoCo's free base, in our coordinates; at rest, a ball joint is three hinges about the child's axes).
+// So that the comparison can fail, the test case "the MuJoCo comparison fails on a wrong velocity convention" makes
+// three plausible convention mistakes (a ball's ω read in the joint frame instead of the child's; a free spec joint's
+// linear qvel read in body axes; MuJoCo's armature on a free joint taken as ours) and requires each to be seen far
+// above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world is
+// MuJoCo's free base, in our coordinates; at rest, a ball joint is three hinges about the child's axes).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -4,8 +4,9 @@
 //  * the dense reference's kinematics (support/floating_reference.*: world poses, spatial Jacobians at the world
 //    origin and J̇q̇ per link, written joint by joint from the URDF semantics, no recursion shared with zwang): c =
 //    Σ m_l c_l / M from the links' poses and the spec's inertias; J_com = Σ m_l (J_lin − [c_l]× J_ang) / M; ċ =
-//    J_com q̇; c̈ from each link's spatial acceleration J q̈ + J̇ q̇ of the solve's q̈, taken to its centre of mass;
-//    h = Σ I_l J_l q̇ moved from the world origin to c; for the whole robot and for the subtree of every joint;
+//    J_com q̇; c̈ from each link's spatial acceleration J q̈ + J̇ q̇ of the solve's q̈ (and of a random q̈ after
+//    inverseDynamics), taken to its centre of mass; h = Σ I_l J_l q̇ moved from the world origin to c; for the whole
+//    robot and for the subtree of every joint;
 //  * J_com once more by central finite differences of c along each velocity coordinate (integrate), and c̈ by central
 //    differences of ċ along the solver's motion;
 //  * physics: a free-floating robot's centre of mass falls with exactly g whatever its joint torques, and without
@@ -169,7 +170,7 @@ double relative(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
 }
 
 struct Worst {
-  double c = 0, cd = 0, cdd = 0, J = 0, h = 0, mass = 0;
+  double c = 0, cd = 0, cdd = 0, cdd_inverse = 0, J = 0, h = 0, mass = 0;
 };
 
 }  // namespace
@@ -214,11 +215,19 @@ TEST_CASE("centre of mass: position, velocity, acceleration, Jacobian and moment
       worst.h = std::max(worst.h, relative(h, d.h));
       ++subtrees;
     }
+    // After inverseDynamics the acceleration is that of its q̈, any q̈ (here random, gravity on).
+    const Eigen::VectorXd qdd_any = randomVector(rng, model.nv(), 5.0);
+    REQUIRE(inverseDynamics(model, ws, in.q, in.v, qdd_any, task));
+    Vec3 cdd;
+    REQUIRE(centerOfMassAcceleration(model, ws, in.q, in.v, kWholeRobot, cdd));
+    const DenseCom d = denseCom(spec, kin, linksOf(spec, base, -1), in.v, qdd_any);
+    worst.cdd_inverse = std::max(worst.cdd_inverse, relative(cdd, d.cdd));
   }
   std::printf(
       "centre of mass vs dense reference: %d trees (%d floating), %d subtrees; max rel. error: mass %.2e  c %.2e  "
-      "c-dot %.2e  c-ddot %.2e  J_com %.2e  h %.2e\n",
-      trees, floating, subtrees, worst.mass, worst.c, worst.cd, worst.cdd, worst.J, worst.h);
+      "c-dot %.2e  c-ddot %.2e (after inverseDynamics at a random q-ddot: %.2e)  J_com %.2e  h %.2e\n",
+      trees, floating, subtrees, worst.mass, worst.c, worst.cd, worst.cdd, worst.cdd_inverse, worst.J, worst.h);
+  CHECK(worst.cdd_inverse < kTolerance);
   CHECK(floating >= 60);
   CHECK(subtrees >= 1000);
   CHECK(worst.mass < kTolerance);

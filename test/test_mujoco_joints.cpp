@@ -10,6 +10,9 @@
 //  * jointSpaceInertia (CRBA), against mj_fullM;
 //  * every link's velocity and acceleration (frameVelocity, frameAcceleration) against mj_objectVelocity and
 //    mj_objectAcceleration, which tells a wrong q̈ apart from wrong kinematics;
+//  * the centre of mass, its velocity and acceleration and the centroidal momentum of every moving joint's subtree
+//    (and of the whole robot on a free root; center_of_mass.hpp) against subtree_com, mj_subtreeVel's subtree_linvel
+//    and subtree_angmom, and the bodies' accelerations at their centres of mass;
 // each to 1e-9 relative to max(1, |MuJoCo's value|).
 //
 // The MJCF and the bridge are test_mujoco_floating's (support/mjcf_writer.hpp, support/mujoco_bridge.hpp): armature =
@@ -35,10 +38,11 @@
 //    τ before handing τ to mj_forward and takes it out of mj_inverse's answer (armatureCorrection). Rotations (ball
 //    joints, a free joint's ω) have the same coordinates on both sides: no correction.
 //
-// So that the comparison can fail, the last test case makes three plausible convention mistakes (a ball's ω read in
-// the joint frame instead of the child's; a free spec joint's linear qvel read in body axes; MuJoCo's armature on a
-// free joint taken as ours) and requires each to be seen far above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world
-// is MuJoCo's free base, in our coordinates; at rest, a ball joint is three hinges about the child's axes).
+// So that the comparison can fail, the test case "the MuJoCo comparison fails on a wrong velocity convention" makes
+// three plausible convention mistakes (a ball's ω read in the joint frame instead of the child's; a free spec joint's
+// linear qvel read in body axes; MuJoCo's armature on a free joint taken as ours) and requires each to be seen far
+// above 1e-9; two more check the conventions on MuJoCo alone, without zwang (a free spec joint on the world is
+// MuJoCo's free base, in our coordinates; at rest, a ball joint is three hinges about the child's axes).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -649,4 +653,128 @@ TEST_CASE("joint types: the MuJoCo comparison fails on a wrong velocity conventi
     CHECK(least > kMistakeFloor);
     CHECK(correct < kTolerance);
   }
+}
+
+namespace {
+
+// The centre of mass of one subtree, its velocity and acceleration, and the centroidal momentum [M ċ; L_c], world
+// axes.
+struct SubtreeMotion {
+  Eigen::Vector3d c, cd, cdd;
+  Vector6d h;
+};
+
+// The subtrees compared: the one below each moving spec joint (its child link, spec.links[k + 1]), and the whole
+// robot (links[0]'s subtree) on a free root.
+std::vector<int> subtreeRootLinks(const JointsProblem& p) {
+  std::vector<int> links;
+  if (p.base.kind == BaseKind::Free) links.push_back(0);
+  for (const int k : p.spec.movingJoints()) links.push_back(k + 1);
+  return links;
+}
+
+std::vector<SubtreeMotion> subtreesWithZwang(const JointsProblem& p) {
+  const Model model = floatingModelFromSpec(p.spec, p.base);
+  const Task task = floatingTaskFromInput(model, p.input);
+  Workspace ws(model, task);
+  const FloatingInput& in = p.input;
+  REQUIRE(solveHybridDynamics(model, ws, in.q, in.v, in.tau, task));
+  std::vector<SubtreeMotion> out;
+  for (const int link : subtreeRootLinks(p)) {
+    const int joint =
+        link == 0 ? kWholeRobot : model.jointIndex(p.spec.joints[static_cast<std::size_t>(link - 1)].name);
+    SubtreeMotion s;
+    Vec3 c, cd, cdd;
+    Vec6 h;
+    REQUIRE(centerOfMass(model, ws, in.q, joint, c));
+    REQUIRE(centerOfMassVelocity(model, ws, in.q, in.v, joint, cd));
+    REQUIRE(centerOfMassAcceleration(model, ws, in.q, in.v, joint, cdd));
+    REQUIRE(centroidalMomentum(model, ws, in.q, in.v, joint, h));
+    s.c = c;
+    s.cd = cd;
+    s.cdd = cdd;
+    s.h = h;
+    out.push_back(s);
+  }
+  return out;
+}
+
+// MuJoCo's after mj_forward on the same state and forces (solveWithMujoco's forward part): subtree_com, and from
+// mj_subtreeVel subtree_linvel (ċ) and subtree_angmom (L_c), M ċ from body_subtreemass; c̈ as Σ m_b p̈_b / M over the
+// subtree's bodies, p̈_b the classical acceleration of body b's centre of mass (mj_objectAcceleration of mjOBJ_BODY,
+// its inertial frame at xipos, with g added back as in mujocoLinkMotions).
+std::vector<SubtreeMotion> subtreesWithMujoco(const JointsProblem& p) {
+  const FloatingInput& in = p.input;
+  const Mujoco mj(toMjcf(p.spec, in.gravity, p.base));
+  const mjModel* m = mj.m();
+  mjData* d = mj.d();
+  const MujocoCoordinates map = mapCoordinates(p.spec, p.base, m);
+  const VelocityChange change = velocityChange(p, Conversion::Correct);
+  scatter(in.q, map.qpos, d->qpos);
+  scatter(change.T * in.v, map.dof, d->qvel);
+  scatter(change.T.transpose().lu().solve(in.tau + armatureCorrection(p.spec, p.base, in.v)), map.dof, d->qfrc_applied);
+  mj_kinematics(m, d);
+  addWrenchesToXfrc(p.spec, mujocoLinkPoses(p.spec, m, d), in.wrenches, m, d);
+  mj_forward(m, d);
+  mj_subtreeVel(m, d);
+  mj_rnePostConstraint(m, d);
+  std::vector<SubtreeMotion> out;
+  for (const int link : subtreeRootLinks(p)) {
+    const int root = mj_name2id(m, mjOBJ_BODY, p.spec.links[static_cast<std::size_t>(link)].name.c_str());
+    REQUIRE(root >= 1);
+    const double mass = m->body_subtreemass[root];
+    SubtreeMotion s;
+    s.c = Eigen::Map<const Eigen::Vector3d>(d->subtree_com + 3 * root);
+    s.cd = Eigen::Map<const Eigen::Vector3d>(d->subtree_linvel + 3 * root);
+    s.h << mass * s.cd, Eigen::Map<const Eigen::Vector3d>(d->subtree_angmom + 3 * root);
+    Eigen::Vector3d mass_acceleration = Eigen::Vector3d::Zero();
+    for (int b = 1; b < m->nbody; ++b) {
+      bool inside = false;
+      for (int a = b; a > 0 && !inside; a = m->body_parentid[a]) inside = a == root;
+      if (!inside) continue;
+      mjtNum acceleration[6];
+      mj_objectAcceleration(m, d, mjOBJ_BODY, b, acceleration, 0);
+      mass_acceleration +=
+          m->body_mass[b] * (Eigen::Vector3d(acceleration[3], acceleration[4], acceleration[5]) + in.gravity);
+    }
+    s.cdd = mass_acceleration / mass;
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "joint types: centre of mass and centroidal momentum match MuJoCo's subtree_com, subtree_linvel and "
+    "subtree_angmom",
+    "[joints][mujoco][com]") {
+  // The trees, states and forces of the first test case (drawTrial), fewer of them; every moving joint's subtree and
+  // the whole robot on a free root; the same tolerance (both exact sums over the bodies; c̈ from the forward dynamics
+  // of each side, whose q̈ agree to it).
+  std::mt19937_64 rng(2727);
+  double worst[4] = {0, 0, 0, 0};
+  int subtrees = 0, wholes = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const JointsProblem p = drawTrial(rng, trial);
+    const std::vector<SubtreeMotion> ours = subtreesWithZwang(p), theirs = subtreesWithMujoco(p);
+    REQUIRE(ours.size() == theirs.size());
+    wholes += p.base.kind == BaseKind::Free ? 1 : 0;
+    for (std::size_t k = 0; k < ours.size(); ++k, ++subtrees) {
+      worst[0] = std::max(worst[0], relativeError(ours[k].c, theirs[k].c));
+      worst[1] = std::max(worst[1], relativeError(ours[k].cd, theirs[k].cd));
+      worst[2] = std::max(worst[2], relativeError(ours[k].cdd, theirs[k].cdd));
+      worst[3] = std::max(worst[3], relativeError(ours[k].h, theirs[k].h));
+    }
+  }
+  std::printf(
+      "MuJoCo %s vs zwang, centre of mass: 100 trees, %d subtrees (%d whole robots on a free root); max rel. error: c "
+      "(subtree_com) %.2e  c-dot (subtree_linvel) %.2e  c-ddot (bodies' accelerations) %.2e  h ([M subtree_linvel; "
+      "subtree_angmom]) %.2e\n",
+      mj_versionString(), subtrees, wholes, worst[0], worst[1], worst[2], worst[3]);
+  CHECK(subtrees >= 500);
+  CHECK(worst[0] < kTolerance);
+  CHECK(worst[1] < kTolerance);
+  CHECK(worst[2] < kTolerance);
+  CHECK(worst[3] < kTolerance);
 }

@@ -2,12 +2,15 @@
 /// zwang: constrained hybrid dynamics (Popov–Vereshchagin) with static friction.
 #pragma once
 
+#include "zwang/center_of_mass.hpp"
 #include "zwang/configuration.hpp"
 #include "zwang/friction.hpp"
 #include "zwang/hybrid_dynamics.hpp"
 #include "zwang/inverse_dynamics.hpp"
 #include "zwang/kinematics.hpp"
 #include "zwang/model.hpp"
+#include "zwang/orientation.hpp"
+#include "zwang/placement.hpp"
 #include "zwang/status.hpp"
 #include "zwang/task.hpp"
 #include "zwang/urdf.hpp"

@@ -122,6 +122,8 @@ int commandSolve(int argc, char** argv);
 // `zwang forward-dynamics PROBLEM.json`: the same problem, solved without constraints or friction.
 int commandForwardDynamics(int argc, char** argv);
 int commandInfo(int argc, char** argv);
+// `zwang fk MODEL.urdf [--q Q] …` or `zwang fk PROBLEM.json`: frame poses and the centre of mass (fk.cpp).
+int commandFk(int argc, char** argv);
 int commandScenarios(int argc, char** argv);
 int commandEnergy(int argc, char** argv);
 // Its scenarios are in energy_report.hpp.

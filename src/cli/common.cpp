@@ -69,6 +69,20 @@ constexpr const char* kInfoUsage =
     "                        is at 0) instead of refusing the model\n"
     "  --json                print JSON instead of a table\n";
 
+constexpr const char* kFkUsage =
+    "usage: zwang fk MODEL.urdf [--q Q] [--root LINK] [--tip LINK] [--base free|planar] [--pretty]\n"
+    "       zwang fk PROBLEM.json [--pretty]\n"
+    "\n"
+    "Forward kinematics at one state: print every frame's pose in the world\n"
+    "(position, unit quaternion w x y z) and the robot's centre of mass (mass,\n"
+    "position, velocity) as JSON. The state is --q (nq numbers, a floating base's\n"
+    "first, separated by commas or blanks; default: the neutral configuration) at\n"
+    "rest, or a solve problem's model, base, q and qd.\n"
+    "\n"
+    "  --q Q                the configuration, e.g. --q 0,0.5,-1 (quote blanks)\n"
+    "  --root LINK, --tip LINK, --base free|planar   as zwang info\n"
+    "  --pretty             indent the JSON for humans\n";
+
 constexpr const char* kScenariosUsage =
     "usage: zwang scenarios [--out DIR] [--models DIR] [--no-plots]\n"
     "\n"
@@ -109,6 +123,7 @@ constexpr const char* kCommandsUsage =
     "  solve PROBLEM.json [-o FILE] [--pretty]        solve a JSON problem, print the solution as JSON\n"
     "  forward-dynamics PROBLEM.json [-o FILE]        q̈ of the unconstrained robot (no constraints, no friction)\n"
     "  info MODEL.urdf [--root L] [--tip L] [--json]  base, joints, frames and mass of a URDF tree or chain\n"
+    "  fk MODEL.urdf [--q Q] | fk PROBLEM.json        frame poses and centre of mass at one state, as JSON\n"
     "  scenarios [--out DIR] [--models DIR]           the report's chapter 6 and Fig. 5.5, with plots\n"
     "  energy [--out DIR] [--models DIR]              Panda, dual arm + box, humanoid and Solo 12 holding still:\n"
     "                                                 effort with/without friction\n"
@@ -121,11 +136,10 @@ constexpr const char* kCommandsUsage =
 }  // namespace
 
 const char* usageText(const std::string& command) {
-  const std::pair<const char*, const char*> usages[] = {{"solve", kSolveUsage},
-                                                        {"forward-dynamics", kForwardDynamicsUsage},
-                                                        {"info", kInfoUsage},
-                                                        {"scenarios", kScenariosUsage},
-                                                        {"energy", kEnergyUsage}};
+  const std::pair<const char*, const char*> usages[] = {
+      {"solve", kSolveUsage},         {"forward-dynamics", kForwardDynamicsUsage},
+      {"info", kInfoUsage},           {"fk", kFkUsage},
+      {"scenarios", kScenariosUsage}, {"energy", kEnergyUsage}};
   for (const auto& [name, text] : usages)
     if (command == name) return text;
   return kCommandsUsage;

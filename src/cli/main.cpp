@@ -3,6 +3,7 @@
 //   zwang solve PROBLEM.json [-o FILE] [--pretty]
 //   zwang forward-dynamics PROBLEM.json [-o FILE] [--pretty]
 //   zwang info MODEL.urdf [--root L] [--tip L] [--json]
+//   zwang fk MODEL.urdf [--q Q] [--root L] [--tip L] [--base B] [--pretty] | zwang fk PROBLEM.json [--pretty]
 //   zwang scenarios [--out DIR] [--models DIR] [--no-plots]
 //   zwang energy [--out DIR] [--models DIR] [--no-plots]
 #include <cstdio>
@@ -34,6 +35,7 @@ int run(int argc, char** argv) {
   if (command == "solve") return commandSolve(argc, argv);
   if (command == "forward-dynamics") return commandForwardDynamics(argc, argv);
   if (command == "info") return commandInfo(argc, argv);
+  if (command == "fk") return commandFk(argc, argv);
   if (command == "scenarios") return commandScenarios(argc, argv);
   if (command == "energy") return commandEnergy(argc, argv);
   std::fprintf(stderr, "zwang: unknown command '%s'\n\n%s", printable(command, 60).c_str(), usageText(""));

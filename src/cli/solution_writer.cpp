@@ -47,6 +47,19 @@ void pretty(const Json& value, int indent, std::string& out) {
   }
 }
 
+// The robot's centre of mass in the solve's motion (world axes, classical acceleration); null when no moving
+// body has mass (its centre of mass is undefined).
+Json comJson(const Model& model, const Workspace& ws) {
+  const Eigen::VectorXd& q = ws.kinematics.q;
+  const Eigen::VectorXd& qd = ws.kinematics.qd;
+  Vec3 position, velocity, acceleration;
+  if (!centerOfMass(model, ws, q, kWholeRobot, position) ||
+      !centerOfMassVelocity(model, ws, q, qd, kWholeRobot, velocity) ||
+      !centerOfMassAcceleration(model, ws, q, qd, kWholeRobot, acceleration))
+    return Json();
+  return {{"position", array(position)}, {"velocity", array(velocity)}, {"acceleration", array(acceleration)}};
+}
+
 }  // namespace
 
 std::string prettyDump(const Json& value) {
@@ -118,6 +131,7 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
     frame_map[model.frame(f).name] = {{"acceleration_world", array(a)}};
   }
   out["frames"] = std::move(frame_map);
+  out["com"] = comJson(model, ws);
   return out;
 }
 

@@ -12,7 +12,8 @@ namespace zwang::cli {
 // tau_constraint, tau_control (per DOF below the root),
 // base (only for a floating base: its type, acceleration, acceleration_world,
 // tau_constraint, tau_control), nu, gauss, friction (only when
-// `with_friction`), status, frames. Numbers are written
+// `with_friction`), status, frames, com (the robot's centre of mass: position,
+// velocity, acceleration; null without moving mass). Numbers are written
 // by nlohmann::json in their shortest form that reads back exactly.
 Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, const Status& status,
                   const std::vector<int>& frames);

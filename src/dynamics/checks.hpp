@@ -64,4 +64,16 @@ inline bool workspaceFitsModel(const Model& model, const Workspace& ws) {
 // or SizeMismatch for a workspace that fits whose H or τ a user resized.
 Status workspaceMismatch(const Model& model, const Workspace& ws);
 
+// The checks the queries of kinematics.hpp and center_of_mass.hpp share
+// (src/dynamics/kinematics.cpp). The workspace made for this model:
+Status checkKinematicsWorkspace(const Model& model, const Workspace& ws) noexcept;
+// and holding the `needed` results for this model and this state
+// (Workspace::kinematics), for the queries that read a workspace after the
+// call that computed them; NotComputed naming what to call first otherwise.
+// qd is zero-length for a pose query; `query` names the caller in messages.
+Status checkKinematicsHeld(const Model& model, const Workspace& ws, const VectorRef& q, const VectorRef& qd,
+                           KinematicsStage needed, const char* query) noexcept;
+// True when the workspace holds poses of this model at exactly this q.
+bool posesHeldAt(const Model& model, const Workspace& ws, const VectorRef& q);
+
 }  // namespace zwang::internal

@@ -126,18 +126,17 @@ void applyExternalWrenches(const Model& model, const Task& task, Workspace& ws) 
   }
 }
 
-}  // namespace internal
-
-namespace {
-
-// The checks every kinematics entry point shares (no allocation, no exception).
-Status checkWorkspace(const Model& model, const Workspace& ws) noexcept {
+Status checkKinematicsWorkspace(const Model& model, const Workspace& ws) noexcept {
   if (ws.dof() != model.dof())
     return Status::error(StatusCode::ModelMismatch, "workspace was made for %d joints, the model has %d", ws.dof(),
                          model.dof());
-  if (!internal::workspaceFitsModel(model, ws)) return internal::workspaceMismatch(model, ws);
+  if (!workspaceFitsModel(model, ws)) return workspaceMismatch(model, ws);
   return {};
 }
+
+}  // namespace internal
+
+namespace {
 
 Status checkFrame(const Model& model, int frame) noexcept {
   const int frames = static_cast<int>(model.frames().size());
@@ -174,44 +173,12 @@ Status checkHeldState(const char* query, const char* name, const Eigen::VectorXd
                        query, name, name, static_cast<long>(entry), held[entry], given[entry], call);
 }
 
-// Both, and that the workspace holds the `needed` results for this model and
-// this state (Workspace::kinematics), for the queries that read a workspace
-// after the call that computed them. qd is zero-length for a pose query.
+// The frame index and the kinematics held, for the frame queries.
 Status checkQuery(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                   const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, KinematicsStage needed,
                   const char* query) noexcept {
   if (Status s = checkFrame(model, frame); !s) return s;
-  if (Status s = checkWorkspace(model, ws); !s) return s;
-  const auto need = static_cast<int>(needed);
-  if (ws.kinematics.stage == KinematicsStage::None)
-    return Status::error(StatusCode::NotComputed,
-                         "%s: the workspace holds no kinematics (none computed yet, or the last call failed); "
-                         "call %s first",
-                         query, kStageCalls[need]);
-  if (ws.kinematics.model != &model)
-    return Status::error(StatusCode::NotComputed,
-                         "%s: the workspace's kinematics were computed for another Model object; call %s with this "
-                         "model first",
-                         query, kStageCalls[need]);
-  if (ws.kinematics.stage < needed)
-    return Status::error(StatusCode::NotComputed,
-                         "%s: the workspace holds %s only (the last call computed no %s); call %s first", query,
-                         ws.kinematics.stage == KinematicsStage::Poses ? "poses" : "poses and velocities",
-                         kStageNames[need], kStageCalls[need]);
-  const bool with_velocity = needed >= KinematicsStage::Velocities;
-  const char* redo = needed == KinematicsStage::Accelerations ? kStageCalls[need]
-                     : with_velocity                          ? "forwardKinematics(model, ws, q, qd)"
-                                                              : "forwardKinematics(model, ws, q)";
-  if (Status s = checkHeldState(query, "q", ws.kinematics.q, q, redo); !s) return s;
-  if (with_velocity)
-    if (Status s = checkHeldState(query, "qd", ws.kinematics.qd, qd, redo); !s) return s;
-  return {};
-}
-
-// True when the workspace holds poses of this model at exactly this q.
-bool posesHeldAt(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q) {
-  return ws.kinematics.stage >= KinematicsStage::Poses && ws.kinematics.model == &model &&
-         q.size() == ws.kinematics.q.size() && firstDifference(ws.kinematics.q, q) < 0;
+  return internal::checkKinematicsHeld(model, ws, q, qd, needed, query);
 }
 
 // A classical [linear of the frame origin; angular] 6-vector in world axes,
@@ -245,10 +212,49 @@ void jacobianColumns(const Model& model, const Workspace& ws, int frame, Express
 
 }  // namespace
 
+namespace internal {
+
+Status checkKinematicsHeld(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                           const Eigen::Ref<const Eigen::VectorXd>& qd, KinematicsStage needed,
+                           const char* query) noexcept {
+  if (Status s = checkKinematicsWorkspace(model, ws); !s) return s;
+  const auto need = static_cast<int>(needed);
+  if (ws.kinematics.stage == KinematicsStage::None)
+    return Status::error(StatusCode::NotComputed,
+                         "%s: the workspace holds no kinematics (none computed yet, or the last call failed); "
+                         "call %s first",
+                         query, kStageCalls[need]);
+  if (ws.kinematics.model != &model)
+    return Status::error(StatusCode::NotComputed,
+                         "%s: the workspace's kinematics were computed for another Model object; call %s with this "
+                         "model first",
+                         query, kStageCalls[need]);
+  if (ws.kinematics.stage < needed)
+    return Status::error(StatusCode::NotComputed,
+                         "%s: the workspace holds %s only (the last call computed no %s); call %s first", query,
+                         ws.kinematics.stage == KinematicsStage::Poses ? "poses" : "poses and velocities",
+                         kStageNames[need], kStageCalls[need]);
+  const bool with_velocity = needed >= KinematicsStage::Velocities;
+  const char* redo = needed == KinematicsStage::Accelerations ? kStageCalls[need]
+                     : with_velocity                          ? "forwardKinematics(model, ws, q, qd)"
+                                                              : "forwardKinematics(model, ws, q)";
+  if (Status s = checkHeldState(query, "q", ws.kinematics.q, q, redo); !s) return s;
+  if (with_velocity)
+    if (Status s = checkHeldState(query, "qd", ws.kinematics.qd, qd, redo); !s) return s;
+  return {};
+}
+
+bool posesHeldAt(const Model& model, const Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q) {
+  return ws.kinematics.stage >= KinematicsStage::Poses && ws.kinematics.model == &model &&
+         q.size() == ws.kinematics.q.size() && firstDifference(ws.kinematics.q, q) < 0;
+}
+
+}  // namespace internal
+
 Status forwardKinematics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd) noexcept {
   ws.kinematics.stage = KinematicsStage::None;  // until computed below
-  if (Status s = checkWorkspace(model, ws); !s) return s;
+  if (Status s = internal::checkKinematicsWorkspace(model, ws); !s) return s;
   if (Status s = internal::checkStateConfiguration(model, q); !s) return s;  // a free base's quaternion too
   if (qd.size() != 0)
     if (Status s = internal::checkVelocityVector(model, "qd", qd); !s) return s;
@@ -303,8 +309,8 @@ Status frameJacobian(const Model& model, Workspace& ws, const Eigen::Ref<const E
                          model.dof(), internal::jointDofsWord(model));
   }
   if (Status s = checkFrame(model, frame); !s) return s;
-  if (Status s = checkWorkspace(model, ws); !s) return s;
-  if (!posesHeldAt(model, ws, q))  // the poses a solve or forwardKinematics left at this q serve as they are
+  if (Status s = internal::checkKinematicsWorkspace(model, ws); !s) return s;
+  if (!internal::posesHeldAt(model, ws, q))  // the poses a solve or forwardKinematics left at this q serve as they are
     if (Status s = forwardKinematics(model, ws, q); !s) return s;
   jacobianColumns(model, ws, frame, expressed, J);
   return {};

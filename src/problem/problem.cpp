@@ -343,4 +343,22 @@ std::string limitImpactMessage(const Model& model, const FrictionResult& frictio
          "(friction.limit_impact)";
 }
 
+KinematicsReport kinematicsReport(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                  const Eigen::Ref<const Eigen::VectorXd>& qd) {
+  Workspace ws(model, 0);
+  if (const Status s = forwardKinematics(model, ws, q, qd); !s)
+    throw ProblemError(Fault::Value, s.message[0] == 'q' && s.message[1] == 'd' ? "qd" : "q", s.message);
+  KinematicsReport report;
+  for (int f = 0; f < static_cast<int>(model.frames().size()); ++f) {
+    Eigen::Isometry3d pose;
+    (void)framePose(model, ws, q, f, pose);  // the state just computed: nothing to refuse
+    const Eigen::Quaterniond turn(pose.linear());
+    report.frames.push_back({model.frame(f).name, pose.translation(), {turn.w(), turn.x(), turn.y(), turn.z()}});
+  }
+  (void)subtreeMass(model, kWholeRobot, report.mass);
+  report.has_com = centerOfMass(model, ws, q, kWholeRobot, report.com) &&
+                   centerOfMassVelocity(model, ws, q, qd, kWholeRobot, report.com_velocity);
+  return report;
+}
+
 }  // namespace zwang::problem

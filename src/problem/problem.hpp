@@ -167,6 +167,24 @@ std::vector<std::string> beyondEffortLimit(const Model& model, const Eigen::Vect
 std::string impactDofName(const Model& model, const FrictionResult& friction);
 std::string limitImpactMessage(const Model& model, const FrictionResult& friction);
 
+// What `zwang fk` prints (docs/cli.md, "zwang fk"): every frame's pose in the
+// world (position, unit quaternion w first) and the robot's centre of mass.
+struct FramePose {
+  std::string name;
+  Vec3 position = Vec3::Zero();
+  Eigen::Vector4d quaternion{1.0, 0.0, 0.0, 0.0};  // frame → world, [w, x, y, z]
+};
+struct KinematicsReport {
+  std::vector<FramePose> frames;  // Model::frames() order
+  double mass = 0.0;              // of the moving bodies (subtreeMass, kWholeRobot)
+  bool has_com = false;           // false without moving mass: the centre of mass is undefined
+  Vec3 com = Vec3::Zero(), com_velocity = Vec3::Zero();
+};
+// At q (nq entries) and qd (nv); ProblemError(Value, "q" or "qd") with the
+// library's message for a state the model refuses.
+KinematicsReport kinematicsReport(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                  const Eigen::Ref<const Eigen::VectorXd>& qd);
+
 template <class Say>
 void forEachOutsideLimits(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q, int q_offset, Say say) {
   for (int j = 0; j < static_cast<int>(model.joints().size()); ++j) {

@@ -588,6 +588,25 @@ void addSolutionProperties(py::class_<Result>& cls) {
           "every constraint row met (False: least squares only, or a damped direction gave)");
 }
 
+// Result.com: the robot's centre of mass in the solved motion, world axes, as `zwang solve`'s "com"; None
+// without moving mass.
+py::object comOf(const Result& r) {
+  if (r.data) return r.data->com;
+  r.solution();  // stale check
+  const Workspace& ws = *r.live->ws;
+  const Eigen::VectorXd &q = ws.kinematics.q, &qd = ws.kinematics.qd;
+  Vec3 position, velocity, acceleration;
+  if (!centerOfMass(*r.model, ws, q, kWholeRobot, position) ||
+      !centerOfMassVelocity(*r.model, ws, q, qd, kWholeRobot, velocity) ||
+      !centerOfMassAcceleration(*r.model, ws, q, qd, kWholeRobot, acceleration))
+    return py::none();
+  py::dict out;
+  out["position"] = vectorCopy(position);
+  out["velocity"] = vectorCopy(velocity);
+  out["acceleration"] = vectorCopy(acceleration);
+  return std::move(out);
+}
+
 // Frame accelerations, warnings and the outcome.
 void addFrameProperties(py::class_<Result>& cls) {
   cls.def_property_readonly(
@@ -610,7 +629,10 @@ void addFrameProperties(py::class_<Result>& cls) {
     return out;
           },
           "list of (code, message): every warning of this solve ('outside_limits', 'fixed_base_contact'), also\n"
-          "those a zwang.ModelWarning said already (each is issued once per model, code and joint)");
+          "those a zwang.ModelWarning said already (each is issued once per model, code and joint)")
+      .def_property_readonly("com", &comOf,
+                             "the robot's centre of mass in this motion, world axes: {'position', 'velocity',\n"
+                             "'acceleration' (classical, gravity not included)}, new arrays; None without moving mass");
 }
 
 // The friction results (None, 0 or False without friction).
@@ -683,6 +705,7 @@ Result copyResult(const Result& r) {
     data->frame_acc_local.row(f) = frameAccelerationOf(r, f, Expressed::Local).transpose();
     data->frame_acc_world.row(f) = frameAccelerationOf(r, f, Expressed::World).transpose();
   }
+  data->com = comOf(r);
   Result copy;
   copy.model = r.model;
   copy.with_friction = r.with_friction;
@@ -919,6 +942,93 @@ void bindKinematics(py::module_& m) {
       "6×nv J with frame_velocity = J qd (nv = dof on a fixed base)");
 }
 
+// A joint argument of the centre-of-mass functions: None (the whole robot), a joint name or an index in model.joints.
+int comJointArg(const Model& model, py::handle joint) {
+  if (joint.is_none()) return kWholeRobot;
+  if (py::isinstance<py::str>(joint)) return model.jointIndex(joint.cast<std::string>());
+  if (py::isinstance<py::int_>(joint) && !py::isinstance<py::bool_>(joint)) {
+    const long j = joint.cast<long>();
+    if (j < 0 || j >= static_cast<long>(model.joints().size()))
+      raise(exceptions().model_error, "joint index " + std::to_string(j) + " is out of range (the model has " +
+                                          std::to_string(model.joints().size()) + " joints below the root)");
+    return static_cast<int>(j);
+  }
+  raise(PyExc_TypeError, "joint: expected None (the whole robot), a joint name (str) or index (int)");
+}
+
+// A centre-of-mass query at (q, qd) (qd None: poses only), as the frame queries: read or computed first.
+template <class Query>
+void comQuery(const std::shared_ptr<Model>& model, const py::object& ws_obj, py::handle q, py::handle qd,
+              const char* name, Query query) {
+  PyWorkspace& pw = workspaceArg(model, ws_obj);
+  const auto qv = vectorArg("q", q, pw.q_buf);
+  const Status s = qd.is_none() ? queryOrCompute(*model, pw, qv, Eigen::VectorXd(), query)
+                                : queryOrCompute(*model, pw, qv, vectorArg("qd", qd, pw.qd_buf), query);
+  if (!s) raiseStatus(s, name);
+}
+
+// subtree_mass, center_of_mass, center_of_mass_velocity, jacobian_center_of_mass, centroidal_momentum.
+void bindCenterOfMass(py::module_& m) {
+  m.def(
+      "subtree_mass",
+      [](std::shared_ptr<Model> model, py::handle joint) {
+    double mass = 0.0;
+    if (const Status s = subtreeMass(*model, comJointArg(*model, joint), mass); !s) raiseStatus(s, "subtree_mass");
+    return mass;
+      },
+      py::arg("model"), py::arg("joint") = py::none(),
+      "mass [kg] of the subtree below a joint (name or index), or of every moving body (joint=None)");
+  m.def(
+      "center_of_mass",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle joint) {
+    const int j = comJointArg(*model, joint);
+    Vec3 c;
+    comQuery(model, ws_obj, q, py::none(), "center_of_mass", [&](const VectorView& qv, const VectorView&) {
+      return centerOfMass(*model, *ws_obj.cast<PyWorkspace&>().ws, qv, j, c);
+    });
+    return vectorCopy(c);
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("joint") = py::none(),
+      "centre of mass [m], world coordinates, of the robot (joint=None) or of a joint's subtree");
+  m.def(
+      "center_of_mass_velocity",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle joint) {
+    const int j = comJointArg(*model, joint);
+    Vec3 v;
+    comQuery(model, ws_obj, q, qd, "center_of_mass_velocity", [&](const VectorView& qv, const VectorView& qdv) {
+      return centerOfMassVelocity(*model, *ws_obj.cast<PyWorkspace&>().ws, qv, qdv, j, v);
+    });
+    return vectorCopy(v);
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd"), py::arg("joint") = py::none(),
+      "velocity of the centre of mass [m/s], world axes");
+  m.def(
+      "centroidal_momentum",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle qd, py::handle joint) {
+    const int j = comJointArg(*model, joint);
+    Vec6 h;
+    comQuery(model, ws_obj, q, qd, "centroidal_momentum", [&](const VectorView& qv, const VectorView& qdv) {
+      return centroidalMomentum(*model, *ws_obj.cast<PyWorkspace&>().ws, qv, qdv, j, h);
+    });
+    return vectorCopy(h);
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("qd"), py::arg("joint") = py::none(),
+      "[linear momentum; angular momentum about the centre of mass], world axes (Pinocchio's hg)");
+  m.def(
+      "jacobian_center_of_mass",
+      [](std::shared_ptr<Model> model, py::object ws_obj, py::handle q, py::handle joint) {
+    PyWorkspace& pw = workspaceArg(model, ws_obj);
+    const int j = comJointArg(*model, joint);
+    const auto qv = vectorArg("q", q, pw.q_buf);
+    Eigen::MatrixXd J(3, model->nv());
+    ++pw.generation;
+    if (const Status s = jacobianCenterOfMass(*model, *pw.ws, qv, j, J); !s) raiseStatus(s, "jacobian_center_of_mass");
+    return matrixCopy(J);
+      },
+      py::arg("model"), py::arg("ws"), py::arg("q"), py::arg("joint") = py::none(),
+      "3×nv J_com with center_of_mass_velocity = J_com qd, world axes");
+}
+
 // forward_dynamics and inverse_dynamics: (q, qd, x) with `x_name` τ or q̈, the task of wrenches and gravity
 // built once per workspace; `algorithm` runs the C++ call and returns where its result lands.
 template <class Algorithm>
@@ -992,6 +1102,7 @@ void bindSolve(py::module_& m) {
   bindResult(m);
   bindSolveFunctions(m);
   bindKinematics(m);
+  bindCenterOfMass(m);
   bindDynamics(m);
 }
 

@@ -727,3 +727,59 @@ TEST_CASE("prescribed and locked joints allocate nothing: modes changed between 
   CHECK(all_ok);
   CHECK(count == 0);
 }
+
+TEST_CASE("the centre-of-mass and centroidal-momentum calls allocate nothing and are noexcept", "[com]") {
+  using zwang::testing::BaseKind;
+  for (const BaseKind kind : {BaseKind::Fixed, BaseKind::Free, BaseKind::Planar}) {
+    FloatingCase c = sphericalTree(kind, 5u);
+    INFO(zwang::testing::toString(kind) << " base");
+    const Model& m = c.model;
+    Workspace ws(m, c.task);
+    Eigen::MatrixXd J(3, m.nv()), J_wrong(3, 1);
+    Vec3 position, velocity, acceleration;
+    Vec6 momentum;
+    double mass = 0.0;
+    Status statuses[10];
+    const auto cycle = [&] {
+      statuses[0] = solveHybridDynamics(m, ws, c.q, c.v, c.tau, c.task);
+      for (const int joint : {kWholeRobot, 2}) {
+        statuses[1] = subtreeMass(m, joint, mass);
+        statuses[2] = centerOfMass(m, ws, c.q, joint, position);
+        statuses[3] = centerOfMassVelocity(m, ws, c.q, c.v, joint, velocity);
+        statuses[4] = centerOfMassAcceleration(m, ws, c.q, c.v, joint, acceleration);
+        statuses[5] = centroidalMomentum(m, ws, c.q, c.v, joint, momentum);
+        statuses[6] = jacobianCenterOfMass(m, ws, c.q, joint, J);
+      }
+      // Error returns: a joint index out of range, a Jacobian of the wrong size, a query for another q̇ (τ).
+      statuses[7] = centerOfMass(m, ws, c.q, 1000, position);
+      statuses[8] = jacobianCenterOfMass(m, ws, c.q, kWholeRobot, J_wrong);
+      statuses[9] = centerOfMassAcceleration(m, ws, c.q, c.tau, 0, velocity);
+    };
+    cycle();  // warm
+    const long allocations = allocationsDuring(cycle);
+    for (int k = 0; k <= 6; ++k) {
+      INFO("call " << k << ": " << statuses[k].message);
+      CHECK(statuses[k].ok());
+    }
+    CHECK(statuses[7].code == StatusCode::ModelMismatch);
+    CHECK(statuses[8].code == StatusCode::SizeMismatch);
+    CHECK(statuses[9].code == StatusCode::NotComputed);
+    CHECK(allocations == 0);
+    CHECK(mass > 0.0);
+  }
+  const Model model = panda();
+  Workspace ws(model, 0);
+  const Eigen::VectorXd x = Eigen::VectorXd::Zero(7);
+  const Eigen::Ref<const Eigen::VectorXd> r(x);
+  Vec3 out3;
+  Vec6 out6;
+  double mass = 0.0;
+  static_assert(noexcept(subtreeMass(model, kWholeRobot, mass)));
+  static_assert(noexcept(centerOfMass(model, ws, r, kWholeRobot, out3)));
+  static_assert(noexcept(centerOfMassVelocity(model, ws, r, r, kWholeRobot, out3)));
+  static_assert(noexcept(centerOfMassAcceleration(model, ws, r, r, kWholeRobot, out3)));
+  static_assert(noexcept(centroidalMomentum(model, ws, r, r, kWholeRobot, out6)));
+  static_assert(std::is_same_v<decltype(jacobianCenterOfMass),
+                               Status(const Model&, Workspace&, const Eigen::Ref<const Eigen::VectorXd>&, int,
+                                      Eigen::Ref<Eigen::MatrixXd>) noexcept>);
+}

@@ -173,7 +173,7 @@ TEST_CASE("No friction section: the plain solver, no friction key", "[golden]") 
   std::vector<std::string> keys;
   for (const auto& item : s.items()) keys.push_back(item.key());
   CHECK(keys == std::vector<std::string>{"joints", "dofs", "qdd", "tau_constraint", "tau_control", "nu", "gauss",
-                                         "effort_exceeded", "status", "frames"});
+                                         "effort_exceeded", "status", "frames", "com"});
   CHECK(s["dofs"] == s["joints"]);  // one-DOF joints: a DOF is named as its joint
   // friction disabled explicitly: the same
   const Json d = solve(problem("arm_friction_disabled.json"));
@@ -507,6 +507,13 @@ TEST_CASE("A free base (solo12, \"base\" type free): it falls at g; the feet hel
     CHECK(fall["base"]["acceleration"][k].get<double>() == Approx(g[k]).margin(1e-12));  // level, at rest
   }
   for (const Json& x : fall["qdd"]) CHECK(std::abs(x.get<double>()) < 1e-12);
+  // Nothing holds it: its centre of mass falls at g from rest (com, world axes, classical acceleration).
+  for (std::size_t k = 0; k < 3; ++k) {
+    CHECK(fall["com"]["acceleration"][k].get<double>() == Approx(g[k]).margin(1e-12));
+    CHECK(fall["com"]["velocity"][k].get<double>() == 0.0);
+  }
+  CHECK(fall["com"]["position"][2].get<double>() > 0.0);  // above the ground, legs under it: below the base at 0.3
+  CHECK(fall["com"]["position"][2].get<double>() < 0.3);
 
   const Json s = solve(problem("solo_feet.json"));
   CHECK(s["status"]["rank"] == 12);
@@ -529,6 +536,13 @@ TEST_CASE("A free base (solo12, \"base\" type free): it falls at g; the feet hel
   sameAs(s["base"]["tau_constraint"], ws.solution.tau_constraint.head(6));
   sameAs(s["tau_control"], ws.solution.tau_control.tail(12));
   sameAs(s["nu"], ws.solution.nu);
+  zwang::Vec3 c, cd, cdd;
+  REQUIRE(zwang::centerOfMass(f.model, ws, f.q, zwang::kWholeRobot, c));
+  REQUIRE(zwang::centerOfMassVelocity(f.model, ws, f.q, f.qd, zwang::kWholeRobot, cd));
+  REQUIRE(zwang::centerOfMassAcceleration(f.model, ws, f.q, f.qd, zwang::kWholeRobot, cdd));
+  sameAs(s["com"]["position"], c);
+  sameAs(s["com"]["velocity"], cd);
+  sameAs(s["com"]["acceleration"], cdd);
 }
 
 TEST_CASE(
@@ -665,6 +679,57 @@ TEST_CASE("joint_modes: Fig. 5.5's motion prescribed, at rest and moving, in clo
   CHECK(h["qdd"][0].get<double>() == 0.0);
   CHECK(h["tau_control"][0].get<double>() == Approx(5.0).margin(1e-12));
   CHECK(h["friction"]["mu"][0].get<double>() == 0.0);
+}
+
+TEST_CASE("fk: every frame's pose and the centre of mass, the tool and the library agree", "[golden]") {
+  const std::string urdf = std::string(ZWANG_MODELS_DIR) + "/panda.urdf";
+  const Run r = run({"fk", urdf, "--q", "0.1,-0.5,0.2,-2,0.3,1.5,0.7"});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  const Json out = parse(r.out);
+  const zwang::Model model = zwang::loadUrdfFile(urdf);
+  Eigen::VectorXd q(7);
+  q << 0.1, -0.5, 0.2, -2, 0.3, 1.5, 0.7;
+  zwang::Workspace ws(model, 0);
+  REQUIRE(zwang::forwardKinematics(model, ws, q, Eigen::VectorXd::Zero(7)));
+  REQUIRE(out["frames"].size() == model.frames().size());
+  for (int f = 0; f < static_cast<int>(model.frames().size()); ++f) {
+    Eigen::Isometry3d pose;
+    REQUIRE(zwang::framePose(model, ws, q, f, pose));
+    const Json& frame = out["frames"][model.frame(f).name];
+    sameAs(frame["position"], pose.translation());
+    // The quaternion w first: the same rotation (to rounding: converted from the matrix and back).
+    const std::vector<double> wxyz = numbers(frame["quaternion"]);
+    const Eigen::Quaterniond turn(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+    CHECK(std::abs(turn.norm() - 1.0) < 1e-15);
+    CHECK((turn.toRotationMatrix() - pose.linear()).cwiseAbs().maxCoeff() < 1e-15);
+  }
+  zwang::Vec3 c;
+  double mass = 0.0;
+  REQUIRE(zwang::centerOfMass(model, ws, q, zwang::kWholeRobot, c));
+  REQUIRE(zwang::subtreeMass(model, zwang::kWholeRobot, mass));
+  sameAs(out["com"]["position"], c);
+  CHECK(out["com"]["mass"].get<double>() == mass);
+  sameAs(out["com"]["velocity"], Eigen::Vector3d::Zero());
+  sameAs(out["q"], q);
+
+  // A problem file gives the state: solo_fall's com is the one solve prints.
+  const Run fall = run({"fk", problem("solo_fall.json")});
+  REQUIRE(fall.exit_code == 0);
+  const Json solved = solve(problem("solo_fall.json"));
+  CHECK(parse(fall.out)["com"]["position"] == solved["com"]["position"]);
+  CHECK(parse(fall.out)["frames"].contains("FL_FOOT"));
+
+  // Without --q: the neutral configuration (zeros for the Panda's joints, within its limits).
+  const Run neutral = run({"fk", urdf});
+  REQUIRE(neutral.exit_code == 0);
+  CHECK(parse(neutral.out)["q"].size() == 7);
+
+  checkOneLineError(run({"fk", urdf, "--q", "1,2"}), 1);  // nq = 7
+  const Run wrong = run({"fk", urdf, "--q", "1,2"});
+  CHECK(contains(wrong.err, "--q: q has 2 entries"));
+  CHECK(run({"fk", urdf, "--q", "1,x"}).exit_code == 2);
+  CHECK(run({"fk", problem("solo_fall.json"), "--q", "1"}).exit_code == 2);
 }
 
 TEST_CASE("--pretty and -o give the same numbers", "[golden]") {

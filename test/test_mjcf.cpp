@@ -572,12 +572,45 @@ TEST_CASE("MJCF: mapping details (mimic, limits, friction, sites, intermediate f
   }
 }
 
+TEST_CASE("MJCF: a joint equality is a mimic joint that satisfies MuJoCo's equality", "[mjcf]") {
+  // q_a − ref_a = c0 + c1 (q_c − ref_c) in MuJoCo's terms, with refs on both joints: zwang's law must put MuJoCo's
+  // equality residual (efc_pos of its row) at zero wherever the leader is.
+  const std::string xml = R"(<mujoco><compiler angle="radian"/><worldbody>
+      <body name="B"><joint name="a" axis="0 0 1" ref="0.4"/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body>
+      <body name="C"><joint name="c" type="slide" axis="1 0 0" ref="-0.3"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/></body></worldbody>
+      <equality><joint joint1="a" joint2="c" polycoef="0.1 2 0 0 0"/></equality></mujoco>)";
+  const Model model = loadMjcfString(xml);
+  REQUIRE(model.mimicJoints().size() == 1);
+  const Mujoco mj(xml);
+  for (const double leader : {-1.0, 0.0, 0.7}) {
+    Eigen::VectorXd q(2), v = Eigen::VectorXd::Zero(2);
+    q << 0.0, leader;
+    model.followLeaders(q, v);
+    scatter(q, {0, 1}, mj.d()->qpos);
+    mj_forward(mj.m(), mj.d());
+    REQUIRE(mj.d()->nefc >= 1);
+    int row = -1;
+    for (int r = 0; r < mj.d()->nefc; ++r)
+      if (mj.d()->efc_type[r] == mjCNSTR_EQUALITY) row = r;
+    REQUIRE(row >= 0);
+    CHECK(std::abs(mj.d()->efc_pos[row]) < 1e-15);  // a few roundings of numbers below 2
+  }
+}
+
 TEST_CASE("MJCF: bad inputs are refused with the source and the reason", "[mjcf]") {
   CHECK_THROWS_WITH(loadMjcfFile("/no/such/file.xml"), Catch::StartsWith("/no/such/file.xml: cannot open the file"));
   CHECK_THROWS_WITH(loadMjcfFile(ZWANG_MODELS_DIR), Catch::Contains("it is a directory"));
   // MuJoCo's own message, with the line: a syntax error, an unknown element, an unknown attribute value.
   CHECK_THROWS_WITH(loadMjcfString("<mujoco><worldbody>"),
                     Catch::StartsWith("<string>: MuJoCo refuses the model: ") && Catch::Contains("XML parse error"));
+  try {  // MuJoCo's message spans lines; zwang's is one
+    loadMjcfString("<mujoco><worldbody><body><joint/></body></worldbody></mujoco>");
+    FAIL("a massless moving body loaded");
+  } catch (const ModelError& e) {
+    CHECK(std::string(e.what()).find('\n') == std::string::npos);
+    CHECK_THAT(e.what(), Catch::Contains("mass and inertia of moving bodies must be larger than mjMINVAL"));
+  }
   CHECK_THROWS_WITH(loadMjcfString("<mujoco><worldbody><bogus/></worldbody></mujoco>"),
                     Catch::Contains("MuJoCo refuses the model") && Catch::Contains("bogus"));
   CHECK_THROWS_WITH(loadMjcfString("<mujoco><worldbody><body><joint type=\"spiral\"/><geom size=\"1\"/></body>"

@@ -110,6 +110,20 @@ struct ModelDeleter {
 };
 using MjModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 
+// MuJoCo's messages span lines ("Error: …\nObject name = …, line = 3"): one line, as every message of zwang's.
+std::string oneLine(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '\n' || c == '\r' || c == '\t') {
+      if (!out.empty() && out.back() != ' ') out += ' ';
+    } else {
+      out += c;
+    }
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
 // The compiled model and the warnings MuJoCo gave; ModelError with MuJoCo's message when it refuses the file.
 // `vfs`: the text in memory (loadString) or null (a file on disk).
 MjModelPtr compile(const Reporter& report, const std::string& file, const mjVFS* vfs,
@@ -122,8 +136,8 @@ MjModelPtr compile(const Reporter& report, const std::string& file, const mjVFS*
   MjModelPtr model(mj_loadXML(file.c_str(), vfs, error, sizeof error));
   mju_user_warning = saved;
   warnings = capturedWarnings();
-  if (!model) report.fail(std::string("MuJoCo refuses the model: ") + (error[0] ? error : "no message"));
-  if (error[0]) warnings.emplace_back(error);  // with a model, the buffer holds the compiler's warning
+  if (!model) report.fail("MuJoCo refuses the model: " + (error[0] ? oneLine(error) : std::string("no message")));
+  if (error[0]) warnings.push_back(oneLine(error));  // with a model, the buffer holds the compiler's warning
   return model;
 }
 
@@ -239,6 +253,10 @@ Joint makeFreeJoint(Loading& L, int j) {
   joint.name = objectName(L.m, mjOBJ_JOINT, j, "joint");
   joint.type = JointType::Free;  // qpos is the body's pose in the world: the joint frame is the world's
   readJointData(L, j, joint);
+  if (joint.rotor_inertia != 0.0)
+    L.unmapped("joint '" + joint.name + "': armature " + fmt(joint.rotor_inertia) +
+               " on a free joint is zwang's rotor inertia on the body-frame velocity; MuJoCo's acts on the "
+               "world-axes velocity (the dynamics differ by armature · ω × v, docs/mujoco.md)");
   return joint;
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include <mujoco/mujoco.h>
+#include <urdf_parser/urdf_parser.h>
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 
@@ -38,7 +39,8 @@ namespace {
 // the inertia matrix's condition (light bodies next to armatures), stays far below this bound of the issue.
 constexpr double kMujocoTolerance = 1e-9;
 // The same robot through two loaders: the same arithmetic but for the rotations (URDF rpy, MJCF quaternions, read
-// back from %.17g) and the inertias (URDF's tensor, MJCF's principal axes): a few ulps in the data.
+// back from %.17g) and the inertias (URDF's tensor, MJCF's principal axes): a few ulps in the data, which the
+// solutions carry times the balance's condition (compareSolutions).
 constexpr double kLoaderTolerance = 1e-12;
 
 std::string num(double x) {
@@ -355,6 +357,7 @@ Eigen::VectorXd reorder(const Model& from, const Model& to, const Eigen::VectorX
 
 struct Solved {
   Eigen::VectorXd qdd, qdd_friction;
+  double condition = 1.0;  // the plain solve's balance (BalanceReport::condition)
 };
 
 // A plain solve with one random constraint and a friction solve of the same task.
@@ -371,6 +374,7 @@ Solved solveBoth(const Model& model, const Eigen::VectorXd& q, const Eigen::Vect
   INFO(plain.message);
   REQUIRE(plain);
   s.qdd = ws.solution.qdd;
+  s.condition = ws.solution.balance.condition;
   const Status friction = solveWithFriction(model, ws, q, qd, tau, task);
   INFO(friction.message);
   REQUIRE(friction);
@@ -379,6 +383,108 @@ Solved solveBoth(const Model& model, const Eigen::VectorXd& q, const Eigen::Vect
 }
 
 }  // namespace
+
+namespace {
+
+// A plain problem on `urdf` (one random constraint on `frame`, half the joints at rest) solved on both models; the
+// worst scaled difference of q̈, plain and with friction.
+std::pair<double, double> compareSolutions(std::mt19937_64& rng, const Model& urdf, const Model& mjcf,
+                                           const std::string& frame, const Eigen::Vector3d& gravity) {
+  Eigen::VectorXd q(urdf.nq()), qd = randomVector(rng, urdf.nv(), 1.0);
+  for (const Joint& j : urdf.joints()) {
+    const double lo = std::max(j.lower, -3.0), hi = std::min(j.upper, 3.0);
+    q(j.q_index) = uniform(rng, lo, hi);
+    if (uniform01(rng) < 0.5) qd(j.v_index) = 0.0;  // at rest: static friction decides
+  }
+  const Eigen::VectorXd tau = randomVector(rng, urdf.nv(), 5.0);
+  const int rows = uniformInt(rng, 1, 3);
+  ConstraintMatrix A(6, rows);
+  for (int c = 0; c < rows; ++c) A.col(c) = randomVector(rng, 6, 1.0).normalized();
+  const Eigen::VectorXd b = randomVector(rng, rows, 2.0);
+  const Solved su = solveBoth(urdf, q, qd, tau, gravity, frame, A, b);
+  const Solved sm =
+      solveBoth(mjcf, reorder(urdf, mjcf, q), reorder(urdf, mjcf, qd), reorder(urdf, mjcf, tau), gravity, frame, A, b);
+  // The two models' data differ by a few ulps; the balance amplifies such differences by up to its condition
+  // number (a task near singular), so the errors are compared per unit of it (a singular balance, infinite
+  // condition, projects instead: compared as they are).
+  const double per = std::isfinite(su.condition) ? std::max(1.0, su.condition) : 1.0;
+  return {scaledError(reorder(mjcf, urdf, sm.qdd), su.qdd) / per,
+          scaledError(reorder(mjcf, urdf, sm.qdd_friction), su.qdd_friction) / per};
+}
+
+// A URDF chain read by urdfdom alone (not zwang's loader) into a ChainSpec, for mjcf_writer.
+LinkSpec linkSpec(const urdf::Link& link) {
+  LinkSpec spec;
+  spec.name = link.name;
+  if (!link.inertial) return spec;
+  const urdf::Inertial& in = *link.inertial;
+  spec.mass = in.mass;
+  spec.com = Eigen::Vector3d(in.origin.position.x, in.origin.position.y, in.origin.position.z);
+  in.origin.rotation.getRPY(spec.inertial_rpy.x(), spec.inertial_rpy.y(), spec.inertial_rpy.z());
+  spec.inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+  return spec;
+}
+
+ChainSpec chainFromUrdf(const std::string& path) {
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(path);
+  REQUIRE(model);
+  ChainSpec spec;
+  spec.name = model->getName();
+  urdf::LinkConstSharedPtr link = model->getRoot();
+  spec.links.push_back(linkSpec(*link));
+  while (!link->child_joints.empty()) {
+    REQUIRE(link->child_joints.size() == 1);  // a chain
+    const urdf::Joint& uj = *link->child_joints[0];
+    JointSpec j;
+    j.name = uj.name;
+    j.type = uj.type == urdf::Joint::REVOLUTE     ? "revolute"
+             : uj.type == urdf::Joint::CONTINUOUS ? "continuous"
+             : uj.type == urdf::Joint::PRISMATIC  ? "prismatic"
+                                                  : "fixed";
+    const urdf::Pose& o = uj.parent_to_joint_origin_transform;
+    j.xyz = Eigen::Vector3d(o.position.x, o.position.y, o.position.z);
+    o.rotation.getRPY(j.rpy.x(), j.rpy.y(), j.rpy.z());
+    j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
+    if (uj.limits) {
+      j.lower = uj.limits->lower;
+      j.upper = uj.limits->upper;
+    }
+    if (uj.dynamics) {
+      j.friction = uj.dynamics->friction;
+      j.damping = uj.dynamics->damping;
+    }
+    spec.joints.push_back(j);
+    link = model->getLink(uj.child_link_name);
+    spec.links.push_back(linkSpec(*link));
+  }
+  return spec;
+}
+
+}  // namespace
+
+TEST_CASE("MJCF: the Panda as URDF and as MJCF loads into the same model and the same solutions", "[mjcf]") {
+  // models/panda.urdf read by urdfdom and written as MJCF with its limits, friction and damping.
+  const std::string path = std::string(ZWANG_MODELS_DIR) + "/panda.urdf";
+  const Eigen::Vector3d gravity(0.0, 0.0, -9.81);
+  const std::string mjcf_text =
+      toMjcf(chainFromUrdf(path), gravity, FloatingBase{BaseKind::Fixed, Eigen::Isometry3d::Identity()}, {true});
+  const Model urdf = loadUrdfFile(path);
+  const Model mjcf = loadMjcfString(mjcf_text);
+  REQUIRE(urdf.joints().size() == 7);
+  CHECK(urdf.joint(3).breakaway_friction > 0.0);  // the data compared is there
+  checkSameModel(urdf, mjcf);
+  std::mt19937_64 rng(stressSeedOr(30004));
+  double worst_plain = 0.0, worst_friction = 0.0;
+  for (int draw = 0; draw < 50; ++draw) {
+    const auto [plain, friction] = compareSolutions(rng, urdf, mjcf, draw % 2 ? "tool0" : "panda_link4", gravity);
+    CHECK(plain < kLoaderTolerance);
+    CHECK(friction < kLoaderTolerance);
+    worst_plain = std::max(worst_plain, plain);
+    worst_friction = std::max(worst_friction, friction);
+  }
+  std::printf("Panda, MJCF vs URDF: 50 problems; worst q̈ per unit of condition %.2e plain, %.2e with friction\n",
+              worst_plain, worst_friction);
+}
 
 TEST_CASE("MJCF: a random tree as URDF and as MJCF loads into the same model and the same solutions", "[mjcf]") {
   std::mt19937_64 rng(stressSeedOr(30002));
@@ -399,31 +505,18 @@ TEST_CASE("MJCF: a random tree as URDF and as MJCF loads into the same model and
     checkSameModel(urdf, mjcf.model);
     joints += static_cast<int>(urdf.joints().size());
 
-    Eigen::VectorXd q(urdf.nq()), qd = randomVector(rng, urdf.nv(), 1.0);
-    for (const Joint& j : urdf.joints()) {
-      const double lo = std::max(j.lower, -3.0), hi = std::min(j.upper, 3.0);
-      q(j.q_index) = uniform(rng, lo, hi);
-      if (uniform01(rng) < 0.5) qd(j.v_index) = 0.0;  // at rest: static friction decides
-    }
-    const Eigen::VectorXd tau = randomVector(rng, urdf.nv(), 5.0);
     const std::string frame =
         spec.links[static_cast<std::size_t>(uniformInt(rng, 1, static_cast<int>(spec.links.size()) - 1))].name;
-    const int rows = uniformInt(rng, 1, 3);
-    ConstraintMatrix A(6, rows);
-    for (int c = 0; c < rows; ++c) A.col(c) = randomVector(rng, 6, 1.0).normalized();
-    const Eigen::VectorXd b = randomVector(rng, rows, 2.0);
-    const Solved su = solveBoth(urdf, q, qd, tau, gravity, frame, A, b);
-    const Solved sm = solveBoth(mjcf.model, reorder(urdf, mjcf.model, q), reorder(urdf, mjcf.model, qd),
-                                reorder(urdf, mjcf.model, tau), gravity, frame, A, b);
-    const double plain = scaledError(reorder(mjcf.model, urdf, sm.qdd), su.qdd);
-    const double friction = scaledError(reorder(mjcf.model, urdf, sm.qdd_friction), su.qdd_friction);
+    const auto [plain, friction] = compareSolutions(rng, urdf, mjcf.model, frame, gravity);
     CHECK(plain < kLoaderTolerance);
     CHECK(friction < kLoaderTolerance);
     worst_plain = std::max(worst_plain, plain);
     worst_friction = std::max(worst_friction, friction);
   }
-  std::printf("MJCF vs URDF: 100 random trees, %d joints; worst q̈ %.2e plain, %.2e with friction\n", joints,
-              worst_plain, worst_friction);
+  std::printf(
+      "MJCF vs URDF: 100 random trees, %d joints; worst q̈ per unit of condition %.2e plain, %.2e with "
+      "friction\n",
+      joints, worst_plain, worst_friction);
 }
 
 namespace {

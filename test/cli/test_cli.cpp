@@ -98,6 +98,17 @@ TEST_CASE("1-DOF arm from MJCF: mu* = -5, qdd = 0 at 5 N; mu* = -10, qdd = -1/2.
   CHECK(info.exit_code == 0);
   CHECK(contains(info.out, "joint1"));
   CHECK(contains(info.out, "tip"));
+  // Without "gravity", the MJCF's <option gravity>: along -y it pulls the arm's COM (0.5 m out) down, so
+  // qdd = -9.81 * 0.5 / 2.25.
+  std::string arm = cli_test::readText(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.xml");
+  const std::string down = "gravity=\"0 0 -9.81\"";
+  REQUIRE(arm.find(down) != std::string::npos);
+  arm.replace(arm.find(down), down.size(), "gravity=\"0 -9.81 0\"");
+  const std::string dir = cli_test::scratchDir();
+  cli_test::writeText(dir + "/arm_gravity_y.xml", arm);
+  cli_test::writeText(dir + "/arm_gravity_y.json", "{\"model\": \"arm_gravity_y.xml\", \"q\": [0]}");
+  const Json fall = solve(dir + "/arm_gravity_y.json");
+  CHECK(fall["qdd"][0].get<double>() == Approx(-9.81 * 0.5 / 2.25).margin(1e-12));
   // A URDF-only option on an MJCF model is refused, naming it.
   const Run tip = run({"info", std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.xml", "--tip", "tip"});
   CHECK(tip.exit_code != 0);

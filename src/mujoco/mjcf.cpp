@@ -130,11 +130,19 @@ MjModelPtr compile(const Reporter& report, const std::string& file, const mjVFS*
                    std::vector<std::string>& warnings) {
   const std::lock_guard<std::mutex> lock(loadMutex());
   capturedWarnings().clear();
-  void (*saved)(const char*) = mju_user_warning;
-  mju_user_warning = captureWarning;
+  struct Capture {  // MuJoCo's handler back however the load ends
+    void (*saved)(const char*) = mju_user_warning;
+    Capture() { mju_user_warning = captureWarning; }
+    ~Capture() { mju_user_warning = saved; }
+    Capture(const Capture&) = delete;
+    Capture& operator=(const Capture&) = delete;
+  };
   char error[2000] = "";
-  MjModelPtr model(mj_loadXML(file.c_str(), vfs, error, sizeof error));
-  mju_user_warning = saved;
+  MjModelPtr model;
+  {
+    const Capture capture;
+    model.reset(mj_loadXML(file.c_str(), vfs, error, sizeof error));
+  }
   warnings = capturedWarnings();
   if (!model) report.fail("MuJoCo refuses the model: " + (error[0] ? oneLine(error) : std::string("no message")));
   if (error[0]) warnings.push_back(oneLine(error));  // with a model, the buffer holds the compiler's warning

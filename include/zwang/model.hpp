@@ -210,6 +210,9 @@ enum class WarningCode {
   Urdfdom,  ///< urdfdom's own warning, passed on once
   /// a contact on a fixed-base model whose base carries mass (Task::warnings): a robot meant to stand bolted down
   FixedBaseContact,
+  /// something an MJCF file holds that zwang does not model (tendons, actuators, contacts, springs, …): ignored
+  Unmapped,
+  Mujoco,  ///< MuJoCo's compiler warning on an MJCF file, passed on once
 };
 /// "point_mass", "placeholder_inertia", …: stable names for scripts and the CLI's JSON.
 const char* toString(WarningCode code);

@@ -249,7 +249,7 @@ int commandInfo(int argc, char** argv) {
   const internal::NamedUrdfOptions options = problem::urdfOptions(request);
   Model model;
   try {
-    model = internal::loadUrdfFile(path, options);
+    model = problem::loadModelFile(path, options).model;
   } catch (const ModelError& e) {
     throw CliError(kExitError, e.what());
   }

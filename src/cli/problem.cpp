@@ -322,10 +322,13 @@ internal::NamedUrdfOptions urdfOptions(const Problem& p) {
   return urdf;
 }
 
-Model loadModel(const JsonReader& in, const Problem& p) {
+// The model (URDF or MJCF: the problem layer's choice) and the gravity its file states (MJCF).
+Model loadModel(const JsonReader& in, const Problem& p, std::optional<Vec3>& file_gravity) {
   Model model;
   try {
-    model = internal::loadUrdfFile(p.model_path, urdfOptions(p));
+    problem::LoadedModel loaded = problem::loadModelFile(p.model_path, urdfOptions(p));
+    model = std::move(loaded.model);
+    file_gravity = loaded.gravity;
   } catch (const ModelError& e) {
     // A relative "model" the loader could not open: say what it was resolved to and why.
     std::error_code ec;
@@ -334,7 +337,9 @@ Model loadModel(const JsonReader& in, const Problem& p) {
     in.fail("model", e.what());
   }
   if (model.hasFloatingBase() && !p.base.present)
-    in.fail("base", std::string("missing: the URDF's root joint gives the robot a ") + toString(model.baseType()) +
+    in.fail("base", std::string(problem::isMjcfPath(p.model_path) ? "missing: the MJCF's free joint gives"
+                                                                  : "missing: the URDF's root joint gives") +
+                        " the robot a " + toString(model.baseType()) +
                         " base, whose state the problem must give: \"base\": {\"type\": \"" +
                         toString(model.baseType()) + "\", …} (docs/cli.md, \"Floating base\")");
   // An option that would change nothing is refused, as "breakaway" without "friction" is.
@@ -452,7 +457,8 @@ Problem readProblem(const std::string& file) {
 
 BoundProblem bindProblem(const Problem& p) {
   const JsonReader in(p.file);
-  Model model = loadModel(in, p);
+  std::optional<Vec3> file_gravity;
+  Model model = loadModel(in, p, file_gravity);
   // The per-joint overrides by the problem layer's rules: their lengths against the model, each finite and >= 0.
   if (p.rotor_inertia)
     model = atPath(in, "", [&] { return problem::withRotorInertia(model, "rotor_inertia", *p.rotor_inertia); });
@@ -462,6 +468,7 @@ BoundProblem bindProblem(const Problem& p) {
   BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, std::move(friction), {}};
   placeState(in, p, b);
   buildTask(in, p, b);
+  if (!p.gravity && file_gravity) b.task->gravity = *file_gravity;  // an MJCF file's gravity, unless the problem's
   b.with_friction = p.friction.present && p.friction.enabled;
   return b;
 }

@@ -113,6 +113,8 @@ const char* toString(WarningCode code) {
     case WarningCode::MimicLocked: return "mimic_locked";
     case WarningCode::Urdfdom: return "urdfdom";
     case WarningCode::FixedBaseContact: return "fixed_base_contact";
+    case WarningCode::Unmapped: return "unmapped";
+    case WarningCode::Mujoco: return "mujoco";
   }
   return "unknown";
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -66,6 +67,21 @@ struct ModelRequest {
   internal::UrdfOptionNames names;
 };
 internal::NamedUrdfOptions urdfOptions(const ModelRequest& request);
+
+// A model file as a front end loads it, and the gravity the file states (MJCF's <option gravity>; none for URDF).
+struct LoadedModel {
+  Model model;
+  std::optional<Vec3> gravity;
+};
+// True for a path the front ends read as MJCF: it ends in ".xml" (any case); any other is URDF.
+bool isMjcfPath(const std::string& path);
+// The model at `path`: MJCF (isMjcfPath) through the MJCF loader (zwang/mjcf.hpp) when zwang is built with MuJoCo,
+// else URDF with `options`. For MJCF the URDF-only options (root, tip, attach_beyond_tip, lock_mimic, rotor
+// inertias) are refused, a base type must be the file's (options.base_may_match_file) and strict applies.
+// ModelError naming the file; without MuJoCo "MJCF needs zwang built with MuJoCo".
+LoadedModel loadModelFile(const std::string& path, const internal::NamedUrdfOptions& options);
+// An MJCF model from a file (`from_string` false) or from text (true), as loadModelFile loads it.
+LoadedModel loadMjcf(const std::string& source, bool from_string, bool strict);
 
 // "fixed", "free", "planar"; ProblemError(Value) naming the allowed ones. Where
 // "fixed" is no value (`no_fixed` given), "fixed" is refused with `no_fixed` as the hint.

@@ -483,6 +483,38 @@ void bindModelBuilder(py::module_& m) {
           "the Model (ModelError when a moving body has no inertia to move); warnings as load_urdf issues them");
 }
 
+// load_mjcf, load_mjcf_string, read_mjcf: the problem layer's MJCF loader (a ModelError without MuJoCo).
+void bindMjcfLoaders(py::module_& m) {
+  m.def(
+      "load_mjcf",
+      [](py::handle path, bool strict) {
+    return issueWarnings(std::make_shared<Model>(problem::loadMjcf(pathArg(path), false, strict).model));
+      },
+      py::arg("path"), py::kw_only(), py::arg("strict") = false,
+      "Load an MJCF (MuJoCo XML) model through MuJoCo's compiler (docs/mujoco.md): hinge, slide, ball and\n"
+      "free joints, armature, frictionloss, damping, limits; tendons, actuators, contacts and other\n"
+      "equalities are not mapped (a zwang.ModelWarning names them; strict=True raises ModelError instead).\n"
+      "A free joint's linear velocity is in the body frame (MuJoCo: world axes). The file's gravity:\n"
+      "read_mjcf. Raises ModelError (also when zwang was built without MuJoCo).");
+  m.def(
+      "load_mjcf_string",
+      [](const std::string& xml, bool strict) {
+    return issueWarnings(std::make_shared<Model>(problem::loadMjcf(xml, true, strict).model));
+      },
+      py::arg("xml"), py::kw_only(), py::arg("strict") = false, "load_mjcf from a string holding the MJCF XML.");
+  m.def(
+      "read_mjcf",
+      [](py::handle path, bool strict) {
+    problem::LoadedModel loaded = problem::loadMjcf(pathArg(path), false, strict);
+    const Vec3 g = loaded.gravity.value_or(Vec3::Zero());
+    return py::make_tuple(issueWarnings(std::make_shared<Model>(std::move(loaded.model))),
+                          py::array_t<double>(3, g.data()));
+      },
+      py::arg("path"), py::kw_only(), py::arg("strict") = false,
+      "(model, gravity): load_mjcf's model and the file's <option gravity> (numpy array, m/s^2; zero when\n"
+      "the file disables gravity), for Task.gravity.");
+}
+
 // load_urdf, load_urdf_string.
 void bindLoaders(py::module_& m) {
   m.def(
@@ -517,6 +549,7 @@ void bindLoaders(py::module_& m) {
       py::arg("xml"), py::arg("root") = "", py::arg("tip") = "", py::arg("rotor_inertia") = py::none(), py::kw_only(),
       py::arg("strict") = false, py::arg("attach_beyond_tip") = false, py::arg("lock_mimic") = false,
       py::arg("base") = "fixed", "load_urdf from a string holding the URDF XML.");
+  bindMjcfLoaders(m);
 }
 
 }  // namespace

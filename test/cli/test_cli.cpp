@@ -81,6 +81,45 @@ TEST_CASE("1-DOF arm, tip force -5 N: stick, mu* = -5, qdd = 0, tau_control = 0"
   CHECK(s["gauss"].get<double>() == Approx(0.0).margin(1e-12));
 }
 
+// The same arm as MJCF (models/one_dof_arm.xml) through the MJCF loader: the report's seed table again.
+TEST_CASE("1-DOF arm from MJCF: mu* = -5, qdd = 0 at 5 N; mu* = -10, qdd = -1/2.25 at 11 N", "[mjcf]") {
+#ifdef ZWANG_CLI_WITH_MUJOCO
+  const Json stick = solve(problem("arm_stick_mjcf.json"));
+  CHECK(stick["joints"] == Json::array({"joint1"}));
+  CHECK(stick["friction"]["mu"][0].get<double>() == Approx(-5.0).margin(1e-9));
+  CHECK(stick["qdd"][0].get<double>() == Approx(0.0).margin(1e-12));
+  CHECK(stick["friction"]["state"][0] == "stick");
+  const Json slip = solve(problem("arm_slip_mjcf.json"));
+  CHECK(slip["friction"]["mu"][0].get<double>() == Approx(-10.0).margin(1e-12));
+  CHECK(slip["qdd"][0].get<double>() == Approx(-1.0 / 2.25).margin(1e-12));
+  CHECK(slip["friction"]["state"][0] == "slip-");
+  // zwang info reads it too: one joint, its frames (the world body, the link, the site).
+  const Run info = run({"info", std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.xml"});
+  CHECK(info.exit_code == 0);
+  CHECK(contains(info.out, "joint1"));
+  CHECK(contains(info.out, "tip"));
+  // Without "gravity", the MJCF's <option gravity>: along -y it pulls the arm's COM (0.5 m out) down, so
+  // qdd = -9.81 * 0.5 / 2.25.
+  std::string arm = cli_test::readText(std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.xml");
+  const std::string down = "gravity=\"0 0 -9.81\"";
+  REQUIRE(arm.find(down) != std::string::npos);
+  arm.replace(arm.find(down), down.size(), "gravity=\"0 -9.81 0\"");
+  const std::string dir = cli_test::scratchDir();
+  cli_test::writeText(dir + "/arm_gravity_y.xml", arm);
+  cli_test::writeText(dir + "/arm_gravity_y.json", "{\"model\": \"arm_gravity_y.xml\", \"q\": [0]}");
+  const Json fall = solve(dir + "/arm_gravity_y.json");
+  CHECK(fall["qdd"][0].get<double>() == Approx(-9.81 * 0.5 / 2.25).margin(1e-12));
+  // A URDF-only option on an MJCF model is refused, naming it.
+  const Run tip = run({"info", std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.xml", "--tip", "tip"});
+  CHECK(tip.exit_code != 0);
+  CHECK(contains(tip.err, "--tip applies to URDF models only"));
+#else
+  const Run r = run({"solve", problem("arm_stick_mjcf.json")});
+  CHECK(r.exit_code != 0);
+  CHECK(contains(r.err, "MJCF needs zwang built with MuJoCo"));
+#endif
+}
+
 TEST_CASE("1-DOF arm, tip force -11 N: slip, mu* = -10, qdd = -1/2.25", "[golden]") {
   const Json s = solve(problem("arm_slip.json"));
   const double qdd = -1.0 / 2.25;

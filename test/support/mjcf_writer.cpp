@@ -45,6 +45,7 @@ std::string xmlEscape(const std::string& text) {
 
 struct Writer {
   const ChainSpec& spec;
+  bool joint_data;
   std::vector<std::vector<int>> child_joints;  // per link: the joints it is the parent of, in index order
   std::ostringstream out;
 
@@ -81,8 +82,16 @@ struct Writer {
                                                : "hinge";
       out << inner << "<joint name=\"" << xmlEscape(joint.name) << "\" type=\"" << type << "\" pos=\"0 0 0\"";
       if (joint.nv() == 1) out << " axis=\"" << vec(joint.axis) << "\"";
-      out << " limited=\"false\" armature=\"" << num(joint.reflectedInertia())
-          << "\" damping=\"0\" stiffness=\"0\" frictionloss=\"0\"/>\n";
+      if (!joint_data) {
+        out << " limited=\"false\" armature=\"" << num(joint.reflectedInertia())
+            << "\" damping=\"0\" stiffness=\"0\" frictionloss=\"0\"/>\n";
+      } else {
+        const bool limited = joint.nv() == 1 && joint.type != "continuous" && joint.lower < joint.upper;
+        out << (limited ? " limited=\"true\" range=\"" + num(joint.lower) + " " + num(joint.upper) + "\""
+                        : std::string(" limited=\"false\""))
+            << " armature=\"" << num(joint.reflectedInertia()) << "\" damping=\"" << num(joint.damping)
+            << "\" stiffness=\"0\" frictionloss=\"" << num(joint.friction) << "\"/>\n";
+      }
     }
     inertial(link, inner);
     for (const int child : child_joints[static_cast<std::size_t>(k) + 1]) body(child, inner);
@@ -97,9 +106,14 @@ std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity) {
 }
 
 std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const FloatingBase& base) {
+  return toMjcf(spec, gravity, base, MjcfWriteOptions{});
+}
+
+std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const FloatingBase& base,
+                   const MjcfWriteOptions& options) {
   spec.check();  // among others: every joint's parent link comes before its child, so the links form a tree
   // Per link, the joints it is the parent of; one more entry: the free joints (top-level bodies).
-  Writer writer{spec, std::vector<std::vector<int>>(spec.links.size() + 1), {}};
+  Writer writer{spec, options.joint_data, std::vector<std::vector<int>>(spec.links.size() + 1), {}};
   for (std::size_t k = 0; k < spec.joints.size(); ++k) {
     const JointSpec& joint = spec.joints[k];
     const LinkSpec& child = spec.links[k + 1];
@@ -136,9 +150,10 @@ std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const 
       << "  <option gravity=\"" << vec(gravity)
       << "\" integrator=\"Euler\">\n"
       // The smooth dynamics only: no contacts, no constraint solver (hence no limits, friction loss or equality
-      // constraints), no passive forces (springs, damping).
-      << "    <flag contact=\"disable\" constraint=\"disable\" limit=\"disable\" frictionloss=\"disable\" "
-         "equality=\"disable\" passive=\"disable\"/>\n"
+      // constraints), no passive forces (springs, damping); with the joints' data, no contacts only.
+      << (options.joint_data ? "    <flag contact=\"disable\"/>\n"
+                             : "    <flag contact=\"disable\" constraint=\"disable\" limit=\"disable\" "
+                               "frictionloss=\"disable\" equality=\"disable\" passive=\"disable\"/>\n")
       << "  </option>\n"
       << "  <worldbody>\n";
   if (base.kind == BaseKind::Planar) {

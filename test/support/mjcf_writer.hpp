@@ -70,4 +70,15 @@ inline constexpr const char* kMjcfPlanarY = "floating_base_y";
 inline constexpr const char* kMjcfPlanarYaw = "floating_base_yaw";
 std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const FloatingBase& base);
 
+// What toMjcf writes beyond its default (the default writes none of it).
+struct MjcfWriteOptions {
+  // The joints' data as the URDF writer writes it, for loaders to compare (test_mjcf): limited="true" and
+  // range="lower upper" on revolute and prismatic joints with lower < upper (continuous and the others:
+  // limited="false"), frictionloss = JointSpec::friction, damping = JointSpec::damping; and in <option> only
+  // contacts disabled (limits, friction loss, equalities and passive forces enabled, since they are the data).
+  bool joint_data = false;
+};
+std::string toMjcf(const ChainSpec& spec, const Eigen::Vector3d& gravity, const FloatingBase& base,
+                   const MjcfWriteOptions& options);
+
 }  // namespace zwang::testing

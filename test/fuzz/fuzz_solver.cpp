@@ -8,7 +8,7 @@
 // fixed, free or planar (a random plane), with the base link's own inertia, a
 // base state (a free base's quaternion unit, off unit by 1e-12–1e-2, or any,
 // zero included), base velocities and generalized forces; contacts and joint
-// rows among the task's rows. Calls solveHybridDynamics, both friction
+// rows among the task's rows; prescribed and locked DOFs. Calls solveHybridDynamics, both friction
 // maximisers, RNEA, CRBA and a Jacobian.
 //
 // Fails (abort) when a call that returns Ok — or Infeasible, whose outputs
@@ -492,6 +492,19 @@ void checkHeldState(const Model& model, const Workspace& ws, const Eigen::Vector
 }
 
 // The solves, each status documented, every output of a successful one finite.
+// Prescribed DOFs (Task::setDofMode), drawn last so that older corpus entries keep their meaning: each entry of
+// v, the base's too, prescribed one time in four (a mimic joint's never: it follows its leader), its q̈ anywhere
+// in ±1e4 or zero (locked).
+void drawModes(FuzzedDataProvider& in, const Model& model, Task& task) {
+  std::vector<char> mimic(static_cast<std::size_t>(model.nv()), 0);
+  for (const int m : model.mimicJoints()) mimic[static_cast<std::size_t>(model.joint(m).v_index)] = 1;
+  for (int v = 0; v < model.nv() && in.remaining_bytes() > 0; ++v) {
+    if (mimic[static_cast<std::size_t>(v)] || in.ConsumeIntegralInRange(0, 3) != 0) continue;
+    task.setDofMode(v, DofMode::Prescribed);
+    task.prescribedAccelerations()[v] = in.ConsumeBool() ? 0.0 : signedLog(in, 1e-3, 1e4);
+  }
+}
+
 void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                const Eigen::VectorXd& tau, FrictionOptions& options, Workspace& ws) {
   const bool finite_inputs = q.allFinite() && qd.allFinite() && tau.allFinite();
@@ -576,9 +589,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!drawBase(in, chain)) return 0;
   const Model& model = chain.model;
   drawContactOrJointRows(in, model, frames, task_draw);
-  const Task task = buildTask(model, task_draw);
+  Task task = buildTask(model, task_draw);
   Eigen::VectorXd q, qd, tau;
   assembleState(in, model, joints, q, qd, tau);
+  drawModes(in, model, task);
   Workspace ws(model, task);
   runSolves(model, task, q, qd, tau, options, ws);
   checkNormalisation(model, task, q, qd, tau, ws);

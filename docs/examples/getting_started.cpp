@@ -7,7 +7,7 @@ int main(int argc, char** argv) {
   const zwang::Model model = zwang::loadUrdfFile(argc > 1 ? argv[1] : "models/panda.urdf");
   zwang::Task task(model);  // gravity (0, 0, -9.81) by default
   task.addConstraint("tool0", zwang::ConstraintMatrix::Identity(6, 6), zwang::Expressed::World);
-  task.targets().setZero();          // tool0's true acceleration: zero in all six directions
+  task.targets().setZero();  // tool0's true acceleration: zero in all six directions
   zwang::Workspace ws(model, task);  // all scratch memory, allocated once
 
   Eigen::VectorXd q(7), qd = Eigen::VectorXd::Zero(7), tau = Eigen::VectorXd::Zero(7);
@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
     std::printf("%-13s %10.4f %13.4f | %19.4f %13.4f %8.4f  %s\n", model.joint(j).name.c_str(), clean(plain_qdd[j]),
                 clean(plain[j]), clean(ws.solution.qdd[j]), clean(ws.solution.tau_control[j]), clean(ws.friction.mu[j]),
                 zwang::toString(ws.friction.state[j]));
-  std::printf("|tau|^2: %.1f plain, %.1f with friction; rank %d, singular %s, indeterminate %s\n", plain.squaredNorm(),
-              ws.solution.tau_control.squaredNorm(), ws.solution.balance.rank,
+  std::printf("|tau|^2: %.1f plain, %.1f with friction; rank %d, singular %s, indeterminate %s\n",
+              plain.squaredNorm(), ws.solution.tau_control.squaredNorm(), ws.solution.balance.rank,
               ws.solution.balance.singular ? "yes" : "no", ws.friction.indeterminate ? "yes" : "no");
 }

@@ -2035,3 +2035,44 @@ TEST_CASE("solve: multi-DOF joints by name, the solution's dofs; the tool and th
   }
   CHECK(s["qdd"][7].get<double>() == Approx(0.5).margin(1e-12));  // the joint row on j2
 }
+
+TEST_CASE("frames' wrench_world and wrench_local: closed form, and the tool and zwang::constraintWrench agree",
+          "[golden]") {
+  // The report's 1-DOF arm, one moment row about z on link1 (Fig. 5.5): ν = 2.25·5 + 10, a moment about z.
+  const Json s = solve(problem("arm_fig55.json"));
+  const double nu = 2.25 * 5 + 10;
+  for (const char* key : {"wrench_local", "wrench_world"}) {  // q = 0: the link's axes are the world's
+    const std::vector<double> w = numbers(s["frames"]["link1"][key]);
+    REQUIRE(w.size() == 6);
+    for (std::size_t k = 0; k < 5; ++k) CHECK(w[k] == 0.0);
+    CHECK(w[5] == Approx(nu).margin(1e-12));  // the solve's rounding, as "nu" above
+  }
+
+  // A relative constraint: both hands get a wrench (the reference's moment at its own origin), bit for bit the
+  // library's.
+  const Json r = solve(problem("relative_hands.json"));
+  const Json p = problemFile("relative_hands.json");
+  const zwang::Model model = zwang::loadUrdfFile(problem("two_arms.urdf"));
+  zwang::Task task(model);
+  task.addRelativeConstraint("left_hand", "right_hand", directionsOf(p["constraints"][0]));
+  zwang::Workspace ws(model, task);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(5), q = vectorOf(p["q"]);
+  REQUIRE(zwang::solveHybridDynamics(model, ws, q, zero, zero, task));
+  zwang::Vec6 left_world, right_world;
+  for (const char* frame : {"left_hand", "right_hand"})
+    for (const auto expressed : {zwang::Expressed::World, zwang::Expressed::Local}) {
+      zwang::Vec6 w;
+      REQUIRE(zwang::constraintWrench(model, ws, task, q, model.frameIndex(frame), expressed, w));
+      INFO(frame);
+      sameAs(r["frames"][frame][expressed == zwang::Expressed::World ? "wrench_world" : "wrench_local"], w);
+      if (expressed == zwang::Expressed::World) (std::string(frame) == "left_hand" ? left_world : right_world) = w;
+    }
+  CHECK(left_world.head<3>() == -right_world.head<3>());  // equal and opposite forces: one negated sum
+  CHECK(left_world.head<3>().norm() > 0.0);
+
+  // A frame that is only loaded (a wrench, no constraint) reports no constraint wrench.
+  const Json loaded = solve(problem("arm_plain.json"));
+  REQUIRE(loaded["frames"].contains("tip"));
+  CHECK_FALSE(loaded["frames"]["tip"].contains("wrench_world"));
+  CHECK_FALSE(loaded["frames"]["tip"].contains("wrench_local"));
+}

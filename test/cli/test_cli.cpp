@@ -2070,6 +2070,25 @@ TEST_CASE("frames' wrench_world and wrench_local: closed form, and the tool and 
   CHECK(left_world.head<3>() == -right_world.head<3>());  // equal and opposite forces: one negated sum
   CHECK(left_world.head<3>().norm() > 0.0);
 
+  // Solo 12 standing on four contacts (joints held by joint rows, which act on no frame): the feet's wrenches are
+  // the ground's forces, and with gravity they move the centre of mass: Σ f + M g = M c̈ (Newton, whole robot).
+  const Json stand = solve(problem("solo_stand.json"));
+  zwang::UrdfOptions options;
+  options.base = zwang::BaseType::Free;
+  double mass = 0;
+  REQUIRE(zwang::subtreeMass(zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/solo12.urdf", options),
+                             zwang::kWholeRobot, mass));
+  Eigen::Vector3d ground = Eigen::Vector3d::Zero();
+  for (const char* foot : {"FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"}) {
+    const Eigen::VectorXd w = vectorOf(stand["frames"][foot]["wrench_world"]);
+    ground += w.head<3>();
+    CHECK(w.tail<3>().isZero(0.0));  // force rows only: no moment at the foot, exactly
+  }
+  const Eigen::Vector3d com_acc = vectorOf(stand["com"]["acceleration"]);
+  const Eigen::Vector3d newton = ground + mass * Eigen::Vector3d(0, 0, -9.81) - mass * com_acc;
+  CHECK(newton.norm() < 1e-9 * mass * 9.81);  // the solve's rounding, relative to the weight
+  CHECK(ground.z() > 0.5 * mass * 9.81);      // the ground carries the robot
+
   // A frame that is only loaded (a wrench, no constraint) reports no constraint wrench.
   const Json loaded = solve(problem("arm_plain.json"));
   REQUIRE(loaded["frames"].contains("tip"));

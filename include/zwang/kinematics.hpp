@@ -60,6 +60,25 @@ Status frameAcceleration(const Model& model, const Workspace& ws, const Eigen::R
                          const Eigen::Ref<const Eigen::VectorXd>& qd, int frame, Expressed expressed,
                          Vec6& acceleration) noexcept;
 
+/// After a solve (solveHybridDynamics, solveWithFriction) at q with `task`:
+/// the 6-D wrench [f; n] the task's constraints exert on `frame`, at the
+/// frame's origin, in its axes (Local) or the world's (World; Reference is
+/// World too), from the ν the workspace holds (Solution::nu, read as it is,
+/// in the task's row order) and the poses at q. It is the sum over the task's
+/// constraints on the frame of A ν: an absolute constraint's, a contact's
+/// (the ground's force on the robot) and a relative constraint's +A ν on its
+/// frame; a frame that is the reference of a relative constraint gets −A ν,
+/// the force acting at the constrained frame's origin p_a, so that its moment
+/// about the reference's origin p_r is −(n + (p_a − p_r) × f). Joint rows and
+/// mimic couplings act along joints, not on frames: they are left out. A frame
+/// the task does not constrain gets zero. ModelMismatch for a task made for
+/// another model; NotComputed when solution.nu does not have the task's rows
+/// (no solve with it yet) or the workspace holds no poses at q
+/// (docs/solver.md, "Constraint wrenches").
+Status constraintWrench(const Model& model, const Workspace& ws, const Task& task,
+                        const Eigen::Ref<const Eigen::VectorXd>& q, int frame, Expressed expressed,
+                        Vec6& wrench) noexcept;
+
 /// J (6 × nv()) with frameVelocity = J q̇. Reads the poses when the workspace
 /// holds them at q (after forwardKinematics(q) or a solve at q: its results are
 /// kept); otherwise runs forwardKinematics(q) first, and the workspace then

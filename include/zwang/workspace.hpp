@@ -83,7 +83,9 @@ struct Solution {
   int first_joint_outside_limits = -1;  ///< the first joint outside its limits, −1 when none
   // The true classical acceleration of any frame (a body's own frame:
   // model.bodyFrame(b)) is computed on demand from the sweep by
-  // frameAcceleration() (kinematics.hpp), so a solve does not pay for it.
+  // frameAcceleration() (kinematics.hpp), and the wrench the task's
+  // constraints exert on a frame from `nu` by constraintWrench(), so a solve
+  // does not pay for them.
 };
 
 /// How far the kinematic results in a workspace go (Workspace::kinematics):

@@ -1,6 +1,7 @@
 // Reading the JSON problem of `zwang solve` and binding it to its model.
 #include "problem.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -370,9 +371,13 @@ void placeState(const JsonReader& in, const Problem& p, BoundProblem& b) {
   if (p.follow_leaders) m.followLeaders(b.q, b.qd);  // the followers' entries of "q" and "qd" are replaced
 }
 
-// A frame the solution reports: constrained, reference or loaded, in first appearance order.
-void reportFrame(BoundProblem& b, const std::string& name) {
+// A frame the solution reports: constrained, reference or loaded, in first appearance order; a constrained or
+// reference frame also in constrained_frames (its constraint wrench is reported).
+void reportFrame(BoundProblem& b, const std::string& name, bool constrained = false) {
   const int f = problem::frameIndex(b.model, name);
+  if (constrained &&
+      std::find(b.constrained_frames.begin(), b.constrained_frames.end(), f) == b.constrained_frames.end())
+    b.constrained_frames.push_back(f);
   for (const int g : b.reported_frames)
     if (g == f) return;
   b.reported_frames.push_back(f);
@@ -391,8 +396,8 @@ void buildTask(const JsonReader& in, const Problem& p, BoundProblem& b) {
     if (!c.desc.joint.empty() && targets.size() == 0)
       targets = Eigen::VectorXd::Zero(m.joint(problem::jointIndex(kJson, m, c.desc.joint)).nv());
     task.targets().segment(first, targets.size()) = targets;
-    if (c.desc.joint.empty()) reportFrame(b, c.desc.frame);
-    if (!c.desc.relative_to.empty()) reportFrame(b, c.desc.relative_to);
+    if (c.desc.joint.empty()) reportFrame(b, c.desc.frame, true);
+    if (!c.desc.relative_to.empty()) reportFrame(b, c.desc.relative_to, true);
   }
   for (const JointModeSpec& mode : p.joint_modes)
     atPath(in, mode.path, [&] { problem::setJointMode(kJson, m, task, mode.desc); });
@@ -465,7 +470,7 @@ BoundProblem bindProblem(const Problem& p) {
   FrictionOptions friction = p.friction.options;
   if (p.breakaway) friction.breakaway = *p.breakaway;
   atPath(in, "", [&] { problem::checkFrictionOverrides(model, friction); });
-  BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, std::move(friction), {}};
+  BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, std::move(friction), {}, {}};
   placeState(in, p, b);
   buildTask(in, p, b);
   if (!p.gravity && file_gravity) b.task->gravity = *file_gravity;  // an MJCF file's gravity, unless the problem's

@@ -89,6 +89,9 @@ struct BoundProblem {
   bool with_friction = false;  // run solveWithFriction (else solveHybridDynamics)
   FrictionOptions friction_options;
   std::vector<int> reported_frames;  // constrained, reference or loaded frames, first appearance order
+  // The reported frames the task's constraint rows act on: constrained or reference frames (not joint rows'),
+  // whose constraint wrench the solution reports.
+  std::vector<int> constrained_frames;
 };
 
 // Load the model (rotor_inertia applied), check lengths and frames, build the

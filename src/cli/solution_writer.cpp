@@ -1,6 +1,7 @@
 // Writing the solution of `zwang solve` as JSON.
 #include "solution_writer.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "cli.hpp"
@@ -60,6 +61,18 @@ Json comJson(const Model& model, const Workspace& ws) {
   return {{"position", array(position)}, {"velocity", array(velocity)}, {"acceleration", array(acceleration)}};
 }
 
+// The task's constraint wrench on frame f (constraintWrench: [f; n] at its origin), world and local axes.
+void addConstraintWrench(const Model& model, const Workspace& ws, const Task& task, int f, Json& entry) {
+  const auto wrench = [&](Expressed expressed) {
+    Vec6 w;
+    if (const Status s = constraintWrench(model, ws, task, ws.kinematics.q, f, expressed, w); !s)
+      throw CliError(kExitError, std::string("solve: ") + s.message);
+    return array(w);
+  };
+  entry["wrench_world"] = wrench(Expressed::World);
+  entry["wrench_local"] = wrench(Expressed::Local);
+}
+
 }  // namespace
 
 std::string prettyDump(const Json& value) {
@@ -68,8 +81,8 @@ std::string prettyDump(const Json& value) {
   return out;
 }
 
-Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, const Status& status,
-                  const std::vector<int>& frames) {
+Json solutionJson(const Model& model, const Workspace& ws, const Task& task, bool with_friction, const Status& status,
+                  const std::vector<int>& frames, const std::vector<int>& constrained_frames) {
   const Solution& s = ws.solution;
   Json out = Json::object();
   Json joints = Json::array();
@@ -128,7 +141,9 @@ Json solutionJson(const Model& model, const Workspace& ws, bool with_friction, c
     Vec6 a;
     if (const Status s = frameAcceleration(model, ws, ws.kinematics.q, ws.kinematics.qd, f, Expressed::World, a); !s)
       throw CliError(kExitError, std::string("solve: ") + s.message);
-    frame_map[model.frame(f).name] = {{"acceleration_world", array(a)}};
+    Json& entry = frame_map[model.frame(f).name] = {{"acceleration_world", array(a)}};
+    if (std::find(constrained_frames.begin(), constrained_frames.end(), f) != constrained_frames.end())
+      addConstraintWrench(model, ws, task, f, entry);
   }
   out["frames"] = std::move(frame_map);
   out["com"] = comJson(model, ws);

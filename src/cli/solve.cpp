@@ -53,7 +53,8 @@ int runProblem(const char* command, Solver solver, int argc, char** argv) {
   const bool infeasible = status.code == StatusCode::Infeasible;
   if (!status && !infeasible) throw CliError(kExitError, problem.file + ": " + command + ": " + status.message);
 
-  const Json solution = solutionJson(bound.model, ws, bound.with_friction, status, bound.reported_frames);
+  const Json solution = solutionJson(bound.model, ws, *bound.task, bound.with_friction, status, bound.reported_frames,
+                                     bound.constrained_frames);
   writeOutput(output, (args.has("--pretty") ? prettyDump(solution) : solution.dump()) + "\n");
   if (bound.with_friction)
     if (const std::string impact = problem::limitImpactMessage(bound.model, ws.friction); !impact.empty())

@@ -131,6 +131,7 @@ struct ResultData {
   Solution solution;
   FrictionResult friction;
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> frame_acc_local, frame_acc_world;
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> frame_wrench_local, frame_wrench_world;  // per frame
   py::object com;  // Result.com as it was: a dict of three arrays, or None
 };
 

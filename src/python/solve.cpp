@@ -238,6 +238,18 @@ Vec6 frameAccelerationOf(const Result& r, int frame, Expressed e) {
   return a;
 }
 
+// The constraint wrench of the solve's task on a frame (zwang::constraintWrench), live or as copied.
+Vec6 constraintWrenchOf(const Result& r, int frame, Expressed e) {
+  if (r.data)
+    return (e == Expressed::Local ? r.data->frame_wrench_local : r.data->frame_wrench_world).row(frame).transpose();
+  r.solution();  // stale check: the workspace's task is still the one this result was solved with
+  Vec6 w;
+  if (const Status s = constraintWrench(*r.model, *r.live->ws, *r.live->task, r.live->ws->kinematics.q, frame, e, w);
+      !s)
+    raiseStatus(s, "constraint_wrench");
+  return w;
+}
+
 // (bodies × 6) accelerations of every body's own frame, computed on demand.
 py::array bodyAccelerations(const Result& r, Expressed e) {
   const int bodies = r.model->bodyCount();
@@ -621,6 +633,15 @@ void addFrameProperties(py::class_<Result>& cls) {
     return vectorCopy(frameAccelerationOf(r, frameArg(*r.model, frame), expressedArg("expressed", expressed, true)));
           },
           py::arg("frame"), py::arg("expressed") = "world", "true classical acceleration [p̈; ω̇] of a frame's origin")
+      .def(
+          "constraint_wrench",
+          [](const Result& r, py::handle frame, const std::string& expressed) {
+    return vectorCopy(constraintWrenchOf(r, frameArg(*r.model, frame), expressedArg("expressed", expressed, true)));
+          },
+          py::arg("frame"), py::arg("expressed") = "world",
+          "the wrench [f; n] the task's constraints exert on a frame, at its origin (zwang::constraintWrench):\n"
+          "+A nu of its rows and contacts, -A nu of the relative rows it is the reference of; zeros for a frame\n"
+          "without constraints (joint rows act on no frame)")
       .def_property_readonly(
           "warnings",
           [](const Result& r) {
@@ -701,9 +722,13 @@ Result copyResult(const Result& r) {
   const auto frames = static_cast<Eigen::Index>(r.model->frames().size());
   data->frame_acc_local.resize(frames, 6);
   data->frame_acc_world.resize(frames, 6);
+  data->frame_wrench_local.resize(frames, 6);
+  data->frame_wrench_world.resize(frames, 6);
   for (int f = 0; f < frames; ++f) {
     data->frame_acc_local.row(f) = frameAccelerationOf(r, f, Expressed::Local).transpose();
     data->frame_acc_world.row(f) = frameAccelerationOf(r, f, Expressed::World).transpose();
+    data->frame_wrench_local.row(f) = constraintWrenchOf(r, f, Expressed::Local).transpose();
+    data->frame_wrench_world.row(f) = constraintWrenchOf(r, f, Expressed::World).transpose();
   }
   data->com = comOf(r);
   Result copy;

@@ -246,6 +246,37 @@ TEST_CASE("frame accelerations and kinematics without velocities allocate nothin
   CHECK(count == 0);
 }
 
+TEST_CASE("constraint wrenches allocate nothing, also on a relative constraint's reference and a contact") {
+  const Model model = panda();
+  Task task(model);
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 3), Expressed::World);
+  task.addRelativeConstraint("panda_link4", "panda_link2", ConstraintMatrix::Identity(6, 2));
+  task.addContact("panda_link6", ConstraintMatrix::Identity(6, 1));
+  Workspace ws(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(7, -0.5, 0.7), qd = Eigen::VectorXd::Constant(7, 0.3);
+  const Eigen::Ref<const Eigen::VectorXd> r(q);  // (building a Ref from q is not noexcept itself)
+  static_assert(noexcept(constraintWrench(model, ws, task, r, 0, Expressed::World, std::declval<Vec6&>())));
+  REQUIRE(solveHybridDynamics(model, ws, q, qd, qd, task));
+  Vec6 w;
+  bool ok = true;
+  double sink = 0.0;
+  StatusCode error = StatusCode::Ok;
+  const int frames[] = {model.frameIndex("tool0"), model.frameIndex("panda_link4"), model.frameIndex("panda_link2"),
+                        model.frameIndex("panda_link6"), model.frameIndex("panda_link1")};
+  const long count = allocationsDuring([&] {
+    for (const int frame : frames)
+      for (const Expressed e : {Expressed::World, Expressed::Local}) {
+        ok = constraintWrench(model, ws, task, q, frame, e, w).ok() && ok;
+        sink += w.sum();
+      }
+    error = constraintWrench(model, ws, task, qd, 1, Expressed::World, w).code;  // NotComputed: poses at another q
+  });
+  CHECK(ok);
+  CHECK(std::isfinite(sink));
+  CHECK(error == StatusCode::NotComputed);
+  CHECK(count == 0);
+}
+
 TEST_CASE("every error return of every entry point allocates nothing and throws nothing") {
   const Model model = panda(), other = zwang::testing::oneDofArmModel();
   Task task(model);

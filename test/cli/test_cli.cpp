@@ -2074,3 +2074,63 @@ TEST_CASE("solve: multi-DOF joints by name, the solution's dofs; the tool and th
   }
   CHECK(s["qdd"][7].get<double>() == Approx(0.5).margin(1e-12));  // the joint row on j2
 }
+
+TEST_CASE("frames' wrench_world and wrench_local: closed form, and the tool and zwang::constraintWrench agree",
+          "[golden]") {
+  // The report's 1-DOF arm, one moment row about z on link1 (Fig. 5.5): ν = 2.25·5 + 10, a moment about z.
+  const Json s = solve(problem("arm_fig55.json"));
+  const double nu = 2.25 * 5 + 10;
+  for (const char* key : {"wrench_local", "wrench_world"}) {  // q = 0: the link's axes are the world's
+    const std::vector<double> w = numbers(s["frames"]["link1"][key]);
+    REQUIRE(w.size() == 6);
+    for (std::size_t k = 0; k < 5; ++k) CHECK(w[k] == 0.0);
+    CHECK(w[5] == Approx(nu).margin(1e-12));  // the solve's rounding, as "nu" above
+  }
+
+  // A relative constraint: both hands get a wrench (the reference's moment at its own origin), bit for bit the
+  // library's.
+  const Json r = solve(problem("relative_hands.json"));
+  const Json p = problemFile("relative_hands.json");
+  const zwang::Model model = zwang::loadUrdfFile(problem("two_arms.urdf"));
+  zwang::Task task(model);
+  task.addRelativeConstraint("left_hand", "right_hand", directionsOf(p["constraints"][0]));
+  zwang::Workspace ws(model, task);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(5), q = vectorOf(p["q"]);
+  REQUIRE(zwang::solveHybridDynamics(model, ws, q, zero, zero, task));
+  zwang::Vec6 left_world, right_world;
+  for (const char* frame : {"left_hand", "right_hand"})
+    for (const auto expressed : {zwang::Expressed::World, zwang::Expressed::Local}) {
+      zwang::Vec6 w;
+      REQUIRE(zwang::constraintWrench(model, ws, task, q, model.frameIndex(frame), expressed, w));
+      INFO(frame);
+      sameAs(r["frames"][frame][expressed == zwang::Expressed::World ? "wrench_world" : "wrench_local"], w);
+      if (expressed == zwang::Expressed::World) (std::string(frame) == "left_hand" ? left_world : right_world) = w;
+    }
+  CHECK(left_world.head<3>() == -right_world.head<3>());  // equal and opposite forces: one negated sum
+  CHECK(left_world.head<3>().norm() > 0.0);
+
+  // Solo 12 standing on four contacts (joints held by joint rows, which act on no frame): the feet's wrenches are
+  // the ground's forces, and with gravity they move the centre of mass: Σ f + M g = M c̈ (Newton, whole robot).
+  const Json stand = solve(problem("solo_stand.json"));
+  zwang::UrdfOptions options;
+  options.base = zwang::BaseType::Free;
+  double mass = 0;
+  REQUIRE(zwang::subtreeMass(zwang::loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/solo12.urdf", options),
+                             zwang::kWholeRobot, mass));
+  Eigen::Vector3d ground = Eigen::Vector3d::Zero();
+  for (const char* foot : {"FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"}) {
+    const Eigen::VectorXd w = vectorOf(stand["frames"][foot]["wrench_world"]);
+    ground += w.head<3>();
+    CHECK(w.tail<3>().isZero(0.0));  // force rows only: no moment at the foot, exactly
+  }
+  const Eigen::Vector3d com_acc = vectorOf(stand["com"]["acceleration"]);
+  const Eigen::Vector3d newton = ground + mass * Eigen::Vector3d(0, 0, -9.81) - mass * com_acc;
+  CHECK(newton.norm() < 1e-9 * mass * 9.81);  // the solve's rounding, relative to the weight
+  CHECK(ground.z() > 0.5 * mass * 9.81);      // the ground carries the robot
+
+  // A frame that is only loaded (a wrench, no constraint) reports no constraint wrench.
+  const Json loaded = solve(problem("arm_plain.json"));
+  REQUIRE(loaded["frames"].contains("tip"));
+  CHECK_FALSE(loaded["frames"]["tip"].contains("wrench_world"));
+  CHECK_FALSE(loaded["frames"]["tip"].contains("wrench_local"));
+}

@@ -74,7 +74,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fuzz::requireFinite(ws.solution.tau_control, "tau_control", where);
     fuzz::requireFinite(ws.solution.gauss, "gauss", where);
     if (bound.with_friction) fuzz::requireFinite(ws.friction.mu, "mu", where);
-    const Json solution = solutionJson(bound.model, ws, bound.with_friction, status, bound.reported_frames);
+    const Json solution = solutionJson(bound.model, ws, *bound.task, bound.with_friction, status, bound.reported_frames,
+                                       bound.constrained_frames);
     if (solution.dump().empty()) fuzz::failure("empty solution JSON", where);
   } else if (status.code != StatusCode::Degenerate && status.code != StatusCode::BadOption) {
     fuzz::failure("unexpected status for a bound problem", status.message);

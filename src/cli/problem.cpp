@@ -109,12 +109,14 @@ std::vector<JointModeSpec> parseJointModes(const JsonReader& in, const Json& val
     in.fail(path, "must be an object of joint names to modes (\"locked\", \"torque\" or {\"acceleration\": …}), got " +
                       describe(value));
   std::vector<JointModeSpec> modes;
-  for (const auto& [name, mode] : value.items()) {
+  for (const auto& item : value.items()) {  // not a structured binding: the lambda below reads the mode
+    const Json& mode = item.value();
     JointModeSpec m;
-    m.path = childPath(path, name);
-    m.desc.name = name;
+    m.path = childPath(path, item.key());
+    m.desc.name = item.key();
     if (mode.is_string()) {
-      m.desc.kind = atPath(in, m.path, [&] { return problem::parseModeKind(kJson, mode.get<std::string>()); });
+      const std::string text = mode.get<std::string>();
+      m.desc.kind = atPath(in, m.path, [&] { return problem::parseModeKind(kJson, text); });
     } else if (mode.is_object()) {
       in.object(mode, m.path, {"acceleration"});
       if (!mode.contains("acceleration")) in.fail(m.path, "needs \"acceleration\" (q̈, or one per DOF)");

@@ -220,7 +220,8 @@ std::pair<int, int> modeDofs(const Spelling& spelling, const Model& model, const
 }  // namespace
 
 void setJointMode(const Spelling& spelling, const Model& model, Task& task, const JointModeDesc& mode) {
-  const auto [first, dofs] = modeDofs(spelling, model, mode.name);
+  const std::pair<int, int> covered = modeDofs(spelling, model, mode.name);
+  const int first = covered.first, dofs = covered.second;  // named: a lambda cannot capture a structured binding
   if (mode.kind == ModeKind::Acceleration) {
     if (mode.acceleration.size() != dofs)
       throw ProblemError(Fault::Value, "acceleration",

@@ -769,7 +769,8 @@ void applyModes(const Model& model, Task& task, py::handle modes) {
           "modes: expected a dict of joint names to modes ('locked', 'torque' or an acceleration), "
           "got " +
               std::string(py::str(py::type::handle_of(modes).attr("__name__"))));
-  for (const auto& [key, value] : modes.cast<py::dict>()) {
+  for (const auto& item : modes.cast<py::dict>()) {  // not a structured binding: the lambdas below read it
+    const py::handle key = item.first, value = item.second;
     if (!py::isinstance<py::str>(key)) raise(PyExc_TypeError, "modes: keys are joint names (str)");
     problem::JointModeDesc mode;
     mode.name = key.cast<std::string>();

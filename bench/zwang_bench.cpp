@@ -564,6 +564,39 @@ void benchTreeHybrid(benchmark::State& state, const Problem* p, TaskKind kind) {
   state.counters["rank"] = rank;
 }
 
+// Many rows (docs/solver.md "Many rows"): a comb, 10 branches of 6 joints from the base (randomProblemOfSize(60)'s
+// joints re-hung), with `rows` spread evenly over the 10 tips (each tip's first rows/10 axes, world axes, held
+// still): every row independent. Solved in a workspace made with the default room; the first solve, outside the
+// clock, makes room.
+constexpr int kCombBranches = 10, kCombLength = 6;
+
+std::unique_ptr<Problem> combProblem() {
+  auto p = randomProblemOfSize(kCombBranches * kCombLength);
+  p->label = "comb10x6";
+  for (int j = 0; j < p->n; ++j)  // a branch's first joint hangs from the base, the others from the joint before
+    p->spec.joints[static_cast<std::size_t>(j)].parent = j % kCombLength == 0 ? 0 : j;
+  p->spec.name = "comb";
+  p->spec.check();
+  p->model = modelFromSpec(p->spec);
+  return p;
+}
+
+void benchCombRows(benchmark::State& state, const Problem* p, int rows) {
+  Task task(p->model);
+  for (int b = 0; b < kCombBranches && rows > 0; ++b) {
+    const auto tip = static_cast<std::size_t>((b + 1) * kCombLength);
+    task.addConstraint(p->spec.links[tip].name, ConstraintMatrix::Identity(6, rows / kCombBranches), Expressed::World);
+  }
+  Workspace ws(p->model);
+  if (!firstSolveSucceeded(state, solveHybridDynamics(p->model, ws, p->q, p->qd, p->tau, task))) return;
+  const int rank = ws.solution.balance.rank;
+  const bool singular = ws.solution.balance.singular;  // the eigendecomposition path (docs/solver.md)
+  timeHybridSolves(state, *p, task, p->qd, ws);
+  setCounters(state, *p, task.constraintRows(), 0);
+  state.counters["rank"] = rank;
+  state.counters["singular"] = singular;
+}
+
 void benchOursRnea(benchmark::State& state, const Problem* p) {
   const Task task(p->model);  // gravity (0, 0, −9.81), no wrenches
   Workspace ws(p->model, task);
@@ -912,7 +945,7 @@ std::string fmt(double x) {
 
 int main(int argc, char** argv) {
   std::vector<std::unique_ptr<Problem>> problems, trees;
-  std::unique_ptr<Problem> dual;
+  std::unique_ptr<Problem> dual, comb;
   std::vector<std::unique_ptr<Problem>> floating;  // the robots first, then their chains
   std::string floating_poses;
   try {
@@ -921,6 +954,7 @@ int main(int argc, char** argv) {
     for (int n : {7, 16, 32, 64, 128})
       for (int b : {1, 2, 4}) trees.push_back(treeProblemOfSize(n, b));
     dual = dualPandaProblem();
+    comb = combProblem();
     std::string humanoid_pose, solo_pose;
     floating.push_back(humanoidProblem(&humanoid_pose));
     floating.push_back(solo12Problem(&solo_pose));
@@ -1013,6 +1047,9 @@ int main(int argc, char** argv) {
     for (const auto& p : trees)
       reg(std::string("tree_hd_") + name, *p,
           [q = p.get(), kind = kind](benchmark::State& s) { benchTreeHybrid(s, q, kind); });
+  for (const int rows : {0, 10, 20, 30, 40, 60})
+    reg("comb_rows" + std::to_string(rows), *comb,
+        [q = comb.get(), rows](benchmark::State& s) { benchCombRows(s, q, rows); });
   const std::pair<TaskKind, const char*> dual_tasks[] = {{TaskKind::Hands12, "hands12"}, {TaskKind::Relative6, "rel6"}};
   for (const auto& [kind, name] : dual_tasks)
     reg(std::string("ours_hd_") + name, *dual,

@@ -1,5 +1,8 @@
 #include "zwang/workspace.hpp"
 
+#include <new>
+
+#include "dynamics/checks.hpp"
 #include "dynamics/workspace_scratch.hpp"
 #include "friction/friction_scratch.hpp"
 
@@ -80,6 +83,28 @@ Workspace::Workspace(const Model& model, int max_constraint_rows)
 Workspace::~Workspace() = default;
 Workspace::Workspace(Workspace&&) noexcept = default;
 Workspace& Workspace::operator=(Workspace&&) noexcept = default;
+
+Status Workspace::reserve(const Model& model, int constraint_rows) noexcept {
+  if (constraint_rows <= capacity_) return {};
+  // The scratch's sizes follow the model's bodies and mimic joints: another model's would not fit.
+  if (dof_ != model.dof() || !internal::workspaceFitsModel(model, *this) ||
+      mimic_rows_ != static_cast<int>(model.mimicJoints().size()))
+    return Status::error(StatusCode::ModelMismatch,
+                         "Workspace::reserve: the workspace was made for another model (%d joints, %d mimic joints)",
+                         dof_, mimic_rows_);
+  const int old_capacity = capacity_;
+  try {
+    capacity_ = constraint_rows;
+    scratch_ = std::make_unique<WorkspaceScratch>(model, columnCapacity(), balanceCapacity());
+  } catch (const std::bad_alloc&) {  // the old scratch is kept when the new one cannot be made
+    capacity_ = old_capacity;
+    return Status::error(StatusCode::WorkspaceTooSmall,
+                         "could not make room for %d constraint rows (out of memory); the workspace keeps room for %d",
+                         constraint_rows, old_capacity);
+  }
+  kinematics.stage = KinematicsStage::None;  // they lived in the scratch just replaced
+  return {};
+}
 
 Workspace::Workspace(const Model& model, const Task& task) : Workspace(model, task.constraintRows()) {
   solution.nu.setZero(task.constraintRows());

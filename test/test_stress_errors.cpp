@@ -77,9 +77,9 @@ TEST_CASE("errors: solve statuses (sizes, non-finite inputs, workspace and task)
   CHECK(s.code == StatusCode::NonFinite);
   CHECK_THAT(s.message, Contains("wrench 0 (on frame 'panda_link5') is not finite"));
   task.wrench(w)[0] = 0.0;
-  s = solveHybridDynamics(model, small, x, x, x, task);
-  CHECK(s.code == StatusCode::WorkspaceTooSmall);
-  CHECK_THAT(s.message, Contains("task has 6 constraint rows, the workspace was made for at most 2"));
+  s = solveHybridDynamics(model, small, x, x, x, task);  // makes room for the task's 6 rows
+  CHECK(s);
+  CHECK(small.constraintCapacity() == 6);
   s = solveHybridDynamics(model, foreign, x, x, x, task);
   CHECK(s.code == StatusCode::ModelMismatch);
   CHECK_THAT(s.message, Contains("workspace was made for 1 joints, the model has 7"));

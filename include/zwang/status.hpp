@@ -12,7 +12,7 @@ enum class StatusCode {
   Ok = 0,             ///< success
   SizeMismatch,       ///< an input vector has the wrong length
   NonFinite,          ///< an input holds NaN or Inf
-  WorkspaceTooSmall,  ///< the workspace was sized for fewer constraint rows
+  WorkspaceTooSmall,  ///< no room for the task's rows: out of memory, or a workspace of a model with fewer mimic joints
   ModelMismatch,      ///< task or workspace built for another model
   Degenerate,         ///< a joint has no inertia to move (D_j ≤ 0) in this configuration
   BadOption,          ///< an option or per-solve override is out of range

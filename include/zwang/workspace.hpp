@@ -2,7 +2,9 @@
 /// A workspace: the results of the last call (the solution, the friction
 /// result, τ of inverse dynamics, H, the kinematics held) and, hidden behind
 /// them, all the scratch memory of the algorithms, made once per model (and
-/// constraint capacity); a solve writes there and allocates nothing. One
+/// constraint capacity); a solve writes there and allocates nothing, except
+/// once to make room when a task has more constraint rows than the workspace
+/// held so far (Workspace(model, task) or reserve() make it up front). One
 /// workspace per thread: the Model is shared, the Workspace is not.
 #pragma once
 
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "zwang/friction_result.hpp"
+#include "zwang/status.hpp"
 #include "zwang/task.hpp"
 
 namespace zwang {
@@ -63,7 +66,8 @@ struct Solution {
   Vec6 base_acceleration_world = Vec6::Zero();
   /// ν, constraint magnitudes, in the task's row order. Sized to the task's
   /// rows; a solve resizes it only when the task's row count changed since the
-  /// last solve (the one allocation a solve can make; none for a fixed task).
+  /// last solve (an allocation, as is making room for more rows than the
+  /// workspace had: none for a fixed task).
   Eigen::VectorXd nu;
   /// τ_c = Σ J_iᵀ A_i ν_i, the generalized forces of the constraint forces
   /// (nv: a floating base's first, in its own coordinates).
@@ -125,7 +129,8 @@ struct KinematicsHeld {
 /// The results of the last call, and the algorithms' scratch memory behind them: see the file comment.
 class Workspace {
  public:
-  /// Room for tasks with up to `max_constraint_rows` rows in all.
+  /// Room for tasks with up to `max_constraint_rows` rows in all; a solve of a
+  /// task with more makes room itself (reserve), allocating that once.
   explicit Workspace(const Model& model, int max_constraint_rows = 6);
   /// Sized exactly for this task (solution.nu has its row count from the start).
   Workspace(const Model& model, const Task& task);
@@ -139,8 +144,16 @@ class Workspace {
 
   /// Model::dof() of the model the workspace was made for.
   int dof() const { return dof_; }
-  /// The most constraint rows a task solved here may have.
+  /// The most constraint rows a task may have without the solve making room first.
   int constraintCapacity() const { return capacity_; }
+  /// Makes room for tasks of up to `constraint_rows` rows on `model` (the
+  /// model the workspace was made for), allocating when it has less: what a
+  /// solve does itself for a task with more rows than constraintCapacity(), so
+  /// a control loop that switches between tasks can make room before its
+  /// first cycle. The scratch memory is made anew, so the kinematics held are
+  /// dropped (KinematicsStage::None); the results stay. ModelMismatch for
+  /// another model, WorkspaceTooSmall when the memory cannot be had.
+  Status reserve(const Model& model, int constraint_rows) noexcept;
   /// The most balance rows: the constraint rows and one per mimic joint.
   int balanceCapacity() const { return capacity_ + mimic_rows_; }
   /// The most solver columns: two per row, since a relative row has one on

@@ -9,10 +9,11 @@ namespace zwang {
 Status solveHybridDynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                            const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
                            const Task& task) noexcept {
-  WorkspaceScratch& sw = scratchOf(ws);
   using namespace internal;
   ws.kinematics.stage = KinematicsStage::None;  // until the sweeps below compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
+  if (Status s = roomForTask(model, task, ws); !s) return s;  // allocates only for more rows than ever before
+  WorkspaceScratch& sw = scratchOf(ws);
   Solution& out = ws.solution;
   jointsOutsideLimits(model, q, out);                              // a warning: solved as given
   outwardSweep(model, task, q, qd, ws);                            // lines 2–10

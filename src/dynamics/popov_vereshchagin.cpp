@@ -89,7 +89,7 @@ Status checkPrescribed(const Model& model, const Task& task) {
                          static_cast<long>(qdd.size()), model.nv());
   if (task.prescribedCount() == 0) return {};
   for (int v = 0; v < model.nv(); ++v)
-    if (task.dofMode(v) == DofMode::Prescribed && !std::isfinite(qdd[v]))
+    if (isPrescribed(task, v) && !std::isfinite(qdd[v]))
       return Status::error(StatusCode::NonFinite, "the prescribed acceleration of '%s' is %g",
                            model.dofs()[at(v)].name.c_str(), qdd[v]);
   return {};
@@ -121,20 +121,12 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
   if (task.modelDof() != model.dof() || task.modelFrames() != static_cast<int>(model.frames().size()))
     return Status::error(StatusCode::ModelMismatch, "task was made for another model (%d joints, %d frames)",
                          task.modelDof(), task.modelFrames());
-  if (task.constraintRows() > ws.constraintCapacity() || task.solverColumns() > ws.columnCapacity())
-    return Status::error(StatusCode::WorkspaceTooSmall,
-                         "task has %d constraint rows, the workspace was made for at most %d", task.constraintRows(),
-                         ws.constraintCapacity());
   if (Status s = checkBalanceOptions(task.balance); !s) return s;
   if (Status s = checkConfiguration(model, q); !s) return s;  // size, finite (naming the joint), unit quaternions
   if (!workspaceFitsModel(model, ws)) return workspaceMismatch(model, ws);
   if (Status s = checkVelocityVector(model, "qd", qd); !s) return s;
   if (Status s = checkVelocityVector(model, "tau", tau); !s) return s;
   if (Status s = checkSolutionSizes(model, ws.solution); !s) return s;
-  if (task.balanceRows() > ws.balanceCapacity())  // a workspace made for a model with fewer mimic joints
-    return Status::error(StatusCode::WorkspaceTooSmall,
-                         "task has %d balance rows (%d constraint, %d mimic), the workspace was made for at most %d",
-                         task.balanceRows(), task.constraintRows(), task.mimicRows(), ws.balanceCapacity());
   if (!task.mimicLawsMatch(model))
     return Status::error(StatusCode::ModelMismatch,
                          "task was made for a model with other mimic joints (%d; this one has %d, or other laws)",
@@ -152,6 +144,16 @@ Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q
     if (!task.wrench(w).allFinite())
       return Status::error(StatusCode::NonFinite, "wrench %d (on frame '%s') is not finite", w,
                            model.frame(task.wrenches()[at(w)].frame).name.c_str());
+  return {};
+}
+
+Status roomForTask(const Model& model, const Task& task, Workspace& ws) noexcept {
+  if (Status s = ws.reserve(model, task.constraintRows()); !s) return s;
+  // Left when the model has more mimic joints than the one the workspace was made for (same joints otherwise).
+  if (task.solverColumns() > ws.columnCapacity() || task.balanceRows() > ws.balanceCapacity())
+    return Status::error(StatusCode::WorkspaceTooSmall,
+                         "task has %d balance rows (%d constraint, %d mimic), the workspace was made for at most %d",
+                         task.balanceRows(), task.constraintRows(), task.mimicRows(), ws.balanceCapacity());
   return {};
 }
 
@@ -445,7 +447,7 @@ Status mixedJointSteps(const Model& model, const Task& task, int first, int last
     const Mat6& IA = sw.IA[at(k)];
     Vec6 pA = sw.FA[at(k)];
     pA.noalias() += IA * sw.c[at(k)];
-    if (task.dofMode(k - 1) == DofMode::Prescribed) {
+    if (isPrescribed(task, k - 1)) {
       const double y = task.prescribedAccelerations()[k - 1];
       prescribedColumnsStep(task, k, y, sw);
       passRigidly(model, k, IA, pA, y, sw);
@@ -462,7 +464,7 @@ Status mixedJointSteps(const Model& model, const Task& task, int first, int last
 
 bool anyPrescribed(const Task& task, int first, int last) {
   for (int k = first; k <= last; ++k)
-    if (task.dofMode(k - 1) == DofMode::Prescribed) return true;
+    if (isPrescribed(task, k - 1)) return true;
   return false;
 }
 
@@ -605,7 +607,7 @@ void outwardBodies(const Model& model, const Task& task, WorkspaceScratch& sw, E
   for (int i = 1; i <= model.nv(); ++i) {
     const int p = model.parent(i);
     const Vec6 a_parent = p == i - 1 ? a_previous : sw.a[at(p)];
-    if (kPrescribed && task.dofMode(i - 1) == DofMode::Prescribed) {
+    if (kPrescribed && isPrescribed(task, i - 1)) {
       qdd[i - 1] = task.prescribedAccelerations()[i - 1];
     } else {
       const int first = solverOrder(task).firstColumn(i), column_count = solverOrder(task).columnsEnd(i) - first;
@@ -684,7 +686,7 @@ void outwardLanes(const Model& model, const Task& task, const WorkspaceScratch& 
   const bool prescribed = task.prescribedCount() > 0;
   for (int e = 0; e < 6 * W; ++e) da[e] = 0.0;  // the world: δẌ₀ = 0
   for (int i = 1; i <= N; ++i) {
-    if (prescribed && task.dofMode(i - 1) == DofMode::Prescribed) {  // δq̈_i = 0: the child moves with its parent
+    if (prescribed && isPrescribed(task, i - 1)) {  // δq̈_i = 0: the child moves with its parent
       dqdd.template block<1, W>(i - 1, c0).setZero();
       for (int e = 0; e < 6 * W; ++e) da[i * da_stride + e] = da[model.parent(i) * da_stride + e];
       continue;
@@ -830,7 +832,7 @@ void multiDofColumns(const Model& model, const Task& task, const WorkspaceScratc
 void mixedJointColumns(const Model& model, const Task& task, const WorkspaceScratch& sw, const std::vector<int>& dofs,
                        int first, int last, UnitTorqueScratch& s) {
   for (int k = last; k >= first; --k)
-    if (task.dofMode(k - 1) != DofMode::Prescribed) oneDofColumns(model, task, sw, dofs, k, s);
+    if (!isPrescribed(task, k - 1)) oneDofColumns(model, task, sw, dofs, k, s);
 }
 }  // namespace
 
@@ -1026,7 +1028,7 @@ void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, c
   const int N = model.nv();
   // The bodies before the first prescribed DOF's lie in no prescribed DOF's subtree (depth-first order).
   int lowest = 1;
-  while (task.dofMode(lowest - 1) != DofMode::Prescribed) ++lowest;
+  while (!isPrescribed(task, lowest - 1)) ++lowest;
   for (int i = lowest; i <= N; ++i) sw.f[at(i)].setZero();
   const std::vector<char>& contact = solverOrder(task).contactColumns();
   const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
@@ -1036,7 +1038,7 @@ void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, c
     const int own_first = solverOrder(task).columnsEnd(i + 1), own_end = solverOrder(task).columnsEnd(i);
     for (int col = own_first; col < own_end; ++col)
       if (contact[at(col)]) f.noalias() -= sw.A_body.col(col) * nu_solver[col];
-    if (task.dofMode(i - 1) == DofMode::Prescribed)
+    if (isPrescribed(task, i - 1))
       tau_c[i - 1] = sw.S[at(i)].dot(f) + (kMotion ? rotor_inertia[i - 1] * qdd[i - 1] - tau[i - 1] : 0.0);
     if (model.parent(i) >= lowest) sw.f[at(model.parent(i))] += f;
   }

@@ -25,9 +25,18 @@ inline double dofInertia(const Workspace& ws, int dof) {
   return scratchOf(ws).D[static_cast<std::size_t>(bodyOfDof(dof))];
 }
 
+// Whether entry `dof` of v is prescribed: the sweeps' hot loops index the task's modes unchecked (the input
+// checks sized them).
+inline bool isPrescribed(const Task& task, int dof) {
+  return task.dofModes()[static_cast<std::size_t>(dof)] == DofMode::Prescribed;
+}
+
 // Input checks shared by every solve (the balance options included).
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,
                         const VectorRef& tau, const Workspace& ws);
+// Room in the workspace for the task's rows, made when it has less
+// (Workspace::reserve: the scratch is made anew, so take scratchOf(ws) after).
+Status roomForTask(const Model& model, const Task& task, Workspace& ws) noexcept;
 
 // Lines 2–10: kinematics, F_bias (with the task's wrenches), I^A = I, F^A = F_bias,
 // and the task's constraints in body form.

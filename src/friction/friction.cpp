@@ -158,7 +158,7 @@ void stuckSetAndKineticFriction(const Model& model, const Task& task, const Eige
     const double qj = limited ? q[model.joint(dof.joint).q_index] : 0.0, qdj = qd[v];
     const bool at_lower = limited && qj <= dof.lower + options.limit_tolerance;
     const bool at_upper = limited && qj >= dof.upper - options.limit_tolerance;
-    const bool prescribed = task.dofMode(v) == DofMode::Prescribed;
+    const bool prescribed = isPrescribed(task, v);
     if (std::abs(qdj) <= options.velocity_tolerance && !prescribed) {
       const auto a = static_cast<Eigen::Index>(fr.stuck.size());
       fr.stuck.push_back(j);
@@ -430,9 +430,10 @@ Status limitInfeasible(const Model& model, const QpReport& report, const std::ve
 Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                          const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,
                          const Task& task, const FrictionOptions& options) noexcept {
-  WorkspaceScratch& sw = scratchOf(ws);
   ws.kinematics.stage = KinematicsStage::None;  // until the sweeps compute them
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
+  if (Status s = roomForTask(model, task, ws); !s) return s;  // allocates only for more rows than ever before
+  WorkspaceScratch& sw = scratchOf(ws);
   if (Status s = checkOptions(model, options); !s) return s;
   if (Status s = checkFrictionResultSizes(model, ws.friction); !s) return s;
   const int m = task.solverColumns();

@@ -6,7 +6,8 @@
 // inertia (MuJoCo's armature, on each DOF of a joint) on some joints of every type, random q (random unit
 // quaternions for ball and free joints), q̇, τ, gravity and up to one wrench:
 //  * solveHybridDynamics with an empty task: q̈ against mj_forward's qacc;
-//  * inverseDynamics (RNEA) at a random q̈, against mj_inverse's qfrc_inverse;
+//  * inverseDynamics (RNEA) at a random q̈, against mj_inverse's qfrc_inverse, and solveHybridDynamics with every
+//    DOF prescribed at that q̈ (issue #27: τ_control is then inverse dynamics) against the same;
 //  * jointSpaceInertia (CRBA), against mj_fullM;
 //  * every link's velocity and acceleration (frameVelocity, frameAcceleration) against mj_objectVelocity and
 //    mj_objectAcceleration, which tells a wrong q̈ apart from wrong kinematics;
@@ -236,8 +237,9 @@ struct Answers {
   // Every link's (index as spec.links) classical velocity [ṗ; ω] and acceleration [p̈; ω̇] at its origin, world
   // axes, in the forward motion.
   std::vector<Vector6d> link_velocity, link_acceleration;
-  Eigen::VectorXd tau;  // inverse dynamics at qdd_inverse
-  Eigen::MatrixXd H;    // joint-space inertia
+  Eigen::VectorXd tau;             // inverse dynamics at qdd_inverse
+  Eigen::VectorXd tau_prescribed;  // the same by the hybrid solve with every DOF prescribed (MuJoCo: = tau)
+  Eigen::MatrixXd H;               // joint-space inertia
 };
 
 Answers solveWithZwang(const JointsProblem& p) {
@@ -262,6 +264,11 @@ Answers solveWithZwang(const JointsProblem& p) {
   }
   REQUIRE(inverseDynamics(model, ws, p.input.q, p.input.v, p.qdd_inverse, task));
   a.tau = ws.tau;
+  Task prescribed = task;
+  for (int v = 0; v < model.nv(); ++v) prescribed.setDofMode(v, DofMode::Prescribed);
+  prescribed.prescribedAccelerations() = p.qdd_inverse;
+  REQUIRE(solveHybridDynamics(model, ws, p.input.q, p.input.v, p.input.tau, prescribed));
+  a.tau_prescribed = ws.solution.tau_control;
   REQUIRE(jointSpaceInertia(model, ws, p.input.q));
   a.H = ws.H;
   return a;
@@ -369,6 +376,7 @@ Answers solveWithMujoco(const ChainSpec& spec, const FloatingBase& base, const J
   mj_inverse(m, d);
   const std::vector<mjtNum> qfrc_wrenches = wrenchGeneralizedForces(spec, poses, in.wrenches, m, d);
   a.tau = change.T.transpose() * (gather(d->qfrc_inverse, map.dof) - gather(qfrc_wrenches.data(), map.dof)) - armature;
+  a.tau_prescribed = a.tau;
   return a;
 }
 
@@ -393,13 +401,14 @@ double linkError(const std::vector<Vector6d>& ours, const std::vector<Vector6d>&
 }
 
 struct Errors {
-  double qdd = 0.0, link_velocity = 0.0, link_acceleration = 0.0, tau = 0.0, H = 0.0;
-  double largest() const { return std::max({qdd, link_velocity, link_acceleration, tau, H}); }
+  double qdd = 0.0, link_velocity = 0.0, link_acceleration = 0.0, tau = 0.0, tau_prescribed = 0.0, H = 0.0;
+  double largest() const { return std::max({qdd, link_velocity, link_acceleration, tau, tau_prescribed, H}); }
   void max(const Errors& o) {
     qdd = std::max(qdd, o.qdd);
     link_velocity = std::max(link_velocity, o.link_velocity);
     link_acceleration = std::max(link_acceleration, o.link_acceleration);
     tau = std::max(tau, o.tau);
+    tau_prescribed = std::max(tau_prescribed, o.tau_prescribed);
     H = std::max(H, o.H);
   }
 };
@@ -410,6 +419,7 @@ Errors compare(const Answers& ours, const Answers& theirs) {
   e.link_velocity = linkError(ours.link_velocity, theirs.link_velocity);
   e.link_acceleration = linkError(ours.link_acceleration, theirs.link_acceleration);
   e.tau = relativeError(ours.tau, theirs.tau);
+  e.tau_prescribed = relativeError(ours.tau_prescribed, theirs.tau_prescribed);
   e.H = matrixRelativeError(ours.H, theirs.H);
   return e;
 }
@@ -437,8 +447,9 @@ TEST_CASE("joint types: solver, RNEA and CRBA match MuJoCo on 320 trees of hinge
                   << " moving joints, nv " << p.base.nv(p.spec));
     const Errors e = compare(solveWithZwang(p), solveWithMujoco(p));
     worst.max(e);
-    INFO("rel. errors: qdd " << e.qdd << ", tau " << e.tau << ", H " << e.H << ", link velocity " << e.link_velocity
-                             << ", link acceleration " << e.link_acceleration);
+    INFO("rel. errors: qdd " << e.qdd << ", tau " << e.tau << ", tau all prescribed " << e.tau_prescribed << ", H "
+                             << e.H << ", link velocity " << e.link_velocity << ", link acceleration "
+                             << e.link_acceleration);
     CHECK(e.largest() < kTolerance);
     if (!(e.largest() < kTolerance) && ++failures == 1)  // the first failing tree in full, to reproduce it
       std::printf("first failing tree (trial %d):\n%s", trial, toMjcf(p.spec, p.input.gravity, p.base).c_str());
@@ -446,11 +457,12 @@ TEST_CASE("joint types: solver, RNEA and CRBA match MuJoCo on 320 trees of hinge
   std::printf(
       "MuJoCo %s vs zwang on joint types: %d trees (%d on a free root, %d fixed bases, %d of them with free joints), "
       "joints: %d hinge, %d slide, %d ball (%d not at a leaf, %d with armature), %d free; up to %d DOFs; max rel. "
-      "error: q̈ (solveHybridDynamics vs mj_forward) %.2e  tau (inverseDynamics vs mj_inverse) %.2e  H "
+      "error: q̈ (solveHybridDynamics vs mj_forward) %.2e  tau (inverseDynamics vs mj_inverse) %.2e  tau (every DOF "
+      "prescribed vs mj_inverse) %.2e  H "
       "(jointSpaceInertia vs mj_fullM) %.2e  link velocity %.2e  link acceleration %.2e\n",
       mj_versionString(), census.trees, census.free_roots, census.fixed_bases, census.with_free_joints, census.hinge,
       census.slide, census.ball, census.ball_inner, census.ball_armature, census.free, census.most_dofs, worst.qdd,
-      worst.tau, worst.H, worst.link_velocity, worst.link_acceleration);
+      worst.tau, worst.tau_prescribed, worst.H, worst.link_velocity, worst.link_acceleration);
   CHECK(census.trees >= 300);
   CHECK(census.free_roots >= 100);
   CHECK(census.fixed_bases >= 100);
@@ -460,6 +472,7 @@ TEST_CASE("joint types: solver, RNEA and CRBA match MuJoCo on 320 trees of hinge
   CHECK(census.slide >= 100);
   CHECK(worst.qdd < kTolerance);
   CHECK(worst.tau < kTolerance);
+  CHECK(worst.tau_prescribed < kTolerance);
   CHECK(worst.H < kTolerance);
   CHECK(worst.link_velocity < kTolerance);
   CHECK(worst.link_acceleration < kTolerance);

@@ -75,16 +75,24 @@ TEST_CASE("compare-mujoco: the 1-DOF arm holds exactly at 5 N, MuJoCo's soft fri
 }
 
 TEST_CASE("compare-mujoco: on a slipping joint MuJoCo's friction torque is the frictionloss, as zwang's") {
-  const MujocoComparison c = compareWithMujoco(kArm, {armAt(-11)}, shortRun());
-  const PostureComparison& p = c.postures[0];
-  CHECK(p.state[0] == JointState::SlipNegative);
-  CHECK(p.tau_friction[0] == Approx(10.0).margin(1e-12));
-  CHECK(p.qdd[0] == Approx(-1.0 / 2.25).margin(1e-12));
-  // The friction row saturates at its bound: exactly frictionloss, opposing the motion (the same sign as zwang's).
-  for (const MujocoSettingResult& r : p.mujoco) {
-    CHECK(r.tau_friction[0] == Approx(10.0).margin(1e-9));
-    CHECK(r.qacc[0] == Approx(-1.0 / 2.25).margin(1e-9));
+  const MujocoComparison c = compareWithMujoco(kArm, {armAt(-11), armAt(-20)}, shortRun());
+  for (const PostureComparison& p : c.postures) {
+    CHECK(p.state[0] == JointState::SlipNegative);
+    CHECK(p.tau_friction[0] == Approx(10.0).margin(1e-12));
+    CHECK(p.qdd[0] == Approx((p.tau[0] + 10.0) / 2.25).margin(1e-12));
   }
+  // At 20 N·m every setting's friction row saturates at its bound: exactly frictionloss, opposing the load (zwang's
+  // sign), and MuJoCo's qacc is zwang's.
+  for (const MujocoSettingResult& r : c.postures[1].mujoco) {
+    CHECK(r.tau_friction[0] == Approx(10.0).margin(1e-9));
+    CHECK(r.qacc[0] == Approx(-10.0 / 2.25).margin(1e-9));
+  }
+  // At 11 N·m the default soft row (impedance 0.9: a regulariser R = A (1 − 0.9) / 0.9) carries 11 / (1 + 1/9) =
+  // 9.9 N·m, below its bound; noslip and tight reach it.
+  const std::vector<MujocoSettingResult>& at11 = c.postures[0].mujoco;
+  CHECK(at11[0].tau_friction[0] == Approx(9.9).margin(1e-9));
+  CHECK(at11[1].tau_friction[0] == Approx(10.0).margin(1e-9));
+  CHECK(at11[2].tau_friction[0] == Approx(10.0).margin(1e-9));
   // With --frictionloss: both sides take the override.
   MujocoCompareOptions o = shortRun();
   o.frictionloss = 20;

@@ -1860,7 +1860,8 @@ TEST_CASE("getting-started.md quotes the example that ctest compiles and runs", 
 
 TEST_CASE("the docs link only to files that exist", "[docs]") {
   const std::string docs = ZWANG_DOCS_DIR;
-  for (const char* name : {"getting-started.md", "conventions.md", "theory.md", "evaluation.md", "cli.md"}) {
+  for (const char* name :
+       {"getting-started.md", "conventions.md", "theory.md", "evaluation.md", "cli.md", "mujoco.md"}) {
     INFO(name);
     REQUIRE(cli_test::fileExists(docs + "/" + name));
     // The page without its fenced code blocks (code may contain "](").

@@ -75,6 +75,7 @@ TEST_CASE("compare-mujoco: the 1-DOF arm holds exactly at 5 N, MuJoCo's soft fri
   CHECK(def.drift_series(0, 0) == 0.0);
   CHECK(def.drift_series(def.drift_series.rows() - 1, 0) == Approx(def.drift(0, 0)).epsilon(1e-12));
   CHECK(heldDriftMax(p, def.drift)[0] == def.drift(0, 0));
+  CHECK(def.mujoco_warnings.empty());
 }
 
 TEST_CASE("compare-mujoco: on a slipping joint MuJoCo's friction torque is the frictionloss, as zwang's") {

@@ -54,6 +54,9 @@ struct MujocoSettingResult {
   Eigen::MatrixXd drift;         ///< row r: |q(seconds[r]) − q(0)| per DOF after mj_step from rest
   Eigen::VectorXd times;         ///< the sample times of drift_series [s], 0 first
   Eigen::MatrixXd drift_series;  ///< row r: |q(times[r]) − q(0)| per DOF
+  /// The warnings MuJoCo raised while simulating (mjData::warning, by name: "bad qacc" means it reset the
+  /// state), empty when none; the comparison silences MuJoCo's handler, which would print them on stdout.
+  std::vector<std::string> mujoco_warnings;
 };
 
 /// One posture: zwang's exact solve and MuJoCo's settings (in MujocoComparison::settings' order).
@@ -92,7 +95,9 @@ Model mujocoCompareModel(const std::string& path);
 /// Compare at `postures`, or (empty) at the generated ones: "home" (the file's first keyframe, else the neutral
 /// configuration) and options.random_postures drawn within the limits. Throws ModelError naming the file for a
 /// model MuJoCo or zwang refuses (a free joint that is not the floating base among them), std::invalid_argument
-/// naming the posture or option for bad input (sizes, non-finite values, times beyond an hour).
+/// naming the posture or option for bad input (sizes, non-finite values, times beyond an hour). It replaces
+/// MuJoCo's global warning handler while it runs: one comparison at a time (a mutex serialises them), and no
+/// other MuJoCo user on another thread meanwhile.
 MujocoComparison compareWithMujoco(const std::string& path, const std::vector<ComparePosture>& postures,
                                    const MujocoCompareOptions& options = {});
 

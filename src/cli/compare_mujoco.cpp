@@ -157,7 +157,8 @@ Json settingJson(const MujocoComparison& c, const PostureComparison& p, std::siz
           {"qacc", array(r.qacc)},
           {"tau_friction", array(r.tau_friction)},
           {"drift", std::move(drift)},
-          {"held_drift_max", array(heldDriftMax(p, r.drift))}};
+          {"held_drift_max", array(heldDriftMax(p, r.drift))},
+          {"mujoco_warnings", r.mujoco_warnings}};
 }
 
 Json postureJson(const MujocoComparison& c, const PostureComparison& p) {
@@ -230,6 +231,16 @@ void printDrift(const MujocoComparison& c, const PostureComparison& p) {
   }
   rows.push_back(held);
   printColumns(rows, 2);
+}
+
+// The loader's warnings, then MuJoCo's during a simulation, on stderr.
+void printWarnings(const MujocoComparison& c) {
+  for (const std::string& w : c.warnings) std::fprintf(stderr, "zwang: warning: %s\n", printable(w, 4000).c_str());
+  for (const PostureComparison& p : c.postures)
+    for (std::size_t s = 0; s < p.mujoco.size(); ++s)
+      for (const std::string& w : p.mujoco[s].mujoco_warnings)
+        std::fprintf(stderr, "zwang: warning: posture '%s', setting %s: MuJoCo warned: %s\n",
+                     printable(p.name, 200).c_str(), c.settings[s].name.c_str(), w.c_str());
 }
 
 void printText(const MujocoComparison& c) {
@@ -315,7 +326,7 @@ int commandCompareMujoco(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     throw CliError(kExitError, (args.has("--state") ? args.value("--state") : args.positional[0]) + ": " + e.what());
   }
-  for (const std::string& w : c.warnings) std::fprintf(stderr, "zwang: warning: %s\n", printable(w, 4000).c_str());
+  printWarnings(c);
   if (args.has("--csv")) writeCsv(args.value("--csv"), c);
   if (args.has("--json"))
     writeOutput("", prettyDump(comparisonJson(c)) + "\n");

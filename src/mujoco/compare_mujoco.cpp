@@ -115,7 +115,8 @@ int eraseEmptyElements(std::string& text, const std::string& tag, const std::str
 
 // The text with the floating base's free joint and the keyframes (sized for the free joint's qpos) deleted.
 std::string withoutFreeJoint(const std::string& path, std::string text) {
-  const int erased = eraseEmptyElements(text, "freejoint", "") + eraseEmptyElements(text, "joint", "\"free\"");
+  const int erased = eraseEmptyElements(text, "freejoint", "") + eraseEmptyElements(text, "joint", "type=\"free\"") +
+                     eraseEmptyElements(text, "joint", "type='free'");
   if (erased != 1) throw ModelError(path + ": cannot fix the floating base: its free joint is not one <freejoint/>");
   const std::size_t open = text.find("<keyframe");
   if (open != std::string::npos) {
@@ -345,6 +346,22 @@ Eigen::VectorXd driftNow(const Side& side, const mjModel* m, const Eigen::Vector
   return out;
 }
 
+// The warnings a run raised, by name (mjtWarning's order).
+std::vector<std::string> warningsOf(const mjData* d) {
+  static const char* const kNames[mjNWARNING] = {"inertia",
+                                                 "contact buffer full",
+                                                 "constraint buffer full",
+                                                 "visual geom buffer full",
+                                                 "bad qpos",
+                                                 "bad qvel",
+                                                 "bad qacc",
+                                                 "bad ctrl"};
+  std::vector<std::string> out;
+  for (int w = 0; w < mjNWARNING; ++w)
+    if (d->warning[w].number > 0) out.push_back(kNames[w]);
+  return out;
+}
+
 void simulate(const Side& side, const mjModel* m, const PostureComparison& posture, MujocoSettingResult& r) {
   const MjDataPtr d = restingData(side, m, posture);
   const std::vector<double>& seconds = side.options.seconds;
@@ -366,6 +383,7 @@ void simulate(const Side& side, const mjModel* m, const PostureComparison& postu
     while (next < seconds.size() && std::lround(seconds[next] / dt) == step)
       r.drift.row(static_cast<Eigen::Index>(next++)) = driftNow(side, m, qpos0, d.get()).transpose();
   }
+  r.mujoco_warnings = warningsOf(d.get());
 }
 
 PostureComparison comparePosture(const Side& side, const ComparePosture& posture) {

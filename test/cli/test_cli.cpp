@@ -148,11 +148,13 @@ TEST_CASE("compare-mujoco: the 1-DOF arm at 5 and 11 N, JSON keys, CSV, bad inpu
   const Json& def = stick["mujoco"][0];
   std::vector<std::string> setting_keys;
   for (const auto& item : def.items()) setting_keys.push_back(item.key());
-  CHECK(setting_keys == std::vector<std::string>{"name", "qacc", "tau_friction", "drift", "held_drift_max"});
+  CHECK(setting_keys ==
+        std::vector<std::string>{"name", "qacc", "tau_friction", "drift", "held_drift_max", "mujoco_warnings"});
   // MuJoCo's default soft friction: the arm creeps where zwang holds it (docs/mujoco.md explains the sizes).
   CHECK(def["qacc"][0].get<double>() < -1e-3);
   CHECK(def["drift"][0][0].get<double>() > 1e-5);
   CHECK(def["held_drift_max"][0].get<double>() == def["drift"][0][0].get<double>());
+  CHECK(def["mujoco_warnings"].empty());
   const Json& slip = c["postures"][1];
   CHECK(slip["zwang"]["state"][0] == "slip-");
   CHECK(slip["mujoco"][1]["tau_friction"][0].get<double>() == Approx(10.0).margin(1e-9));  // noslip: the bound

@@ -73,9 +73,9 @@ struct PostureComparison {
 
 /// The whole comparison of one model.
 struct MujocoComparison {
-  std::string model_name;                   ///< <mujoco model>
+  std::string model_name;                   ///< `<mujoco model>`
   bool base_fixed = false;                  ///< the file's floating base was fixed (its free joint deleted)
-  double timestep = 0;                      ///< MuJoCo's <option timestep> [s]
+  double timestep = 0;                      ///< MuJoCo's `<option timestep>` [s]
   std::string integrator;                   ///< MuJoCo's integrator ("Euler", "RK4", "implicit")
   std::vector<std::string> dof_names;       ///< per DOF
   Eigen::VectorXd frictionloss;             ///< per DOF, as both used it

@@ -126,6 +126,9 @@ int commandInfo(int argc, char** argv);
 int commandFk(int argc, char** argv);
 int commandScenarios(int argc, char** argv);
 int commandEnergy(int argc, char** argv);
+// `zwang compare-mujoco MODEL.xml …`: MuJoCo's soft joint friction against zwang's exact friction at rest
+// (compare_mujoco.cpp; without MuJoCo it says that it needs it).
+int commandCompareMujoco(int argc, char** argv);
 // Its scenarios are in energy_report.hpp.
 
 }  // namespace zwang::cli

@@ -117,6 +117,34 @@ constexpr const char* kEnergyUsage =
     "\n"
     "Exit code 1 when a result disagrees with the closed form or a check.\n";
 
+constexpr const char* kCompareMujocoUsage =
+    "usage: zwang compare-mujoco MODEL.xml [--state FILE.json] [--postures N] [--seed S]\n"
+    "                            [--seconds T1,T2,...] [--gravity-compensation S]\n"
+    "                            [--frictionloss F] [--noslip-iterations N] [--json] [--csv DIR]\n"
+    "\n"
+    "The robot of an MJCF file at rest under its gravity with its frictionloss: zwang's\n"
+    "exact friction (state, mu*, qdd) against MuJoCo's soft friction in three settings\n"
+    "(default: the file's; noslip: noslip_iterations; tight: dof_solref (2 timestep, 1),\n"
+    "dof_solimp 0.9999): MuJoCo's friction torque and qacc (mj_forward) and the drift\n"
+    "|q(t) - q(0)| after mj_step from rest. MuJoCo's contacts and actuators are off; a\n"
+    "floating base is fixed (its free joint deleted). Needs zwang built with MuJoCo.\n"
+    "(docs/mujoco.md, \"Soft friction against exact friction\")\n"
+    "\n"
+    "  --state FILE.json          the postures: {\"q\": [...], \"tau\": [...], \"name\": ...,\n"
+    "                             \"gravity_compensation\": S} or {\"postures\": [ ... ]}\n"
+    "                             (default: the first keyframe, else the neutral posture,\n"
+    "                             and --postures random ones)\n"
+    "  --postures N               random postures within the limits (default 3)\n"
+    "  --seed S                   their seed (default 1)\n"
+    "  --seconds T1,T2,...        simulated times of the drift (default 1,10)\n"
+    "  --gravity-compensation S   tau = S G(q): S = 0.95 leaves 5 % of gravity to friction\n"
+    "                             (default 0)\n"
+    "  --frictionloss F           every DOF's frictionloss, in both (default: the file's)\n"
+    "  --noslip-iterations N      of the noslip setting (default 10)\n"
+    "  --json                     print JSON instead of tables\n"
+    "  --csv DIR                  also write DIR/compare_joints.csv and DIR/compare_drift.csv\n"
+    "                             (the largest drift on the DOFs zwang holds, every 0.01 s)\n";
+
 constexpr const char* kCommandsUsage =
     "usage: zwang <command> [options]\n"
     "\n"
@@ -129,6 +157,8 @@ constexpr const char* kCommandsUsage =
     "  scenarios [--out DIR] [--models DIR]           the report's chapter 6 and Fig. 5.5, with plots\n"
     "  energy [--out DIR] [--models DIR]              Panda, dual arm + box, humanoid and Solo 12 holding still:\n"
     "                                                 effort with/without friction\n"
+    "  compare-mujoco MODEL.xml [--state FILE]        MuJoCo's soft joint friction against zwang's exact friction\n"
+    "                                                 at rest (zwang built with MuJoCo)\n"
     "\n"
     "  zwang <command> --help   a command's options\n"
     "  zwang --version          the version\n"
@@ -138,10 +168,13 @@ constexpr const char* kCommandsUsage =
 }  // namespace
 
 const char* usageText(const std::string& command) {
-  const std::pair<const char*, const char*> usages[] = {
-      {"solve", kSolveUsage},         {"forward-dynamics", kForwardDynamicsUsage},
-      {"info", kInfoUsage},           {"fk", kFkUsage},
-      {"scenarios", kScenariosUsage}, {"energy", kEnergyUsage}};
+  const std::pair<const char*, const char*> usages[] = {{"solve", kSolveUsage},
+                                                        {"forward-dynamics", kForwardDynamicsUsage},
+                                                        {"info", kInfoUsage},
+                                                        {"fk", kFkUsage},
+                                                        {"scenarios", kScenariosUsage},
+                                                        {"energy", kEnergyUsage},
+                                                        {"compare-mujoco", kCompareMujocoUsage}};
   for (const auto& [name, text] : usages)
     if (command == name) return text;
   return kCommandsUsage;

@@ -6,6 +6,7 @@
 //   zwang fk MODEL.urdf [--q Q] [--root L] [--tip L] [--base B] [--pretty] | zwang fk PROBLEM.json [--pretty]
 //   zwang scenarios [--out DIR] [--models DIR] [--no-plots]
 //   zwang energy [--out DIR] [--models DIR] [--no-plots]
+//   zwang compare-mujoco MODEL.xml [--state FILE] [--postures N] [--seed S] [--seconds T,…] [--json] [--csv DIR]
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -38,6 +39,7 @@ int run(int argc, char** argv) {
   if (command == "fk") return commandFk(argc, argv);
   if (command == "scenarios") return commandScenarios(argc, argv);
   if (command == "energy") return commandEnergy(argc, argv);
+  if (command == "compare-mujoco") return commandCompareMujoco(argc, argv);
   std::fprintf(stderr, "zwang: unknown command '%s'\n\n%s", printable(command, 60).c_str(), usageText(""));
   return kExitUsage;
 }

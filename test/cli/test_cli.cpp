@@ -120,6 +120,85 @@ TEST_CASE("1-DOF arm from MJCF: mu* = -5, qdd = 0 at 5 N; mu* = -10, qdd = -1/2.
 #endif
 }
 
+// `zwang compare-mujoco` (docs/mujoco.md, "Soft friction against exact friction") on the 1-DOF arm: the JSON's
+// keys, zwang's exact stick against MuJoCo's creep, the CSVs, and bad inputs. Half a second simulated: cheap.
+TEST_CASE("compare-mujoco: the 1-DOF arm at 5 and 11 N, JSON keys, CSV, bad inputs", "[mjcf]") {
+  const std::string arm = std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.xml";
+  const std::string state = std::string(ZWANG_DOCS_DIR) + "/mujoco/one_dof_arm_5N.json";
+#ifdef ZWANG_CLI_WITH_MUJOCO
+  const std::string dir = cli_test::scratchDir() + "/compare";
+  const Run r = run({"compare-mujoco", arm, "--state", state, "--seconds", "0.5", "--json", "--csv", dir});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const Json c = parse(r.out);
+  std::vector<std::string> keys;
+  for (const auto& item : c.items()) keys.push_back(item.key());
+  CHECK(keys == std::vector<std::string>{"model", "base_fixed", "timestep", "integrator", "dofs", "frictionloss",
+                                         "seconds", "settings", "postures", "warnings"});
+  CHECK(c["dofs"] == Json::array({"joint1"}));
+  CHECK(c["settings"][0]["name"] == "default");
+  CHECK(c["settings"][1]["name"] == "noslip");
+  CHECK(c["settings"][2]["name"] == "tight");
+  REQUIRE(c["postures"].size() == 2);
+  const Json& stick = c["postures"][0];
+  CHECK(stick["name"] == "5 N at the tip");
+  CHECK(stick["zwang"]["state"][0] == "stick");
+  CHECK(stick["zwang"]["qdd"][0].get<double>() == 0.0);
+  CHECK(stick["zwang"]["mu"][0].get<double>() == Approx(-5.0).margin(1e-12));
+  const Json& def = stick["mujoco"][0];
+  std::vector<std::string> setting_keys;
+  for (const auto& item : def.items()) setting_keys.push_back(item.key());
+  CHECK(setting_keys ==
+        std::vector<std::string>{"name", "qacc", "tau_friction", "drift", "held_drift_max", "mujoco_warnings"});
+  // MuJoCo's default soft friction: the arm creeps where zwang holds it (docs/mujoco.md explains the sizes).
+  CHECK(def["qacc"][0].get<double>() < -1e-3);
+  CHECK(def["drift"][0][0].get<double>() > 1e-5);
+  CHECK(def["held_drift_max"][0].get<double>() == def["drift"][0][0].get<double>());
+  CHECK(def["mujoco_warnings"].empty());
+  const Json& slip = c["postures"][1];
+  CHECK(slip["zwang"]["state"][0] == "slip-");
+  CHECK(slip["mujoco"][1]["tau_friction"][0].get<double>() == Approx(10.0).margin(1e-9));  // noslip: the bound
+  CHECK(contains(cli_test::readText(dir + "/compare_drift.csv"), "posture,t,default,noslip,tight\n0,0,0,0,0\n"));
+  CHECK(contains(cli_test::readText(dir + "/compare_joints.csv"), "0,joint1,stick,10,5,0,"));
+  // The tables.
+  const Run text = run({"compare-mujoco", arm, "--state", state, "--seconds", "0.5"});
+  CHECK(text.exit_code == 0);
+  CHECK(contains(text.out, "posture '5 N at the tip': zwang holds 1 of 1 DOFs"));
+  CHECK(contains(text.out, "largest, held"));
+  // Bad inputs: usage errors (exit 2) and files (exit 1), each naming what is wrong.
+  const std::vector<std::pair<std::vector<std::string>, std::string>> usage{
+      {{"compare-mujoco"}, "no model file given"},
+      {{"compare-mujoco", arm, "--seconds", "0"}, "--seconds: each time must be in (0, 3600] s"},
+      {{"compare-mujoco", arm, "--seconds", "1,x"}, "--seconds: 'x' is not a finite number"},
+      {{"compare-mujoco", arm, "--postures", "-1"}, "--postures: '-1' is not an integer in [0, 1000]"},
+      {{"compare-mujoco", arm, "--frictionloss", "-1"}, "--frictionloss: must be at least 0"},
+      {{"compare-mujoco", arm, "--state", state, "--postures", "2"}, "--state gives the postures"}};
+  for (const auto& [args, message] : usage) {
+    const Run bad = run(args);
+    INFO(bad.err);
+    CHECK(bad.exit_code == 2);
+    CHECK(contains(bad.err, message));
+  }
+  const std::string scratch = cli_test::scratchDir();
+  cli_test::writeText(scratch + "/extra_key.json", "{\"q\": [0], \"torque\": [1]}");
+  cli_test::writeText(scratch + "/long_q.json", "{\"postures\": [{\"name\": \"two\", \"q\": [0, 1]}]}");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> files{
+      {{"compare-mujoco", arm, "--state", scratch + "/extra_key.json"}, "key 'torque' is not one of"},
+      {{"compare-mujoco", arm, "--state", scratch + "/long_q.json"}, "posture 'two': q has 2 entries, the model 1"},
+      {{"compare-mujoco", arm + ".missing"}, "cannot open the file"},
+      {{"compare-mujoco", std::string(ZWANG_MODELS_DIR) + "/one_dof_arm.urdf"}, "not <mujoco>: not an MJCF file"}};
+  for (const auto& [args, message] : files) {
+    const Run bad = run(args);
+    checkOneLineError(bad, 1);
+    CHECK(contains(bad.err, message));
+  }
+#else
+  const Run r = run({"compare-mujoco", arm, "--state", state});
+  CHECK(r.exit_code == 1);
+  CHECK(contains(r.err, "compare-mujoco needs zwang built with MuJoCo"));
+#endif
+}
+
 TEST_CASE("1-DOF arm, tip force -11 N: slip, mu* = -10, qdd = -1/2.25", "[golden]") {
   const Json s = solve(problem("arm_slip.json"));
   const double qdd = -1.0 / 2.25;
@@ -1172,7 +1251,7 @@ TEST_CASE("Usage: help, unknown commands and options", "[usage]") {
     CHECK(contains(r.err, "zwang: unknown command 'frobnicate'"));
     CHECK(contains(r.err, "usage: zwang <command>"));
   }
-  for (const std::string command : {"solve", "info", "scenarios", "energy"}) {
+  for (const std::string command : {"solve", "info", "scenarios", "energy", "compare-mujoco"}) {
     SECTION(command + " --help") {
       const Run r = run({command, "--help"});
       CHECK(r.exit_code == 0);
@@ -1783,7 +1862,8 @@ TEST_CASE("getting-started.md quotes the example that ctest compiles and runs", 
 
 TEST_CASE("the docs link only to files that exist", "[docs]") {
   const std::string docs = ZWANG_DOCS_DIR;
-  for (const char* name : {"getting-started.md", "conventions.md", "theory.md", "evaluation.md", "cli.md"}) {
+  for (const char* name :
+       {"getting-started.md", "conventions.md", "theory.md", "evaluation.md", "cli.md", "mujoco.md"}) {
     INFO(name);
     REQUIRE(cli_test::fileExists(docs + "/" + name));
     // The page without its fenced code blocks (code may contain "](").

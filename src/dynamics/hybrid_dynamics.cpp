@@ -14,6 +14,7 @@ Status solveHybridDynamics(const Model& model, Workspace& ws, const Eigen::Ref<c
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   if (Status s = roomForTask(model, task, ws); !s) return s;  // allocates only for more rows than ever before
   WorkspaceScratch& sw = scratchOf(ws);
+  bindTaskModes(task, sw);  // the sweeps read the DOF modes from here
   Solution& out = ws.solution;
   jointsOutsideLimits(model, q, out);                              // a warning: solved as given
   outwardSweep(model, task, q, qd, ws);                            // lines 2–10

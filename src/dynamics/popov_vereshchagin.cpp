@@ -447,8 +447,8 @@ Status mixedJointSteps(const Model& model, const Task& task, int first, int last
     const Mat6& IA = sw.IA[at(k)];
     Vec6 pA = sw.FA[at(k)];
     pA.noalias() += IA * sw.c[at(k)];
-    if (isPrescribed(task, k - 1)) {
-      const double y = task.prescribedAccelerations()[k - 1];
+    if (isPrescribed(sw, k - 1)) {
+      const double y = prescribedAcceleration(sw, k - 1);
       prescribedColumnsStep(task, k, y, sw);
       passRigidly(model, k, IA, pA, y, sw);
       continue;
@@ -462,9 +462,9 @@ Status mixedJointSteps(const Model& model, const Task& task, int first, int last
   return {};
 }
 
-bool anyPrescribed(const Task& task, int first, int last) {
+bool anyPrescribed(const WorkspaceScratch& sw, int first, int last) {
   for (int k = first; k <= last; ++k)
-    if (isPrescribed(task, k - 1)) return true;
+    if (isPrescribed(sw, k - 1)) return true;
   return false;
 }
 
@@ -478,7 +478,7 @@ Status inwardJoints(const Model& model, const Task& task, const VectorRef& tau, 
       sw.IA[at(i)] = sw.I[at(i)].matrix();
       sw.FA[at(i)] = sw.Fbias[at(i)];
     }
-    if (kPrescribed && anyPrescribed(task, first, i)) {
+    if (kPrescribed && anyPrescribed(sw, first, i)) {
       if (Status s = mixedJointSteps(model, task, first, i, tau, sw); !s) return s;
       i = first - 1;
       continue;
@@ -517,8 +517,7 @@ Status inwardSweep(const Model& model, const Task& task, const VectorRef& tau, W
   sw.L_scale.head(m).setZero();
   sw.L.topLeftCorner(m, m).setZero();           // 𝓛_N = 0 (only the lower triangle is kept)
   sw.Ahat.leftCols(m) = sw.A_body.leftCols(m);  // A_i, each column updated in place on its way to the base
-  return task.prescribedCount() > 0 ? inwardJoints<true>(model, task, tau, sw)
-                                    : inwardJoints<false>(model, task, tau, sw);
+  return sw.prescribed_count > 0 ? inwardJoints<true>(model, task, tau, sw) : inwardJoints<false>(model, task, tau, sw);
 }
 
 namespace {
@@ -607,8 +606,8 @@ void outwardBodies(const Model& model, const Task& task, WorkspaceScratch& sw, E
   for (int i = 1; i <= model.nv(); ++i) {
     const int p = model.parent(i);
     const Vec6 a_parent = p == i - 1 ? a_previous : sw.a[at(p)];
-    if (kPrescribed && isPrescribed(task, i - 1)) {
-      qdd[i - 1] = task.prescribedAccelerations()[i - 1];
+    if (kPrescribed && isPrescribed(sw, i - 1)) {
+      qdd[i - 1] = prescribedAcceleration(sw, i - 1);
     } else {
       const int first = solverOrder(task).firstColumn(i), column_count = solverOrder(task).columnsEnd(i) - first;
       const double constraint =
@@ -623,7 +622,7 @@ void outwardBodies(const Model& model, const Task& task, WorkspaceScratch& sw, E
 void outwardAccelerations(const Model& model, const Task& task, Workspace& ws, Eigen::Ref<Eigen::VectorXd> qdd) {
   WorkspaceScratch& sw = scratchOf(ws);
   sw.a_world = sw.a[0] = gravityAcceleration(task.gravity);  // Ẍ₀ = [−g; 0]
-  if (task.prescribedCount() > 0)
+  if (sw.prescribed_count > 0)
     outwardBodies<true>(model, task, sw, qdd);
   else
     outwardBodies<false>(model, task, sw, qdd);
@@ -683,10 +682,10 @@ void outwardLanes(const Model& model, const Task& task, const WorkspaceScratch& 
   }
   double* da = s.da.data();
   const Eigen::Index da_stride = s.da.outerStride();
-  const bool prescribed = task.prescribedCount() > 0;
+  const bool prescribed = sw.prescribed_count > 0;
   for (int e = 0; e < 6 * W; ++e) da[e] = 0.0;  // the world: δẌ₀ = 0
   for (int i = 1; i <= N; ++i) {
-    if (prescribed && isPrescribed(task, i - 1)) {  // δq̈_i = 0: the child moves with its parent
+    if (prescribed && isPrescribed(sw, i - 1)) {  // δq̈_i = 0: the child moves with its parent
       dqdd.template block<1, W>(i - 1, c0).setZero();
       for (int e = 0; e < 6 * W; ++e) da[i * da_stride + e] = da[model.parent(i) * da_stride + e];
       continue;
@@ -832,7 +831,7 @@ void multiDofColumns(const Model& model, const Task& task, const WorkspaceScratc
 void mixedJointColumns(const Model& model, const Task& task, const WorkspaceScratch& sw, const std::vector<int>& dofs,
                        int first, int last, UnitTorqueScratch& s) {
   for (int k = last; k >= first; --k)
-    if (!isPrescribed(task, k - 1)) oneDofColumns(model, task, sw, dofs, k, s);
+    if (!isPrescribed(sw, k - 1)) oneDofColumns(model, task, sw, dofs, k, s);
 }
 }  // namespace
 
@@ -852,7 +851,7 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   columnRuns(model, dofs, s);
   for (int i = model.nv(); i >= 1;) {  // joint by joint from the leaves; body i is a joint's last DOF body
     const int first = model.jointStart(i);
-    if (task.prescribedCount() > 0 && anyPrescribed(task, first, i))
+    if (sw.prescribed_count > 0 && anyPrescribed(sw, first, i))
       mixedJointColumns(model, task, sw, dofs, first, i, s);
     else if (first == i)
       oneDofColumns(model, task, sw, dofs, i, s);
@@ -1023,12 +1022,12 @@ namespace {
 template <bool kMotion>
 void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                           const double* qdd, const double* tau, Eigen::Ref<Eigen::VectorXd> tau_c) {
-  if (task.prescribedCount() == 0) return;
   WorkspaceScratch& sw = scratchOf(ws);
+  if (sw.prescribed_count == 0) return;
   const int N = model.nv();
   // The bodies before the first prescribed DOF's lie in no prescribed DOF's subtree (depth-first order).
   int lowest = 1;
-  while (!isPrescribed(task, lowest - 1)) ++lowest;
+  while (!isPrescribed(sw, lowest - 1)) ++lowest;
   for (int i = lowest; i <= N; ++i) sw.f[at(i)].setZero();
   const std::vector<char>& contact = solverOrder(task).contactColumns();
   const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
@@ -1038,7 +1037,7 @@ void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, c
     const int own_first = solverOrder(task).columnsEnd(i + 1), own_end = solverOrder(task).columnsEnd(i);
     for (int col = own_first; col < own_end; ++col)
       if (contact[at(col)]) f.noalias() -= sw.A_body.col(col) * nu_solver[col];
-    if (isPrescribed(task, i - 1))
+    if (isPrescribed(sw, i - 1))
       tau_c[i - 1] = sw.S[at(i)].dot(f) + (kMotion ? rotor_inertia[i - 1] * qdd[i - 1] - tau[i - 1] : 0.0);
     if (model.parent(i) >= lowest) sw.f[at(model.parent(i))] += f;
   }

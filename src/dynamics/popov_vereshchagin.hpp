@@ -25,11 +25,20 @@ inline double dofInertia(const Workspace& ws, int dof) {
   return scratchOf(ws).D[static_cast<std::size_t>(bodyOfDof(dof))];
 }
 
-// Whether entry `dof` of v is prescribed: the sweeps' hot loops index the task's modes unchecked (the input
-// checks sized them).
+// Whether entry `dof` of v is prescribed in the task (the input checks and the friction layer's set-up).
 inline bool isPrescribed(const Task& task, int dof) {
   return task.dofModes()[static_cast<std::size_t>(dof)] == DofMode::Prescribed;
 }
+
+// The DOF modes the sweeps run with (WorkspaceScratch::dof_modes): the task's, bound at the start of a solve. The
+// hot loops index them unchecked (the input checks sized them).
+inline void bindTaskModes(const Task& task, WorkspaceScratch& sw) {
+  sw.dof_modes = task.dofModes().data();
+  sw.prescribed_qdd = task.prescribedAccelerations().data();
+  sw.prescribed_count = task.prescribedCount();
+}
+inline bool isPrescribed(const WorkspaceScratch& sw, int dof) { return sw.dof_modes[dof] == DofMode::Prescribed; }
+inline double prescribedAcceleration(const WorkspaceScratch& sw, int dof) { return sw.prescribed_qdd[dof]; }
 
 // Input checks shared by every solve (the balance options included).
 Status checkSolveInputs(const Model& model, const Task& task, const VectorRef& q, const VectorRef& qd,

@@ -43,6 +43,12 @@ struct WorkspaceScratch {
   std::vector<Vec6> c;            // Ẍ_bias,i = Ẋ_i × S_i q̇_i
   std::vector<Vec6> Fbias;        // F_bias,i = Ẋ_i ×* I_i Ẋ_i − F_ext,i
 
+  // --- the DOF modes the sweeps run with: the task's (bindTaskModes at the start of a solve), or another
+  // source's of the same sizes (a stick pattern's locked DOFs)
+  const DofMode* dof_modes = nullptr;      // nv entries
+  const double* prescribed_qdd = nullptr;  // nv entries, read on the prescribed DOFs only
+  int prescribed_count = 0;                // how many are prescribed (0: the sweeps take their plain loops)
+
   // --- inward sweep: articulated quantities (lines 11–22)
   std::vector<Mat6> IA;           // I^A_i
   std::vector<Vec6> FA;           // F^A_bias,i

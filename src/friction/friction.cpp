@@ -434,6 +434,7 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   if (Status s = checkSolveInputs(model, task, q, qd, tau, ws); !s) return s;
   if (Status s = roomForTask(model, task, ws); !s) return s;  // allocates only for more rows than ever before
   WorkspaceScratch& sw = scratchOf(ws);
+  bindTaskModes(task, sw);  // the sweeps read the DOF modes from here
   if (Status s = checkOptions(model, options); !s) return s;
   if (Status s = checkFrictionResultSizes(model, ws.friction); !s) return s;
   const int m = task.solverColumns();

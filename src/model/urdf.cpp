@@ -54,12 +54,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <mutex>
 #include <set>
 #include <sstream>
 #include <vector>
 
+#include "model/loader_messages.hpp"
 #include "model/urdf_option_names.hpp"
 #include "model/validate.hpp"
 
@@ -70,42 +70,9 @@ using internal::NamedUrdfOptions;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// ---------------------------------------------------------------------------
-// Messages
-
-std::string fmt(double value) {
-  std::ostringstream out;
-  out << std::setprecision(12) << value;
-  return out.str();
-}
-
-std::string nameList(const std::vector<std::string>& names, std::size_t max_shown = 12) {
-  std::ostringstream out;
-  for (std::size_t k = 0; k < names.size() && k < max_shown; ++k) out << (k ? ", " : "") << "'" << names[k] << "'";
-  if (names.size() > max_shown) out << ", … (" << names.size() - max_shown << " more)";
-  return out.str();
-}
-
-// Everything the loader throws goes through here: "<source>: <what>".
-class Reporter {
- public:
-  explicit Reporter(std::string source) : source_(std::move(source)) {}
-  [[noreturn]] void fail(const std::string& what) const { throw ModelError(source_ + ": " + what); }
-  const std::string& source() const { return source_; }
-
-  // Runs a ModelBuilder call and prefixes its errors with the source.
-  template <class F>
-  void builder(F&& call) const {
-    try {
-      call();
-    } catch (const ModelError& e) {
-      fail(e.what());
-    }
-  }
-
- private:
-  std::string source_;
-};
+using internal::fmt;
+using internal::nameList;
+using internal::Reporter;
 
 // ---------------------------------------------------------------------------
 // Numbers as text (pass 1)

@@ -1,8 +1,12 @@
 // The model loaders' messages, shared by the URDF loader (urdf.cpp) and the MJCF loader (src/mujoco/mjcf.cpp) so
-// that both spell numbers, name lists and their source alike (not installed).
+// that both spell numbers, name lists, their source and a file that cannot be read alike (not installed).
 #pragma once
 
+#include <cerrno>
 #include <cstddef>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <string>
@@ -34,6 +38,18 @@ class Reporter {
   explicit Reporter(std::string source) : source_(std::move(source)) {}
   [[noreturn]] void fail(const std::string& what) const { throw ModelError(source_ + ": " + what); }
   const std::string& source() const { return source_; }
+
+  // The source as a file opened for reading; fails naming why it cannot be (a directory, errno's reason).
+  std::ifstream open() const {
+    std::error_code ec;
+    if (std::filesystem::is_directory(source_, ec)) fail("cannot read the file: it is a directory");
+    std::ifstream in(source_, std::ios::binary);
+    if (!in) {
+      const int err = errno;
+      fail(std::string("cannot open the file (") + (err ? std::strerror(err) : "unknown error") + ")");
+    }
+    return in;
+  }
 
   // Runs a ModelBuilder call and prefixes its errors with the source.
   template <class F>

@@ -48,11 +48,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <set>
@@ -1285,13 +1282,7 @@ Model internal::loadUrdfString(const std::string& xml, const internal::NamedUrdf
 
 Model internal::loadUrdfFile(const std::string& path, const internal::NamedUrdfOptions& options) {
   const Reporter report(path);
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) report.fail("cannot read the file: it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int err = errno;
-    report.fail(std::string("cannot open the file (") + (err ? std::strerror(err) : "unknown error") + ")");
-  }
+  std::ifstream in = report.open();
   std::ostringstream content;
   content << in.rdbuf();
   if (in.bad()) report.fail("cannot read the file");

@@ -23,9 +23,7 @@
 #include <mujoco/mujoco.h>
 
 #include <Eigen/Geometry>
-#include <cerrno>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <memory>
@@ -462,13 +460,7 @@ MjcfModel readMjcfString(const std::string& xml, const MjcfOptions& options) {
 
 MjcfModel readMjcfFile(const std::string& path, const MjcfOptions& options) {
   const Reporter report(path);
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) report.fail("cannot read the file: it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int err = errno;
-    report.fail(std::string("cannot open the file (") + (err ? std::strerror(err) : "unknown error") + ")");
-  }
+  std::ifstream in = report.open();
   std::ostringstream content;
   content << in.rdbuf();
   requireMjcf(report, content.str());

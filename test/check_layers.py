@@ -15,8 +15,9 @@ allowed = {
     "model": {"model"},
     "dynamics": {"linalg", "model", "dynamics"},  # model/task_layout.hpp: the task's constraints as the solver reads them
     "friction": {"linalg", "qp", "model", "dynamics", "friction"},
-    # The MJCF loader (zwang_mujoco, optional): above the model layer through its public API only.
-    "mujoco": {"mujoco"},
+    # The MJCF loader (zwang_mujoco, optional): above the model layer through its public API and
+    # model/loader_messages.hpp, the messages it spells as the URDF loader does.
+    "mujoco": {"mujoco", "model"},
     # The front ends' problem layer: above the library (which never includes it), below the front ends.
     "problem": {"problem", "model"},  # model/urdf_option_names.hpp: the front ends' spelling of the URDF options
     "cli": {"problem"},

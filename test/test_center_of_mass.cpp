@@ -24,6 +24,7 @@
 
 #include "support/bad_inputs.hpp"
 #include "support/floating_reference.hpp"
+#include "support/joint_types_problem.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"
 #include "zwang/zwang.hpp"
@@ -37,77 +38,11 @@ namespace {
 // of a few 1e-15 relative to the sizes, grown by the tree's depth; 1e-10 leaves room and still sees any wrong term.
 constexpr double kTolerance = 1e-10;
 
-Eigen::Vector4d randomQuaternion(std::mt19937_64& rng) {
-  for (;;) {
-    const Eigen::Vector4d quat(gaussian(rng), gaussian(rng), gaussian(rng), gaussian(rng));
-    if (quat.norm() > 1e-6) return quat.normalized();
-  }
-}
-
-// A random tree of 1–20 moving joints, each spherical (0.3), planar (0.1), free (0.05) or a one-DOF joint.
-ChainSpec randomJointTypesTree(std::mt19937_64& rng) {
-  RandomTreeOptions options;
-  options.min_moving_joints = 1;
-  options.max_moving_joints = 20;
-  ChainSpec spec = randomTree(rng, options);
-  spec.name = "com_tree";
-  for (JointSpec& joint : spec.joints) {
-    if (joint.isFixed()) continue;
-    const double u = uniform01(rng);
-    if (u < 0.3)
-      joint.type = "spherical";
-    else if (u < 0.4)
-      joint.type = "planar";
-    else if (u < 0.45)
-      joint.type = "free";
-    else
-      continue;
-    joint.lower = joint.upper = 0.0;
-  }
-  spec.check();
-  return spec;
-}
-
-// q (base pose, one-DOF joints in their limits or ±π, unit quaternions, planar and free offsets), v in ±2, τ in ±5
-// on the joints (0 on the base).
+// The tree's random state (drawState) as a value, for the const inputs below.
 FloatingInput randomState(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& base) {
   FloatingInput in;
-  in.q.resize(base.nq(spec));
-  if (base.kind == BaseKind::Free) {
-    in.q.head<3>() = randomVector(rng, 3, 2.0);
-    in.q.segment<4>(3) = randomQuaternion(rng);
-  } else if (base.kind == BaseKind::Planar) {
-    in.q.head<3>() << uniform(rng, -2.0, 2.0), uniform(rng, -2.0, 2.0), uniform(rng, -3.14159, 3.14159);
-  }
-  Eigen::Index qi = base.baseConfigurationSize();
-  for (const int k : spec.movingJoints()) {
-    const JointSpec& joint = spec.joints[static_cast<std::size_t>(k)];
-    if (joint.isSpherical()) {
-      in.q.segment<4>(qi) = randomQuaternion(rng);
-    } else if (joint.isFree()) {
-      in.q.segment<3>(qi) = randomVector(rng, 3, 1.0);
-      in.q.segment<4>(qi + 3) = randomQuaternion(rng);
-    } else if (joint.isPlanar()) {
-      in.q.segment<3>(qi) << uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5), uniform(rng, -3.14159, 3.14159);
-    } else if (joint.upper > joint.lower && joint.type != "continuous") {
-      in.q(qi) = uniform(rng, joint.lower, joint.upper);
-    } else {
-      in.q(qi) = uniform(rng, -3.14159, 3.14159);
-    }
-    qi += joint.nq();
-  }
-  const int nv = base.nv(spec);
-  in.v = randomVector(rng, nv, 2.0);
-  in.tau = randomVector(rng, nv, 5.0);
-  in.tau.head(base.baseVelocitySize()).setZero();
+  drawState(rng, spec, base, in);
   return in;
-}
-
-FloatingBase randomBase(std::mt19937_64& rng) {
-  FloatingBase base;
-  const double u = uniform01(rng);
-  base.kind = u < 0.4 ? BaseKind::Fixed : u < 0.7 ? BaseKind::Free : BaseKind::Planar;
-  return base;
 }
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& a) {
@@ -181,7 +116,7 @@ TEST_CASE("centre of mass: position, velocity, acceleration, Jacobian and moment
   Worst worst;
   int trees = 0, subtrees = 0, floating = 0;
   for (int trial = 0; trial < 150; ++trial) {
-    const ChainSpec spec = randomJointTypesTree(rng);
+    const ChainSpec spec = randomJointTypesTree(rng, 1, 20, 0.3);
     const FloatingBase base = randomBase(rng);
     const FloatingInput in = randomState(rng, spec, base);
     const Model model = floatingModelFromSpec(spec, base);
@@ -244,7 +179,7 @@ TEST_CASE("centre of mass: the Jacobian is the derivative of the position along 
   std::mt19937_64 rng(2706);
   double worst = 0.0;
   for (int trial = 0; trial < 40; ++trial) {
-    const ChainSpec spec = randomJointTypesTree(rng);
+    const ChainSpec spec = randomJointTypesTree(rng, 1, 20, 0.3);
     const FloatingBase base = randomBase(rng);
     const FloatingInput in = randomState(rng, spec, base);
     const Model model = floatingModelFromSpec(spec, base);
@@ -278,7 +213,7 @@ TEST_CASE("centre of mass: the acceleration is the derivative of the velocity al
   double worst = 0.0;
   int subtrees = 0;
   for (int trial = 0; trial < 40; ++trial) {
-    const ChainSpec spec = randomJointTypesTree(rng);
+    const ChainSpec spec = randomJointTypesTree(rng, 1, 20, 0.3);
     const FloatingBase base = randomBase(rng);
     const FloatingInput in = randomState(rng, spec, base);
     const Model model = floatingModelFromSpec(spec, base);
@@ -323,7 +258,7 @@ TEST_CASE("centre of mass: in free flight it falls with g and the centroidal mom
   std::mt19937_64 rng(2707);
   double worst_fall = 0.0, worst_rate = 0.0, largest_h = 0.0;
   for (int trial = 0; trial < 60; ++trial) {
-    const ChainSpec spec = randomJointTypesTree(rng);
+    const ChainSpec spec = randomJointTypesTree(rng, 1, 20, 0.3);
     const FloatingBase base{BaseKind::Free, Eigen::Isometry3d::Identity()};
     const FloatingInput in = randomState(rng, spec, base);
     const Model model = floatingModelFromSpec(spec, base);

@@ -99,17 +99,6 @@ double largestError(const std::vector<Vector6d>& x, const std::vector<Vector6d>&
   return diff / size;
 }
 
-// One of the input's absolute frame constraints made a contact on a floating base, half the time.
-bool makeContact(std::mt19937_64& rng, const FloatingBase& base, FloatingInput& in) {
-  if (base.kind == BaseKind::Fixed || uniform01(rng) < 0.5) return false;
-  for (ConstraintInput& c : in.constraints)
-    if (c.joint < 0 && c.relative_to.empty()) {
-      c.contact = true;
-      return true;
-    }
-  return false;
-}
-
 // J_Bᵀ (Σ_i I_i a_i + v_i ×* I_i v_i − I_i [g; 0] − w_i): the base rows of the whole robot's Newton–Euler balance
 // with the wrenches w on the links (world axes at their origins), the accelerations those of qdd. Zero when the
 // wrenches and gravity are all the outside world exerts (τ on the base is 0, no applied wrenches).
@@ -138,15 +127,8 @@ TEST_CASE("constraint wrench: the dense reference's A nu per frame, and tau_c = 
   double e_wrench = 0, e_local = 0, e_g_nu = 0, e_tau_c = 0;
   while (compared < 250) {
     REQUIRE(++draws < 3000);
-    const ChainSpec spec = randomJointTypesTree(rng, 2, 12, 0.3);
-    const FloatingBase base = randomBase(rng);
-    RandomProblemOptions options;
-    options.max_constraint_rows = 6;
-    options.max_constraint_frames = 3;
-    options.relative_probability = 0.4;
-    FloatingInput in = loadedInput(rng, spec, base, options);
+    auto [spec, base, in, model] = drawLoadedTree(rng, 2, 12, 0.3, rowOptions(6, 0.4));
     const bool has_contact = makeContact(rng, base, in);
-    const Model model = floatingModelFromSpec(spec, base);
     const Task task = floatingTaskFromInput(model, in);
     if (task.constraintRows() == 0) continue;
     const FloatingResult dense = floatingDynamics(spec, base, in);

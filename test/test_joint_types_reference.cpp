@@ -110,16 +110,9 @@ TEST_CASE("joint types: solveHybridDynamics against the dense reference on trees
   double e_qdd = 0, e_nu = 0, e_tau_c = 0, e_tau_control = 0, e_gauss = 0;
   while (compared < 300) {
     REQUIRE(++draws < 3000);
-    const ChainSpec spec = randomJointTypesTree(rng, 2, 16, 0.35);
-    const FloatingBase base = randomBase(rng);
-    RandomProblemOptions options;
-    options.max_constraint_rows = 8;
-    options.max_constraint_frames = 3;
-    options.relative_probability = 0.3;
-    FloatingInput in = loadedInput(rng, spec, base, options);
+    auto [spec, base, in, model] = drawLoadedTree(rng, 2, 16, 0.35, rowOptions(8, 0.3));
     std::vector<JointRows> joint_rows;
     if (uniform01(rng) < 0.3) joint_rows.push_back(randomJointRows(rng, spec));
-    const Model model = floatingModelFromSpec(spec, base);
     const Task task = taskWithJointRows(model, in, joint_rows);
     const FloatingResult dense = floatingDynamics(spec, base, in);
     if (!wellPosed(dense)) continue;
@@ -389,13 +382,8 @@ TEST_CASE(
   double e_qdd = 0, e_default = 0, e_round_trip = 0;
   while (compared < 200) {
     REQUIRE(++draws < 2000);
-    const ChainSpec spec = randomJointTypesTree(rng, 2, 16, 0.35);
-    const FloatingBase base = randomBase(rng);
-    RandomProblemOptions options;
-    options.max_constraint_rows = 0;
-    FloatingInput in = loadedInput(rng, spec, base, options);
+    auto [spec, base, in, model] = drawLoadedTree(rng, 2, 16, 0.35, rowOptions(0, 0.0));
     in.constraints.clear();
-    const Model model = floatingModelFromSpec(spec, base);
     const Task task = floatingTaskFromInput(model, in);
     REQUIRE(task.constraintRows() == 0);
     const FloatingResult dense = floatingDynamics(spec, base, in);

@@ -82,18 +82,6 @@ Prescription prescribeRandomly(std::mt19937_64& rng, const ChainSpec& spec, cons
   return out;
 }
 
-// One of the input's absolute frame constraints, if any, made a contact (the environment's force): on a floating
-// base half the time, so that the prescribed torques see forces the motors do not give.
-int makeContact(std::mt19937_64& rng, const FloatingBase& base, FloatingInput& in) {
-  if (base.kind == BaseKind::Fixed || uniform01(rng) < 0.5) return 0;
-  for (ConstraintInput& c : in.constraints)
-    if (c.joint < 0 && c.relative_to.empty()) {
-      c.contact = true;
-      return 1;
-    }
-  return 0;
-}
-
 }  // namespace
 
 TEST_CASE("prescribed joints: solveHybridDynamics against the dense KKT with the prescriptions as rows",
@@ -103,15 +91,9 @@ TEST_CASE("prescribed joints: solveHybridDynamics against the dense KKT with the
   double e_qdd = 0, e_nu = 0, e_tau_c = 0, e_tau_control = 0, e_gauss = 0, e_prescribed = 0;
   while (compared < 400) {
     REQUIRE(++draws < 4000);
-    const ChainSpec spec = randomJointTypesTree(rng, 2, 14, 0.3);
-    const FloatingBase base = randomBase(rng);
-    RandomProblemOptions options;
-    options.max_constraint_rows = 6;
-    options.max_constraint_frames = 3;
-    options.relative_probability = 0.3;
-    FloatingInput in = loadedInput(rng, spec, base, options);
-    const int has_contact = makeContact(rng, base, in);
-    const Model model = floatingModelFromSpec(spec, base);
+    auto [spec, base, in, model] = drawLoadedTree(rng, 2, 14, 0.3, rowOptions(6, 0.3));
+    // A contact half the time on a floating base: forces the motors do not give, which the prescribed torques see.
+    const int has_contact = makeContact(rng, base, in) ? 1 : 0;
     Task task = floatingTaskFromInput(model, in);
     const int user_rows = task.constraintRows();
     const Prescription prescribed = prescribeRandomly(rng, spec, base, 0.4, task, in);
@@ -164,12 +146,7 @@ TEST_CASE("prescribed joints: with every DOF prescribed the torques are inverse 
   double e_tau = 0;
   int compared = 0;
   for (int draw = 0; draw < 200; ++draw) {
-    const ChainSpec spec = randomJointTypesTree(rng, 1, 16, 0.3);
-    const FloatingBase base = randomBase(rng);
-    RandomProblemOptions options;
-    options.max_constraint_rows = 0;
-    FloatingInput in = loadedInput(rng, spec, base, options);
-    const Model model = floatingModelFromSpec(spec, base);
+    auto [spec, base, in, model] = drawLoadedTree(rng, 1, 16, 0.3, rowOptions(0, 0.0));
     Task task = floatingTaskFromInput(model, in);
     if (!model.mimicJoints().empty()) continue;  // a mimic joint follows its leader: it cannot be prescribed
     const Eigen::VectorXd qdd = randomVector(rng, model.nv(), 3.0);

@@ -62,6 +62,10 @@ using problem::printable;
 // Each of the model's warnings once on stderr: "zwang: warning: <message>".
 void printWarnings(const Model& model);
 
+// The URDF options of --root, --tip, --base and the flags --strict, --attach-beyond-tip and --lock-mimic (false
+// where `command` takes none), named as the command line spells them; UsageError naming `command` for a bad --base.
+internal::NamedUrdfOptions commandLineUrdfOptions(const std::string& command, const Arguments& args);
+
 // Read a whole file; CliError "<path>: cannot read the file (<reason>)" on failure.
 // Files larger than max_bytes are refused.
 std::string readFile(const std::string& path, std::size_t max_bytes);

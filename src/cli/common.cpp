@@ -246,6 +246,26 @@ void printWarnings(const Model& model) {
     std::fprintf(stderr, "zwang: warning: %s\n", printable(w.message, 4000).c_str());
 }
 
+internal::NamedUrdfOptions commandLineUrdfOptions(const std::string& command, const Arguments& args) {
+  problem::ModelRequest request{args.value("--root"),
+                                args.value("--tip"),
+                                args.has("--strict"),
+                                args.has("--attach-beyond-tip"),
+                                args.has("--lock-mimic"),
+                                BaseType::Fixed,
+                                {}};
+  request.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
+  request.names.base = "--base";
+  if (args.has("--base")) {
+    try {
+      request.base = problem::parseBaseType(problem::Spelling{'\'', ""}, args.value("--base"));  // quoted with '
+    } catch (const problem::ProblemError& e) {
+      throw UsageError(command, std::string("--base: ") + e.what());
+    }
+  }
+  return problem::urdfOptions(request);
+}
+
 std::string readFile(const std::string& path, std::size_t max_bytes) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))

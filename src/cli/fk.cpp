@@ -16,9 +16,6 @@ namespace zwang::cli {
 
 namespace {
 
-// Command-line values are quoted with ' in messages.
-const problem::Spelling kCommandLine{'\'', ""};
-
 // --q: numbers separated by commas or blanks.
 Eigen::VectorXd parseNumbers(const std::string& text) {
   std::vector<double> values;
@@ -39,18 +36,8 @@ Eigen::VectorXd parseNumbers(const std::string& text) {
 
 // The URDF, loaded as `zwang info` loads it.
 Model loadModel(const Arguments& args) {
-  problem::ModelRequest request{args.value("--root"), args.value("--tip"), false, false, false, BaseType::Fixed, {}};
-  request.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
-  request.names.base = "--base";
-  if (args.has("--base")) {
-    try {
-      request.base = problem::parseBaseType(kCommandLine, args.value("--base"));
-    } catch (const problem::ProblemError& e) {
-      throw UsageError("fk", std::string("--base: ") + e.what());
-    }
-  }
   try {
-    return internal::loadUrdfFile(args.positional[0], problem::urdfOptions(request));
+    return internal::loadUrdfFile(args.positional[0], commandLineUrdfOptions("fk", args));
   } catch (const ModelError& e) {
     throw CliError(kExitError, e.what());
   }

@@ -16,9 +16,6 @@ namespace zwang::cli {
 
 namespace {
 
-// Command-line values are quoted with ' in messages.
-const problem::Spelling kCommandLine{'\'', ""};
-
 // Limits may be infinite ("none"): null in JSON, "-" in the table.
 Json finiteOrNull(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
@@ -230,26 +227,9 @@ int commandInfo(int argc, char** argv) {
   if (args.positional.size() != 1)
     throw UsageError("info", args.positional.empty() ? "no URDF file given" : "more than one URDF file given");
   const std::string path = args.positional[0];
-  problem::ModelRequest request{args.value("--root"),
-                                args.value("--tip"),
-                                args.has("--strict"),
-                                args.has("--attach-beyond-tip"),
-                                args.has("--lock-mimic"),
-                                BaseType::Fixed,
-                                {}};
-  request.names = {"--tip", "--rotor-inertia", "--attach-beyond-tip", "--lock-mimic"};
-  request.names.base = "--base";
-  if (args.has("--base")) {
-    try {
-      request.base = problem::parseBaseType(kCommandLine, args.value("--base"));
-    } catch (const problem::ProblemError& e) {
-      throw UsageError("info", std::string("--base: ") + e.what());
-    }
-  }
-  const internal::NamedUrdfOptions options = problem::urdfOptions(request);
   Model model;
   try {
-    model = problem::loadModelFile(path, options).model;
+    model = problem::loadModelFile(path, commandLineUrdfOptions("info", args)).model;
   } catch (const ModelError& e) {
     throw CliError(kExitError, e.what());
   }

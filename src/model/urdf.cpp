@@ -48,18 +48,15 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <mutex>
 #include <set>
 #include <sstream>
 #include <vector>
 
+#include "model/loader_messages.hpp"
 #include "model/urdf_option_names.hpp"
 #include "model/validate.hpp"
 
@@ -70,42 +67,9 @@ using internal::NamedUrdfOptions;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// ---------------------------------------------------------------------------
-// Messages
-
-std::string fmt(double value) {
-  std::ostringstream out;
-  out << std::setprecision(12) << value;
-  return out.str();
-}
-
-std::string nameList(const std::vector<std::string>& names, std::size_t max_shown = 12) {
-  std::ostringstream out;
-  for (std::size_t k = 0; k < names.size() && k < max_shown; ++k) out << (k ? ", " : "") << "'" << names[k] << "'";
-  if (names.size() > max_shown) out << ", … (" << names.size() - max_shown << " more)";
-  return out.str();
-}
-
-// Everything the loader throws goes through here: "<source>: <what>".
-class Reporter {
- public:
-  explicit Reporter(std::string source) : source_(std::move(source)) {}
-  [[noreturn]] void fail(const std::string& what) const { throw ModelError(source_ + ": " + what); }
-  const std::string& source() const { return source_; }
-
-  // Runs a ModelBuilder call and prefixes its errors with the source.
-  template <class F>
-  void builder(F&& call) const {
-    try {
-      call();
-    } catch (const ModelError& e) {
-      fail(e.what());
-    }
-  }
-
- private:
-  std::string source_;
-};
+using internal::fmt;
+using internal::nameList;
+using internal::Reporter;
 
 // ---------------------------------------------------------------------------
 // Numbers as text (pass 1)
@@ -1318,13 +1282,7 @@ Model internal::loadUrdfString(const std::string& xml, const internal::NamedUrdf
 
 Model internal::loadUrdfFile(const std::string& path, const internal::NamedUrdfOptions& options) {
   const Reporter report(path);
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) report.fail("cannot read the file: it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int err = errno;
-    report.fail(std::string("cannot open the file (") + (err ? std::strerror(err) : "unknown error") + ")");
-  }
+  std::ifstream in = report.open();
   std::ostringstream content;
   content << in.rdbuf();
   if (in.bad()) report.fail("cannot read the file");

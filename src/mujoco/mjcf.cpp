@@ -23,11 +23,8 @@
 #include <mujoco/mujoco.h>
 
 #include <Eigen/Geometry>
-#include <cerrno>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -35,32 +32,14 @@
 #include <sstream>
 #include <vector>
 
+#include "model/loader_messages.hpp"
+
 namespace zwang {
 namespace {
 
-// Everything the loader throws: "<source>: <what>".
-class Reporter {
- public:
-  explicit Reporter(std::string source) : source_(std::move(source)) {}
-  [[noreturn]] void fail(const std::string& what) const { throw ModelError(source_ + ": " + what); }
-  const std::string& source() const { return source_; }
-
- private:
-  std::string source_;
-};
-
-std::string fmt(double value) {
-  std::ostringstream out;
-  out << std::setprecision(12) << value;
-  return out.str();
-}
-
-std::string nameList(const std::vector<std::string>& names, std::size_t max_shown = 12) {
-  std::ostringstream out;
-  for (std::size_t k = 0; k < names.size() && k < max_shown; ++k) out << (k ? ", " : "") << "'" << names[k] << "'";
-  if (names.size() > max_shown) out << ", … (" << names.size() - max_shown << " more)";
-  return out.str();
-}
+using internal::fmt;
+using internal::nameList;
+using internal::Reporter;
 
 // ---------------------------------------------------------------------------
 // MuJoCo's compiler
@@ -481,13 +460,7 @@ MjcfModel readMjcfString(const std::string& xml, const MjcfOptions& options) {
 
 MjcfModel readMjcfFile(const std::string& path, const MjcfOptions& options) {
   const Reporter report(path);
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) report.fail("cannot read the file: it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int err = errno;
-    report.fail(std::string("cannot open the file (") + (err ? std::strerror(err) : "unknown error") + ")");
-  }
+  std::ifstream in = report.open();
   std::ostringstream content;
   content << in.rdbuf();
   requireMjcf(report, content.str());

@@ -107,4 +107,30 @@ FloatingInput loadedInput(std::mt19937_64& rng, const ChainSpec& spec, const Flo
   return in;
 }
 
+RandomProblemOptions rowOptions(int max_rows, double relative) {
+  RandomProblemOptions options;
+  options.max_constraint_rows = max_rows;
+  options.relative_probability = relative;
+  return options;
+}
+
+LoadedTree drawLoadedTree(std::mt19937_64& rng, int min_moving, int max_moving, double spherical,
+                          const RandomProblemOptions& options) {
+  ChainSpec spec = randomJointTypesTree(rng, min_moving, max_moving, spherical);
+  const FloatingBase base = randomBase(rng);
+  FloatingInput in = loadedInput(rng, spec, base, options);
+  Model model = floatingModelFromSpec(spec, base);
+  return {std::move(spec), base, std::move(in), std::move(model)};
+}
+
+bool makeContact(std::mt19937_64& rng, const FloatingBase& base, FloatingInput& in) {
+  if (base.kind == BaseKind::Fixed || uniform01(rng) < 0.5) return false;
+  for (ConstraintInput& c : in.constraints)
+    if (c.joint < 0 && c.relative_to.empty()) {
+      c.contact = true;
+      return true;
+    }
+  return false;
+}
+
 }  // namespace zwang::testing

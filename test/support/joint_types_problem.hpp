@@ -1,6 +1,6 @@
 // Random problems on trees of every joint type (issue #25), shared by the tests that compare them with the dense
-// reference and the friction brute force (test_joint_types_reference, test_prescribed): the trees, their bases,
-// their states and loads, and which draws are well posed.
+// reference and the friction brute force (test_joint_types_reference, test_prescribed, test_constraint_wrench,
+// test_center_of_mass): the trees, their bases, their states and loads, and which draws are well posed.
 #pragma once
 
 #include <random>
@@ -35,5 +35,24 @@ void moveEveryDof(std::mt19937_64& rng, int base_velocity_size, int n, FloatingI
 // order of draws.
 FloatingInput loadedInput(std::mt19937_64& rng, const ChainSpec& spec, const FloatingBase& base,
                           const RandomProblemOptions& options);
+
+// randomProblem's options with up to `max_rows` task rows (on up to three frames), a frame's rows relative to
+// another link with probability `relative`.
+RandomProblemOptions rowOptions(int max_rows, double relative);
+
+// One draw of the dense-reference comparisons: a tree (randomJointTypesTree), its base (randomBase), its loaded
+// input (loadedInput), in that order of draws, and its model (floatingModelFromSpec).
+struct LoadedTree {
+  ChainSpec spec;
+  FloatingBase base;
+  FloatingInput in;
+  Model model;
+};
+LoadedTree drawLoadedTree(std::mt19937_64& rng, int min_moving, int max_moving, double spherical,
+                          const RandomProblemOptions& options);
+
+// One of the input's absolute frame constraints made a contact (the environment's force) on a floating base, half
+// the time: false when none is.
+bool makeContact(std::mt19937_64& rng, const FloatingBase& base, FloatingInput& in);
 
 }  // namespace zwang::testing

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "mujoco/mujoco_model.hpp"
 #include "zwang/configuration.hpp"
 #include "zwang/friction.hpp"
 #include "zwang/inverse_dynamics.hpp"
@@ -81,18 +82,6 @@ MjModelPtr compileText(const std::string& path, const std::string& text) {
   MjModelPtr m(mj_loadXML(kFile, vfs.get(), error, sizeof error));
   if (!m) throw ModelError(path + ": MuJoCo refuses the model: " + error);
   return m;
-}
-
-// The floating base's body (the world's only child, on a free joint) or −1, as the MJCF loader decides it.
-int floatingBaseBody(const mjModel* m) {
-  int children = 0, body = -1;
-  for (int b = 1; b < m->nbody; ++b)
-    if (m->body_parentid[b] == 0) {
-      ++children;
-      body = b;
-    }
-  if (children != 1 || m->body_jntnum[body] < 1 || m->jnt_type[m->body_jntadr[body]] != mjJNT_FREE) return -1;
-  return body;
 }
 
 // Erase every element `<tag …/>` whose opening text contains `must_contain` ("" for all); the count erased.
@@ -187,7 +176,7 @@ void prepareMujoco(mjModel* m) {
 Pair load(const std::string& path) {
   const std::string text = readText(path);
   const MjModelPtr original = compileText(path, text);
-  const int base_body = floatingBaseBody(original.get());
+  const int base_body = internal::floatingBaseBody(original.get());
   Pair p;
   p.base_fixed = base_body >= 0;
   const std::string compared = p.base_fixed ? withoutFreeJoint(path, text) : text;

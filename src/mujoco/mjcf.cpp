@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "model/loader_messages.hpp"
+#include "mujoco/mujoco_model.hpp"
 
 namespace zwang {
 namespace {
@@ -156,18 +157,6 @@ RigidInertia bodyInertia(const mjModel* m, int b) {
   const Mat3 R = rotation(m->body_iquat + 4 * b);
   const Mat3 I = R * vec3(m->body_inertia + 3 * b).asDiagonal() * R.transpose();
   return RigidInertia::fromMassComInertia(m->body_mass[b], vec3(m->body_ipos + 3 * b), I);
-}
-
-// The floating base: the world's only child body, on a free joint.
-int floatingBaseBody(const mjModel* m) {
-  int children = 0, body = -1;
-  for (int b = 1; b < m->nbody; ++b)
-    if (m->body_parentid[b] == 0) {
-      ++children;
-      body = b;
-    }
-  if (children != 1 || m->body_jntnum[body] < 1 || m->jnt_type[m->body_jntadr[body]] != mjJNT_FREE) return -1;
-  return body;
 }
 
 // Per-DOF values of a joint must agree (zwang keeps one per joint).
@@ -394,7 +383,7 @@ void refuseWarnings(const Reporter& report, const Model& model) {
 }
 
 Loading settings(const mjModel* m, const Reporter& report) {
-  Loading L{m, report, {}, std::vector<std::string>(static_cast<std::size_t>(m->nbody)), floatingBaseBody(m)};
+  Loading L{m, report, {}, std::vector<std::string>(static_cast<std::size_t>(m->nbody)), internal::floatingBaseBody(m)};
   const int off = m->opt.disableflags;
   L.limits = !(off & (mjDSBL_LIMIT | mjDSBL_CONSTRAINT));
   L.frictionloss = !(off & (mjDSBL_FRICTIONLOSS | mjDSBL_CONSTRAINT));

@@ -671,13 +671,15 @@ void benchKdlRne(benchmark::State& state, const Problem* p) {
 // ---------------------------------------------------------------------------
 // Static friction: ours
 
-void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int k, FrictionMethod method) {
+void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int k, FrictionMethod method,
+                   bool warm_start = false) {
   const std::vector<int> stuck = stuckSet(p->n, k);
   const Eigen::VectorXd qd = stuckVelocities(*p, stuck);
   const Task task = taskFromInput(p->model, makeInput(*p, kind, qd));
   Workspace ws(p->model, task);
   FrictionOptions options;
   options.method = method;
+  options.warm_start = warm_start;  // the first solve below keeps the pattern the timed ones start from
   if (!firstSolveSucceeded(state, solveWithFriction(p->model, ws, p->q, qd, p->tau, task, options))) return;
   if (static_cast<int>(ws.friction.stuck.size()) != k) {
     state.SkipWithError("stuck set has the wrong size");
@@ -686,6 +688,7 @@ void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int
   timeFrictionSolves(state, *p, task, qd, options, ws);
   setCounters(state, *p, task.constraintRows(), k);
   state.counters["iterations"] = ws.friction.iterations;
+  state.counters["warm"] = ws.friction.warm_started;
 }
 
 // ---------------------------------------------------------------------------
@@ -1027,6 +1030,13 @@ int main(int argc, char** argv) {
           });
         }
 
+  // Warm start (#28): every joint stuck, the last solve's pattern kept, against the same cold and the plain solve.
+  for (const auto& [kind, task_name] : fric_tasks)
+    for (const auto& p : problems)
+      if (p->n > 1)
+        reg(std::string("fric_warm_") + task_name + "_kall", *p, [q = p.get(), kind = kind](benchmark::State& s) {
+          benchFriction(s, q, kind, q->n, FrictionMethod::ActiveSet, true);
+        });
   for (const auto& [kind, task_name] : fric_tasks)
     for (int k : {1, 2})
       for (const auto& p : problems) {

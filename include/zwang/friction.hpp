@@ -39,6 +39,17 @@ struct FrictionOptions {
   double margin = 1.0;
   /// Active set (exact, the default) or projected gradient.
   FrictionMethod method = FrictionMethod::ActiveSet;
+  /// Try the stick/slip pattern of the last solveWithFriction in this
+  /// workspace first (a control loop or a simulation, whose next state is
+  /// close to the last): for the same model, task object and stuck set, one
+  /// pass of the sweeps with the sticking DOFs locked and the slipping ones at
+  /// their friction bound, accepted when its μ lies inside the boxes, the
+  /// slipping DOFs move the way their friction allows and μ* is unique (the
+  /// balance with the sticking DOFs locked is regular); otherwise, or with no
+  /// pattern to try, the full solve (docs/friction.md, "Warm start"). The
+  /// answer is the same either way; FrictionResult::warm_started tells which
+  /// ran, and dqdd_dmu is left zero when the pattern's pass did.
+  bool warm_start = false;
   int max_iterations = 500;      ///< of the maximiser
   double kkt_tolerance = 1e-12;  ///< relative to 1 + the largest |q̈(0)| on Θ₀
   ///@{

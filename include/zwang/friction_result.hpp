@@ -35,8 +35,11 @@ struct FrictionResult {
   bool converged = true;       ///< the maximiser met its KKT tolerance within max_iterations
   double kkt_residual = 0.0;   ///< max violation of the optimality conditions [rad/s² or m/s²]
   bool indeterminate = false;  ///< μ* is not unique; the effort-minimising one was chosen
-  bool limit_impact = false;   ///< a joint on a limit moves into it (needs an impulse; not modelled)
-  int impact_joint = -1;       ///< the joint of limit_impact, −1 when there is none
+  /// The last solve's stick/slip pattern held (FrictionOptions::warm_start): the answer came from one pass of the
+  /// sweeps with it, and dqdd_dmu is zero (not computed); iterations 0.
+  bool warm_started = false;
+  bool limit_impact = false;  ///< a joint on a limit moves into it (needs an impulse; not modelled)
+  int impact_joint = -1;      ///< the joint of limit_impact, −1 when there is none
 };
 
 }  // namespace zwang

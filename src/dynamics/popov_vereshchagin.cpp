@@ -1018,8 +1018,9 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
 }
 
 namespace {
-// prescribedTorques and prescribedContactTorques: with kMotion the whole torque, without it the contacts' part.
-template <bool kMotion>
+// prescribedTorques and prescribedContactTorques: with kMotion the whole torque, without it the contacts' part;
+// with kEveryColumn every constraint force acts on the bodies, not only the contacts' (prescribedDofResiduals).
+template <bool kMotion, bool kEveryColumn = false>
 void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                           const double* qdd, const double* tau, Eigen::Ref<Eigen::VectorXd> tau_c) {
   WorkspaceScratch& sw = scratchOf(ws);
@@ -1036,7 +1037,7 @@ void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, c
     if (kMotion) f += sw.I[at(i)] * sw.a[at(i)] + sw.Fbias[at(i)];
     const int own_first = solverOrder(task).columnsEnd(i + 1), own_end = solverOrder(task).columnsEnd(i);
     for (int col = own_first; col < own_end; ++col)
-      if (contact[at(col)]) f.noalias() -= sw.A_body.col(col) * nu_solver[col];
+      if (kEveryColumn || contact[at(col)]) f.noalias() -= sw.A_body.col(col) * nu_solver[col];
     if (isPrescribed(sw, i - 1))
       tau_c[i - 1] = sw.S[at(i)].dot(f) + (kMotion ? rotor_inertia[i - 1] * qdd[i - 1] - tau[i - 1] : 0.0);
     if (model.parent(i) >= lowest) sw.f[at(model.parent(i))] += f;
@@ -1052,6 +1053,11 @@ void prescribedTorques(const Model& model, const Task& task, Workspace& ws, cons
 void prescribedContactTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                               Eigen::Ref<Eigen::VectorXd> tau_c) {
   prescribedDofTorques<false>(model, task, ws, nu_solver, nullptr, nullptr, tau_c);
+}
+
+void prescribedDofResiduals(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                            const VectorRef& qdd, const VectorRef& tau, Eigen::Ref<Eigen::VectorXd> residual) {
+  prescribedDofTorques<true, true>(model, task, ws, nu_solver, qdd.data(), tau.data(), residual);
 }
 
 double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd, const VectorRef& tau,

@@ -127,6 +127,11 @@ void prescribedTorques(const Model& model, const Task& task, Workspace& ws, cons
 // fixed motion (the friction's flat directions).
 void prescribedContactTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                               Eigen::Ref<Eigen::VectorXd> tau_c);
+// For each DOF the sweeps held prescribed (the modes bound in sw), what the rest of its joint's equation leaves
+// over with every constraint force acting: λ = d q̈ + Sᵀ Σ_subtree (I a + F_bias − A ν) − τ, the generalized force
+// something else must give it (a locked DOF of a stick pattern: its friction, −λ). Other entries untouched.
+void prescribedDofResiduals(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                            const VectorRef& qdd, const VectorRef& tau, Eigen::Ref<Eigen::VectorXd> residual);
 // Mimic joints' torques onto their leaders' motors: τ_l += a·τ_m, τ_m = 0.
 void carryMimicTorques(const Model& model, Eigen::Ref<Eigen::VectorXd> tau_control);
 

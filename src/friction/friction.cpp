@@ -24,6 +24,7 @@
 #include "dynamics/checks.hpp"
 #include "dynamics/popov_vereshchagin.hpp"
 #include "friction/friction_scratch.hpp"
+#include "friction/stick_pattern.hpp"
 #include "qp/box_qp.hpp"
 
 namespace zwang {
@@ -416,6 +417,42 @@ double frictionStates(const Model& model, const Eigen::VectorXd& qdd_all, double
   return mu_dot_qdd;
 }
 
+// ---- The solution at μ* (q̈*, ν and the bodies' accelerations in the sweep): the solve's results, the torques,
+// the joints' states, and Z and g(μ*).
+void publishSolution(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& tau,
+                     double acc_tolerance, Workspace& ws, FrictionScratch& fs, FrictionResult& fr) {
+  WorkspaceScratch& sw = scratchOf(ws);
+  Solution& out = ws.solution;
+  const int m = task.solverColumns();
+  ws.kinematics.stage = KinematicsStage::Accelerations;  // those of q̈*
+  out.base_acceleration_world = baseClassicalAcceleration(model, ws);
+  taskResidual(task, ws);
+  publishNu(task, ws);
+  constraintTorques(model, task, ws, sw.nu_columns.head(m), out.tau_constraint);
+  prescribedTorques(model, task, ws, sw.nu_columns.head(m), out.qdd, fs.tau_effective, out.tau_constraint);
+  controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
+  const double mu_dot_qdd = frictionStates(model, out.qdd, acc_tolerance, fs, fr);
+  for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader
+    fr.state[static_cast<std::size_t>(entryOfJoint(model, j))] =
+        fr.state[static_cast<std::size_t>(entryOfJoint(model, model.joint(j).mimic.leader))];
+  // g(μ*) = Z₀(q̈*) + μ*ᵀ W q̈* = Z with the joint torques τ − kinetic − Wᵀμ (eq. 5.7).
+  fr.gauss_dual = gaussFunction(model, task, out.qdd, fs.tau_joint, ws);
+  out.gauss = fr.gauss_dual - mu_dot_qdd;
+}
+
+// ---- Warm start: the last solve's pattern held (src/friction/stick_pattern.cpp). What only the full solve
+// computes: no iterations, no ∂q̈/∂μ (zeroed once after a full solve wrote it).
+void publishWarmSolution(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& tau,
+                         double acc_tolerance, Workspace& ws, FrictionScratch& fs, FrictionResult& fr) {
+  publishSolution(model, task, tau, acc_tolerance, ws, fs, fr);
+  fr.iterations = 0;
+  fr.converged = true;
+  fr.indeterminate = false;
+  fr.kkt_residual = 0.0;  // q̈ = 0 on the locked DOFs by construction, μ inside the boxes, the slips' signs checked
+  if (fs.sensitivities_written) fr.dqdd_dmu.setZero();
+  fs.sensitivities_written = false;
+}
+
 // ---- Joint position limits: a stop the task pushes into makes g unbounded.
 Status limitInfeasible(const Model& model, const QpReport& report, const std::vector<int>& stuck,
                        const FrictionScratch& fs) {
@@ -437,18 +474,24 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   bindTaskModes(task, sw);  // the sweeps read the DOF modes from here
   if (Status s = checkOptions(model, options); !s) return s;
   if (Status s = checkFrictionResultSizes(model, ws.friction); !s) return s;
-  const int m = task.solverColumns();
   FrictionScratch& fs = (*sw.friction_scratch);
   FrictionResult& fr = ws.friction;
   Solution& out = ws.solution;
 
   jointsOutsideLimits(model, q, out);  // a warning: solved as given
   stuckSetAndKineticFriction(model, task, q, qd, tau, options, fs, fr);
+  double acc_tolerance = 0.0;  // what counts as q̈_j = 0 (a sticking joint): set by the path that runs
+  fr.warm_started = options.warm_start && solveLastPattern(model, task, q, qd, fr, ws, fs, acc_tolerance);
+  if (fr.warm_started) {
+    publishWarmSolution(model, task, tau, acc_tolerance, ws, fs, fr);
+    return {};
+  }
   const auto stuck_count = static_cast<Eigen::Index>(fr.stuck.size());
   if (Status s = sweepsWithSensitivities(model, task, q, qd, fr.stuck, ws, fs); !s) return s;
   if (stuck_count < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
   for (Eigen::Index a = 0; a < stuck_count; ++a)         // μ_j enters as the torque −μ_j
     fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);
+  fs.sensitivities_written = stuck_count > 0;
   const int base_velocity_size = model.baseVelocitySize();
 
   // The acceleration scale, of the stuck joints only (a light, fast joint
@@ -456,7 +499,7 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   double acc_max = 0.0;
   for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(fs.qdd0[base_velocity_size + j]));
   const double acc_scale = 1.0 + acc_max;
-  const double acc_tolerance = 1e-9 * acc_scale;  // what counts as q̈_j = 0 (a sticking joint)
+  acc_tolerance = 1e-9 * acc_scale;
   const QpReport report = maximiseDual(model, task, ws, fr.stuck, options, acc_scale, fs);
   fr.iterations = report.iterations;
   fr.converged = stuck_count == 0 || report.converged;
@@ -480,24 +523,12 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   }
 
   motionAtMaximiser(model, task, stuck_count, ws, fs);
-  ws.kinematics.stage = KinematicsStage::Accelerations;  // those of q̈* (the sweep's were q̈(0)'s)
-  out.base_acceleration_world = baseClassicalAcceleration(model, ws);
-  taskResidual(task, ws);
-  publishNu(task, ws);
-  constraintTorques(model, task, ws, sw.nu_columns.head(m), out.tau_constraint);
-  prescribedTorques(model, task, ws, sw.nu_columns.head(m), out.qdd, fs.tau_effective, out.tau_constraint);
-  controlTorques(model, tau, out);  // the leaders carry their mimic joints' torques
-  const double mu_dot_qdd = frictionStates(model, out.qdd, acc_tolerance, fs, fr);
-  for (const int j : model.mimicJoints())  // it moves, sticks or slips with its leader
-    fr.state[static_cast<std::size_t>(entryOfJoint(model, j))] =
-        fr.state[static_cast<std::size_t>(entryOfJoint(model, model.joint(j).mimic.leader))];
-  // g(μ*) = Z₀(q̈*) + μ*ᵀ W q̈* = Z with the joint torques τ − kinetic − Wᵀμ (eq. 5.7).
-  fr.gauss_dual = gaussFunction(model, task, out.qdd, fs.tau_joint, ws);
-  out.gauss = fr.gauss_dual - mu_dot_qdd;
+  publishSolution(model, task, tau, acc_tolerance, ws, fs, fr);
   fr.kkt_residual =
       stuck_count > 0 ? boxQpKktResidual(fs.K.topLeftCorner(stuck_count, stuck_count), fs.qdd0_stuck.head(stuck_count),
                                          fs.lo.head(stuck_count), fs.hi.head(stuck_count), fs.mu.head(stuck_count))
                       : 0.0;
+  rememberPattern(model, task, fr, !report.unbounded && fr.converged && !fr.indeterminate && stuck_count > 0, fs);
   if (report.unbounded) return limitInfeasible(model, report, fr.stuck, fs);
   return {};
 }

@@ -39,6 +39,12 @@ struct FrictionScratch {
         tau_joint(nv) {
     is_mimic.assign(static_cast<std::size_t>(dof), 0);
     stuck_dofs.reserve(static_cast<std::size_t>(dof));
+    pattern_stuck.reserve(static_cast<std::size_t>(dof));
+    pattern_state.reserve(static_cast<std::size_t>(dof));
+    pattern_modes.assign(static_cast<std::size_t>(nv), DofMode::Torque);
+    pattern_qdd.setZero(nv);
+    pattern_tau.setZero(nv);
+    pattern_residual.setZero(nv);
   }
 
   // The model of friction, per joint (the options' overrides, else the model's)
@@ -70,6 +76,17 @@ struct FrictionScratch {
   Eigen::VectorXd tau_constraint_first;  // τ_c at that maximiser
   Eigen::VectorXd tau_control_first;     // τ + τ_c there, mimic joints' carried by their leaders
   MaximiserChoiceScratch choice;
+
+  // The last solve's stick pattern, tried first with FrictionOptions::warm_start (src/friction/stick_pattern.cpp)
+  const Model* pattern_model = nullptr;  // what it was found for: nullptr when there is none to try
+  const Task* pattern_task = nullptr;
+  std::vector<int> pattern_stuck;         // Θ₀ then
+  std::vector<JointState> pattern_state;  // per stuck index: Stick, SlipPositive, SlipNegative or AtLimit
+  std::vector<DofMode> pattern_modes;     // nv: the task's modes with the sticking DOFs locked
+  Eigen::VectorXd pattern_qdd;            // nv: the task's prescribed accelerations, 0 on the locked DOFs
+  Eigen::VectorXd pattern_tau;            // nv: τ_effective with the slipping DOFs' friction bound applied
+  Eigen::VectorXd pattern_residual;       // nv: λ of the locked DOFs (prescribedDofResiduals)
+  bool sensitivities_written = false;     // FrictionResult::dqdd_dmu holds columns of the last full solve
 
   // Outputs
   Eigen::VectorXd tau_joint;  // τ − kinetic − μ*: what the joints feel (the Gauss function's torques)

@@ -308,6 +308,31 @@ TEST_CASE("a task with more rows than the workspace had: the first solve makes r
   CHECK(small.constraintCapacity() == 8);
 }
 
+TEST_CASE("the friction solve's warm start allocates nothing (the full solve, then the pattern held)") {
+  const Model model = panda();
+  Task task(model);
+  task.addConstraint("tool0", ConstraintMatrix::Identity(6, 2), Expressed::World);
+  Workspace ws(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(7, 0.3);
+  Eigen::VectorXd qd(7), tau = Eigen::VectorXd::Constant(7, 0.5);
+  qd << 0.2, 0.3, -0.1, 0.4, 0.0, 0.0, 0.0;  // 3 stuck joints and 2 rows: μ* unique, the pattern kept
+  FrictionOptions options;
+  options.breakaway = Eigen::VectorXd::Constant(7, 50.0);
+  options.warm_start = true;
+  bool ok = true;
+  int warm = 0;
+  const long count = allocationsDuring([&] {
+    for (int k = 0; k < 4; ++k) {
+      tau[2] += 0.01;  // the next cycle
+      ok = solveWithFriction(model, ws, q, qd, tau, task, options).ok() && ok;
+      warm += ws.friction.warm_started ? 1 : 0;
+    }
+  });
+  CHECK(ok);
+  CHECK(warm == 3);  // all but the first
+  CHECK(count == 0);
+}
+
 TEST_CASE("every error return of every entry point allocates nothing and throws nothing") {
   const Model model = panda(), other = zwang::testing::oneDofArmModel();
   Task task(model);

@@ -1,0 +1,198 @@
+// Warm start (FrictionOptions::warm_start, issue #28): the last solve's stick/slip pattern tried first, one pass of
+// the sweeps with the sticking DOFs locked. Against the brute-force enumeration of every stick/slip pattern on the
+// dense reference (support/friction_reference: no recursive algorithm), on random trees of every joint type with up
+// to 5 stuck DOFs, 0–3 task rows (relative ones and contacts among them) and prescribed DOFs: the first call (the
+// full solve, which keeps its pattern), the same call again (the pattern holds: the warm path answers) and the next
+// cycle of a control loop (τ moved a little) must each give the reference's q̈*, g(μ*) and, where μ* is unique, μ*
+// and τ_control. Also: a pattern is not tried for another task or a changed stuck set, and ∂q̈/∂μ is zero after a
+// warm answer.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "support/floating_reference.hpp"
+#include "support/friction_reference.hpp"
+#include "support/joint_types_problem.hpp"
+#include "support/random_chain.hpp"
+#include "support/random_problem.hpp"
+#include "zwang/zwang.hpp"
+
+using namespace zwang;
+using namespace zwang::testing;
+
+namespace {
+
+struct Errors {
+  double qdd = 0, g = 0, mu = 0, tau_control = 0;
+};
+
+// One solve against the reference: q̈* and g(μ*) always, μ* and τ_control where μ* is unique. True when compared
+// with μ* unique.
+bool compareWithReference(const Workspace& ws, const FrictionReference& ref, const FrictionSetup& setup, Errors& e) {
+  const FrictionResult& fr = ws.friction;
+  const double eq = relativeError(ws.solution.qdd, ref.qdd);
+  const double eg = std::abs(fr.gauss_dual - ref.gauss_dual) / std::max(1.0, std::abs(ref.gauss_dual));
+  CHECK(eq < 1e-8);  // both sides solve the same motion; rounding of condition ≤ 1e6 systems
+  CHECK(eg < 1e-8);
+  e.qdd = std::max(e.qdd, eq);
+  e.g = std::max(e.g, eg);
+  const bool mu_unique = ref.mu_spread <= 1e-9 * (1.0 + setup.breakaway.maxCoeff()) && !ref.pinned;
+  if (!mu_unique) return false;
+  const double em = (fr.mu - ref.mu).cwiseAbs().maxCoeff() / (1.0 + setup.breakaway.maxCoeff());
+  const double et = relativeError(ws.solution.tau_control, ref.tau_control);
+  CHECK(em < 1e-8);
+  CHECK(et < 1e-8);
+  e.mu = std::max(e.mu, em);
+  e.tau_control = std::max(e.tau_control, et);
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("warm start: the last pattern gives the brute-force answer, in a loop of nearby states",
+          "[warm_start][friction]") {
+  std::mt19937_64 rng(stressSeedOr(2026112810ULL));
+  int compared = 0, draws = 0, warm_same = 0, warm_next = 0, unique = 0, prescribed_draws = 0;
+  Errors first, same, next;
+  while (compared < 250) {
+    REQUIRE(++draws < 5000);
+    const ChainSpec spec = randomJointTypesTree(rng, 2, 5, 0.4);
+    const int n = spec.dof();
+    if (n > 11) continue;  // the enumeration is 3^stuck
+    const FloatingBase base = randomBase(rng);
+    RandomProblemOptions options = rowOptions(std::min(3, n), 0.2);
+    options.max_constraint_frames = 2;
+    FloatingInput in = loadedInput(rng, spec, base, options);
+    makeContact(rng, base, in);
+    const int base_velocity_size = base.baseVelocitySize();
+    const Model model = floatingModelFromSpec(spec, base);
+    Task task = floatingTaskFromInput(model, in);
+    FrictionSetup setup = sizedFrictionSetup(n);
+    moveEveryDof(rng, base_velocity_size, n, in);
+    for (int k = 0; k < n; ++k) {
+      setup.breakaway(k) = uniform(rng, 0.0, 15.0);
+      setup.kinetic(k) = uniform(rng, 0.0, setup.breakaway(k));
+      setup.viscous(k) = uniform(rng, 0.0, 1.0);
+      if (static_cast<int>(setup.stuck.size()) < 5 && uniform01(rng) < 0.5) {
+        in.v(base_velocity_size + k) = 0.0;
+        setup.stuck.push_back(k);
+      }
+    }
+    if (setup.stuck.empty()) continue;
+    // The first moving DOF prescribed in a third of the draws (a row q̈ = y in the reference; no friction unknown).
+    bool has_prescribed = false;
+    if (model.mimicJoints().empty() && uniform01(rng) < 0.3)
+      for (int k = 0; k < n && !has_prescribed; ++k)
+        if (in.v(base_velocity_size + k) != 0.0) {
+          const double y = uniform(rng, -2.0, 2.0);
+          task.setDofMode(base_velocity_size + k, DofMode::Prescribed);
+          task.prescribedAccelerations()[base_velocity_size + k] = y;
+          ConstraintInput c;
+          c.joint = k;
+          c.A = Matrix6Xd::Zero(6, 1);
+          c.b = Eigen::VectorXd::Constant(1, y);
+          in.constraints.push_back(c);
+          has_prescribed = true;
+        }
+    FrictionOptions fo;
+    fo.joint_limits = false;  // multi-DOF joints have none; the one-DOF ones are drawn inside theirs
+    fo.breakaway = setup.breakaway;
+    fo.kinetic = setup.kinetic;
+    fo.viscous = setup.viscous;
+    fo.warm_start = true;
+
+    const FloatingResult dense = floatingDynamics(spec, base, in);
+    if (!wellPosed(dense)) continue;
+    const FrictionReference ref = bruteForceFloatingFriction(spec, base, in, setup);
+    if (!ref.feasible || ref.qdd_spread > 1e-9) continue;  // the reference itself cannot tell q̈* apart
+    // The next cycle: τ moved by up to 1 % of the friction box on each DOF (the pattern mostly stays).
+    FloatingInput moved = in;
+    for (int k = 0; k < n; ++k)
+      moved.tau(base_velocity_size + k) += 0.01 * uniform(rng, -1.0, 1.0) * setup.breakaway(k);
+    const FloatingResult dense_moved = floatingDynamics(spec, base, moved);
+    if (!wellPosed(dense_moved)) continue;
+    const FrictionReference ref_moved = bruteForceFloatingFriction(spec, base, moved, setup);
+    if (!ref_moved.feasible || ref_moved.qdd_spread > 1e-9) continue;
+
+    Workspace ws(model, task);
+    INFO("draw " << draws << " (" << toString(base.kind) << " base, " << n << " DOFs, " << setup.stuck.size()
+                 << " stuck, " << task.constraintRows() << " rows)");
+    REQUIRE(solveWithFriction(model, ws, in.q, in.v, in.tau, task, fo));
+    CHECK_FALSE(ws.friction.warm_started);  // nothing kept yet: the full solve
+    ++compared;
+    prescribed_draws += has_prescribed ? 1 : 0;
+    unique += compareWithReference(ws, ref, setup, first) ? 1 : 0;
+    REQUIRE(solveWithFriction(model, ws, in.q, in.v, in.tau, task, fo));
+    if (ws.friction.warm_started) {
+      ++warm_same;
+      CHECK(ws.friction.dqdd_dmu.isZero(0.0));  // not computed: zeroed
+    }
+    compareWithReference(ws, ref, setup, same);
+    REQUIRE(solveWithFriction(model, ws, moved.q, moved.v, moved.tau, task, fo));
+    warm_next += ws.friction.warm_started ? 1 : 0;
+    compareWithReference(ws, ref_moved, setup, next);
+  }
+  std::printf(
+      "warm start vs brute force: %d problems (%d draws, %d with a prescribed DOF), mu* unique in %d\n"
+      "  the same call again answered warm in %d, the next cycle (tau moved) in %d\n"
+      "  max rel. error qdd %.2e / %.2e / %.2e, g %.2e / %.2e / %.2e, mu %.2e / %.2e / %.2e, tau_control %.2e / "
+      "%.2e / %.2e (first / again / next)\n",
+      compared, draws, prescribed_draws, unique, warm_same, warm_next, first.qdd, same.qdd, next.qdd, first.g, same.g,
+      next.g, first.mu, same.mu, next.mu, first.tau_control, same.tau_control, next.tau_control);
+  CHECK(warm_same > compared / 2);  // the determinate ones: most of the draws
+  CHECK(warm_next > compared / 3);
+  CHECK(prescribed_draws > 20);
+}
+
+TEST_CASE("warm start: not for another task, a changed stuck set or without the option", "[warm_start][friction]") {
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  const Task task(model), other(model);
+  Workspace ws(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(model.nq(), 0.3), rest = Eigen::VectorXd::Zero(model.nv());
+  const Eigen::VectorXd tau = Eigen::VectorXd::Constant(model.nv(), 0.5);
+  FrictionOptions fo;
+  fo.breakaway = Eigen::VectorXd::Constant(model.dof(), 100.0);  // every joint holds
+  fo.warm_start = true;
+  REQUIRE(solveWithFriction(model, ws, q, rest, tau, task, fo));
+  CHECK_FALSE(ws.friction.warm_started);
+  CHECK_FALSE(ws.friction.dqdd_dmu.isZero(0.0));  // the full solve computes it
+  REQUIRE(solveWithFriction(model, ws, q, rest, tau, task, fo));
+  CHECK(ws.friction.warm_started);
+  CHECK(ws.solution.qdd.isZero(0.0));  // every joint locked: exactly at rest
+  CHECK(ws.friction.dqdd_dmu.isZero(0.0));
+  REQUIRE(solveWithFriction(model, ws, q, rest, tau, other, fo));
+  CHECK_FALSE(ws.friction.warm_started);  // another task object
+  Eigen::VectorXd one_moving = rest;
+  one_moving[3] = 0.5;
+  REQUIRE(solveWithFriction(model, ws, q, one_moving, tau, other, fo));
+  CHECK_FALSE(ws.friction.warm_started);  // another stuck set
+  fo.warm_start = false;
+  REQUIRE(solveWithFriction(model, ws, q, one_moving, tau, other, fo));
+  CHECK_FALSE(ws.friction.warm_started);
+}
+
+TEST_CASE("warm start: when μ* is not unique the full solve chooses, every time", "[warm_start][friction]") {
+  // The Panda holding its flange still (6 rows) with every joint stuck: 13 conditions on 7 joints, so friction and
+  // the task's forces trade (statically indeterminate); the least-effort choice is the full solve's.
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  Task task(model);
+  task.addConstraint("panda_link8", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  Workspace warm(model, task), cold(model, task);
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(model.nq(), -0.4, 0.6), rest = Eigen::VectorXd::Zero(model.nv());
+  const Eigen::VectorXd tau = Eigen::VectorXd::LinSpaced(model.nv(), -3.0, 4.0);
+  FrictionOptions fo;
+  fo.breakaway = Eigen::VectorXd::Constant(model.dof(), 2.0);
+  REQUIRE(solveWithFriction(model, cold, q, rest, tau, task, fo));
+  REQUIRE(cold.friction.indeterminate);
+  fo.warm_start = true;
+  for (int call = 0; call < 3; ++call) {
+    REQUIRE(solveWithFriction(model, warm, q, rest, tau, task, fo));
+    CHECK_FALSE(warm.friction.warm_started);
+    CHECK(warm.solution.qdd == cold.solution.qdd);  // the same path, the same arithmetic
+    CHECK(warm.friction.mu == cold.friction.mu);
+    CHECK(warm.solution.tau_control == cold.solution.tau_control);
+  }
+}

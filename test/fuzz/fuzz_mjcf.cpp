@@ -27,6 +27,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -41,18 +42,25 @@ using namespace zwang;
 // ---------------------------------------------------------------------------
 // The generator
 
-// Numbers as MJCF text: mostly ordinary (in [lo, hi]), else the awkward ones.
+// Per document: 0, every number ordinary; else one number in `awkward_one_in` is an awkward one (most documents
+// should compile, so that zwang's reading and the solves are reached).
+int awkward_one_in = 0;
+
+// A number as MJCF text: ordinary (uniform in [lo, hi]), or zero, any double, or not a number at all.
 std::string number(FuzzedDataProvider& in, double lo, double hi) {
   static const char* const kSpecial[] = {"0",      "-0",   "1",   "-1",   "1e-300", "1e300", "-1e300",  "1e400",
                                          "-1e400", "nan",  "NaN", "-nan", "inf",    "-inf",  "1e-12",   "-1e-12",
                                          "1e12",   "1e15", "",    "x",    "1e",     "0x10",  "4.9e-324"};
   char text[32];
-  switch (in.ConsumeIntegralInRange(0, 11)) {
-    case 0: return kSpecial[in.ConsumeIntegralInRange<std::size_t>(0, std::size(kSpecial) - 1)];
-    case 1: std::snprintf(text, sizeof text, "%.17g", in.ConsumeFloatingPoint<double>()); return text;
-    case 2: return "0";
-    default: std::snprintf(text, sizeof text, "%.6g", in.ConsumeFloatingPointInRange(lo, hi)); return text;
+  if (awkward_one_in > 0 && in.ConsumeIntegralInRange(1, awkward_one_in) == 1) {
+    switch (in.ConsumeIntegralInRange(0, 2)) {
+      case 0: return kSpecial[in.ConsumeIntegralInRange<std::size_t>(0, std::size(kSpecial) - 1)];
+      case 1: std::snprintf(text, sizeof text, "%.17g", in.ConsumeFloatingPoint<double>()); return text;
+      default: return "0";
+    }
   }
+  std::snprintf(text, sizeof text, "%.6g", in.ConsumeFloatingPointInRange(lo, hi));
+  return text;
 }
 
 std::string numbers(FuzzedDataProvider& in, int count, double lo, double hi) {
@@ -72,7 +80,9 @@ const char* pick(FuzzedDataProvider& in, const char* const (&options)[N]) {
 std::string orientation(FuzzedDataProvider& in) {
   switch (in.ConsumeIntegralInRange(0, 7)) {
     case 0: return attr("quat", numbers(in, 4, -1.0, 1.0));
-    case 1: return attr("quat", pick(in, {"0 0 0 0", "1e-200 0 0 0", "-1 0 0 0", "1 1 1 1", "0 0 0 1"}));
+    case 1:
+      if (awkward_one_in == 0) return "";
+      return attr("quat", pick(in, {"0 0 0 0", "1e-200 0 0 0", "1e-200 1e-200 0 0", "-1 0 0 0", "1 1 1 1"}));
     case 2: return attr("euler", numbers(in, 3, -360.0, 360.0));
     case 3: return attr("axisangle", numbers(in, 4, -2.0, 2.0));
     case 4: return attr("xyaxes", numbers(in, 6, -1.0, 1.0));
@@ -100,8 +110,12 @@ struct Generator {
     if (type[0]) xml += attr("type", type);
     if (in.ConsumeBool()) xml += attr("pos", numbers(in, 3, -1.0, 1.0));
     if (in.ConsumeBool()) xml += attr("axis", numbers(in, 3, -1.0, 1.0));
-    if (in.ConsumeBool()) xml += attr("range", numbers(in, 2, -180.0, 180.0));
-    if (in.ConsumeBool()) xml += attr("limited", pick(in, {"true", "false", "auto", "1", "maybe"}));
+    // MuJoCo refuses a ball joint's range (but (0, r)), a range without `limited` and `limited` without a range
+    const bool range = in.ConsumeBool() && (std::string(type) != "ball" || awkward_one_in > 0);
+    if (range) xml += attr("range", number(in, -180.0, -0.01) + " " + number(in, 0.01, 180.0));
+    if (range || (awkward_one_in > 0 && in.ConsumeProbability<double>() < 0.1))
+      xml += attr("limited", in.ConsumeProbability<double>() < 0.97 ? pick(in, {"true", "false"})
+                                                                    : pick(in, {"auto", "1", "maybe"}));
     if (in.ConsumeProbability<double>() < 0.2) xml += attr("ref", number(in, -90.0, 90.0));
     if (in.ConsumeProbability<double>() < 0.3) xml += attr("armature", number(in, 0.0, 1.0));
     if (in.ConsumeProbability<double>() < 0.3) xml += attr("frictionloss", number(in, 0.0, 10.0));
@@ -110,23 +124,35 @@ struct Generator {
     xml += "/>";
   }
 
+  // Principal moments (a, b, c) that meet MuJoCo's triangle inequality: each is the sum of two of three second moments.
+  std::string moments() {
+    const double s1 = in.ConsumeFloatingPointInRange(0.01, 1.0), s2 = in.ConsumeFloatingPointInRange(0.01, 1.0),
+                 s3 = in.ConsumeFloatingPointInRange(0.01, 1.0);
+    char text[96];
+    std::snprintf(text, sizeof text, "%.6g %.6g %.6g", s2 + s3, s1 + s3, s1 + s2);
+    return text;
+  }
+
   void mass() {
     const int kind = in.ConsumeIntegralInRange(0, 9);
     if (kind <= 5) {
-      xml += "<inertial" + attr("pos", numbers(in, 3, -1.0, 1.0)) + attr("mass", number(in, 0.0, 10.0));
-      if (in.ConsumeBool())
-        xml += attr("diaginertia", numbers(in, 3, 0.0, 1.0));
-      else
-        xml += attr("fullinertia", numbers(in, 6, -1.0, 1.0));
-      xml += orientation(in) + "/>";
+      xml += "<inertial" + attr("pos", numbers(in, 3, -1.0, 1.0)) + attr("mass", number(in, 0.01, 10.0));
+      if (in.ConsumeBool())  // MuJoCo takes an orientation with diaginertia only
+        xml += attr("diaginertia", awkward_one_in > 0 && in.ConsumeBool() ? numbers(in, 3, 0.0, 1.0) : moments()) +
+               orientation(in);
+      else  // diagonal dominant: positive definite, within the triangle inequality
+        xml += attr("fullinertia", numbers(in, 3, 1.0, 1.3) + " " + numbers(in, 3, -0.1, 0.1));
+      xml += "/>";
     } else if (kind <= 8) {
-      static const char* const kShapes[] = {"sphere", "box", "capsule", "cylinder", "ellipsoid", "plane"};
-      xml += "<geom" + attr("type", pick(in, kShapes));
-      if (in.ConsumeBool())
-        xml += attr("size", numbers(in, in.ConsumeIntegralInRange(1, 3), 0.0, 1.0));
-      else
-        xml += attr("fromto", numbers(in, 6, -1.0, 1.0)) + attr("size", number(in, 0.0, 0.5));
-      if (in.ConsumeBool()) xml += attr(in.ConsumeBool() ? "mass" : "density", number(in, 0.0, 1000.0));
+      static const char* const kShapes[] = {"sphere", "box", "capsule", "cylinder", "ellipsoid"};
+      if (in.ConsumeBool()) {
+        xml += "<geom" + attr("type", pick(in, kShapes)) +
+               attr("size", numbers(in, in.ConsumeIntegralInRange(1, 3), 0.01, 1.0));
+      } else {
+        xml += "<geom" + attr("type", pick(in, {"capsule", "cylinder"})) + attr("fromto", numbers(in, 6, -1.0, 1.0)) +
+               attr("size", number(in, 0.01, 0.5));
+      }
+      if (in.ConsumeBool()) xml += attr(in.ConsumeBool() ? "mass" : "density", number(in, 0.01, 1000.0));
       xml += "/>";
     }  // else no mass at all
   }
@@ -138,11 +164,12 @@ struct Generator {
     if (in.ConsumeBool()) xml += attr("pos", numbers(in, 3, -1.0, 1.0));
     xml += orientation(in) + ">";
     const int count = in.ConsumeIntegralInRange(0, 9);
-    const int joint_count = count == 0 ? 0 : count <= 6 ? 1 : count - 5;  // 0–4 joints, mostly one
+    const int joint_count = count <= 6 ? 1 : count - 6;  // 0–3 joints, mostly one (one when the bytes run out)
     for (int k = 0; k < joint_count; ++k) joint(world_child);
     mass();
     for (int k = 0; k < 3 && in.remaining_bytes() > 0 && in.ConsumeProbability<double>() < 0.2; ++k) {
-      xml += "<site" + attr("name", in.ConsumeBool() ? "s" + std::to_string(sites++) : "b" + std::to_string(id));
+      xml += "<site" + attr("name", in.ConsumeProbability<double>() < 0.9 ? "s" + std::to_string(sites++)
+                                                                          : "b" + std::to_string(id));
       xml += attr("pos", numbers(in, 3, -1.0, 1.0)) + orientation(in) + "/>";
     }
     while (bodies < 8 && depth < 6 && in.remaining_bytes() > 0 && in.ConsumeProbability<double>() < 0.6)
@@ -156,8 +183,10 @@ struct Generator {
     for (int e = in.ConsumeIntegralInRange(1, 3); e > 0; --e) {
       const int kind = in.ConsumeIntegralInRange(0, 9);
       if (kind <= 7) {
-        xml += "<joint" + attr("joint1", jointName(in.ConsumeIntegralInRange(0, joints - 1)));
-        if (kind <= 6) xml += attr("joint2", jointName(in.ConsumeIntegralInRange(0, joints - 1)));
+        const int first = in.ConsumeIntegralInRange(0, joints - 1);
+        xml += "<joint" + attr("joint1", jointName(first));
+        if (kind <= 6 && joints > 1)  // another joint (MuJoCo refuses a joint equal to itself)
+          xml += attr("joint2", jointName((first + in.ConsumeIntegralInRange(1, joints - 1)) % joints));
         if (in.ConsumeBool()) {
           const bool degree1 = in.ConsumeBool();
           xml += attr("polycoef", numbers(in, 2, -2.0, 2.0) + (degree1 ? " 0 0 0" : " " + numbers(in, 3, -1.0, 1.0)));
@@ -175,6 +204,8 @@ struct Generator {
   }
 
   std::string document() {
+    static const int kAwkward[] = {0, 0, 0, 4, 16, 64};
+    awkward_one_in = kAwkward[in.ConsumeIntegralInRange<std::size_t>(0, std::size(kAwkward) - 1)];
     xml = "<mujoco model=\"fuzz\"><compiler";
     if (in.ConsumeBool()) xml += attr("angle", pick(in, {"degree", "radian"}));
     if (in.ConsumeBool()) xml += attr("inertiafromgeom", pick(in, {"false", "true", "auto"}));
@@ -303,14 +334,20 @@ void solve(const MjcfModel& loaded, std::uint64_t seed) {
 }
 
 // Loads `xml`; a loaded model is checked and solved. Strict mode must refuse exactly the models with warnings.
+// ZWANG_FUZZ_VERBOSE set: each document and what became of it on stderr (to see what the generator reaches).
 void loadAndCheck(const std::string& xml, std::uint64_t seed) {
+  static const bool verbose = std::getenv("ZWANG_FUZZ_VERBOSE") != nullptr;
+  if (verbose) std::fprintf(stderr, "document: %s\n", xml.c_str());
   MjcfModel loaded;
   try {
     loaded = readMjcfString(xml);
   } catch (const ModelError& e) {
+    if (verbose) std::fprintf(stderr, "refused: %s\n", e.what());
     if (e.what()[0] == '\0') fuzz::failure("ModelError without a message", "readMjcfString");
     return;
   }
+  if (verbose)
+    std::fprintf(stderr, "loaded: %d DOFs, %zu warnings\n", loaded.model.dof(), loaded.model.warnings().size());
   checkLoaded(loaded);
   bool strict_loaded = true;
   try {

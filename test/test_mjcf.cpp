@@ -777,3 +777,20 @@ TEST_CASE("MJCF: a free body alone loads and falls, with friction too", "[mjcf]"
   REQUIRE(solveWithFriction(model, ws, q, zero, zero, task).ok());
   CHECK(ws.solution.qdd.norm() == Approx(9.81));
 }
+
+// A finite but absurd coefficient (fuzz_mjcf: damping 8e307 made solveWithFriction's b·q̇ overflow and return Ok with
+// q̈ = −inf): the builder refuses rotor inertia and friction above validate::kMaxJointCoefficient, naming the joint.
+TEST_CASE("MJCF: a joint's damping, frictionloss or armature above 1e12 is refused", "[mjcf]") {
+  for (const char* attribute : {"damping", "frictionloss", "armature"}) {
+    const std::string xml = std::string("<mujoco><worldbody><body name=\"b1\"><joint name=\"j0\" type=\"slide\" ") +
+                            attribute +
+                            "=\"8.1771766090407624e+307\"/><inertial pos=\"1 1 1\" mass=\"10\" diaginertia=\"1 1 1\"/>"
+                            "</body></worldbody></mujoco>";
+    CHECK_THROWS_WITH(loadMjcfString(xml),
+                      Catch::StartsWith("<string>: joint 'j0': ") &&
+                          Catch::Contains("8.17718e+307 is above 1e+12, the largest zwang accepts"));
+  }
+  const std::string fine = R"(<mujoco><worldbody><body name="b1"><joint name="j0" type="slide" damping="1e12"/>
+      <inertial pos="1 1 1" mass="10" diaginertia="1 1 1"/></body></worldbody></mujoco>)";
+  CHECK(loadMjcfString(fine).joint(0).viscous_friction == 1e12);
+}

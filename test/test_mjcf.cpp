@@ -726,3 +726,71 @@ TEST_CASE("MJCF: bad inputs are refused with the source and the reason", "[mjcf]
   CHECK_THROWS_WITH(loadMjcfString(actuated, MjcfOptions{true}),
                     Catch::StartsWith("<string>: refused in strict mode (2 warnings): tendons 't'"));
 }
+
+// Numbers MuJoCo 2.2.2 compiles as written but zwang cannot read (fuzz_mjcf's inputs): a ModelError naming the object.
+TEST_CASE("MJCF: degenerate quaternions and a non-finite gravity are refused with the object", "[mjcf]") {
+  const std::string inertial = R"(<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>)";
+  const auto body = [&](const std::string& attributes, const std::string& inside) {
+    return "<mujoco><worldbody><body name=\"b\" " + attributes + "><joint name=\"j\"/>" + inside +
+           "</body></worldbody></mujoco>";
+  };
+  CHECK_THROWS_WITH(loadMjcfString(body("quat=\"0 0 0 0\"", inertial)),
+                    Catch::Equals("<string>: body 'b': its orientation: the quaternion (0, 0, 0, 0) is zero or not "
+                                  "finite"));
+  CHECK_THROWS_WITH(loadMjcfString(body("quat=\"1e-200 1e-200 0 0\"", inertial)),
+                    Catch::StartsWith("<string>: body 'b': its orientation: the quaternion (1e-200, 1e-200, 0, 0)"));
+  CHECK_THROWS_WITH(loadMjcfString(body("quat=\"nan 0 0 0\"", inertial)),
+                    Catch::StartsWith("<string>: body 'b': its orientation: the quaternion (nan,"));
+  CHECK_THROWS_WITH(loadMjcfString(body("", R"(<inertial pos="0 0 0" quat="0 0 0 0" mass="1" diaginertia="1 1 1"/>)")),
+                    Catch::StartsWith("<string>: body 'b': its inertia's orientation: the quaternion (0, 0, 0, 0)"));
+  CHECK_THROWS_WITH(loadMjcfString(body("", inertial + R"(<site name="s" quat="0 0 0 0"/>)")),
+                    Catch::StartsWith("<string>: site 's': its orientation: the quaternion (0, 0, 0, 0)"));
+  CHECK_THROWS_WITH(loadMjcfString("<mujoco><option gravity=\"nan 0 inf\"/><worldbody><body><joint/>" + inertial +
+                                   "</body></worldbody></mujoco>"),
+                    Catch::Equals("<string>: <option gravity> (nan, 0, inf) is not finite"));
+  // Disabled, the gravity is not read: zero.
+  CHECK(readMjcfString("<mujoco><option gravity=\"nan 0 0\"><flag gravity=\"disable\"/></option><worldbody><body>"
+                       "<joint/>" +
+                       inertial + "</body></worldbody></mujoco>")
+            .gravity == Vec3::Zero());
+  // A NaN axis: the model builder's refusal, naming the joint.
+  CHECK_THROWS_WITH(loadMjcfString("<mujoco><worldbody><body><joint name=\"j\" axis=\"nan 0 1\"/>" + inertial +
+                                   "</body></worldbody></mujoco>"),
+                    Catch::Contains("joint 'j'") && Catch::Contains("axis"));
+}
+
+// A floating base without joints (fuzz_mjcf: solveWithFriction offset a null pointer, the empty ∂q̈/∂μ's data()).
+TEST_CASE("MJCF: a free body alone loads and falls, with friction too", "[mjcf]") {
+  const MjcfModel loaded = readMjcfString(R"(<mujoco><worldbody><body name="b"><joint type="free"/>
+      <inertial pos="-1 -1 -1" mass="0.01" fullinertia="1 1 1 -0.1 -0.1 -0.1"/></body></worldbody></mujoco>)");
+  const Model& model = loaded.model;
+  REQUIRE(model.dof() == 0);
+  REQUIRE(model.nv() == 6);
+  Task task(model);
+  task.gravity = loaded.gravity;
+  Workspace ws(model, task);
+  Eigen::VectorXd q(model.nq());
+  REQUIRE(neutralConfiguration(model, q).ok());
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+  REQUIRE(solveHybridDynamics(model, ws, q, zero, zero, task).ok());
+  CHECK(ws.solution.qdd.norm() == Approx(9.81));  // at rest, every point falls with g: no rotation
+  REQUIRE(solveWithFriction(model, ws, q, zero, zero, task).ok());
+  CHECK(ws.solution.qdd.norm() == Approx(9.81));
+}
+
+// A finite but absurd coefficient (fuzz_mjcf: damping 8e307 made solveWithFriction's b·q̇ overflow and return Ok with
+// q̈ = −inf): the builder refuses rotor inertia and friction above validate::kMaxJointCoefficient, naming the joint.
+TEST_CASE("MJCF: a joint's damping, frictionloss or armature above 1e12 is refused", "[mjcf]") {
+  for (const char* attribute : {"damping", "frictionloss", "armature"}) {
+    const std::string xml = std::string("<mujoco><worldbody><body name=\"b1\"><joint name=\"j0\" type=\"slide\" ") +
+                            attribute +
+                            "=\"8.1771766090407624e+307\"/><inertial pos=\"1 1 1\" mass=\"10\" diaginertia=\"1 1 1\"/>"
+                            "</body></worldbody></mujoco>";
+    CHECK_THROWS_WITH(loadMjcfString(xml),
+                      Catch::StartsWith("<string>: joint 'j0': ") &&
+                          Catch::Contains("8.17718e+307 is above 1e+12, the largest zwang accepts"));
+  }
+  const std::string fine = R"(<mujoco><worldbody><body name="b1"><joint name="j0" type="slide" damping="1e12"/>
+      <inertial pos="1 1 1" mass="10" diaginertia="1 1 1"/></body></worldbody></mujoco>)";
+  CHECK(loadMjcfString(fine).joint(0).viscous_friction == 1e12);
+}

@@ -254,7 +254,7 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
   auto K = fs.K.topLeftCorner(stuck_count, stuck_count);
   for (Eigen::Index a = 0; a < stuck_count; ++a)
     fs.qdd0_stuck[a] = fs.qdd0[base_velocity_size + stuck[static_cast<std::size_t>(a)]];
-  {  // K_ΘΘ = rows Θ of −∂q̈/∂μ, column by column (raw gathers, a pair per store)
+  if (stuck_count > 0) {  // K_ΘΘ = rows Θ of −∂q̈/∂μ (raw gathers); none stuck: dqdd may be empty, data() null
     const int* rows = stuck.data();
     const double* dqdd = fs.dqdd.data() + base_velocity_size;
     const Eigen::Index dqdd_stride = fs.dqdd.outerStride();

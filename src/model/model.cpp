@@ -262,6 +262,9 @@ ModelBuilder& ModelBuilder::addJoint(const Joint& joint_in, const std::string& c
   for (const auto& p : non_negative) {
     if (!std::isfinite(p.value)) throw ModelError(where + ": " + p.field + " is not finite");
     if (p.value < 0.0) throw ModelError(where + ": " + p.field + " " + std::to_string(p.value) + " is negative");
+    if (p.value > validate::kMaxJointCoefficient)
+      throw ModelError(where + ": " + p.field + " " + number(p.value) + " is above " +
+                       number(validate::kMaxJointCoefficient) + ", the largest zwang accepts (a typo?)");
   }
   if (std::isnan(joint.lower) || std::isnan(joint.upper)) throw ModelError(where + ": limit is NaN");
   if (joint.lower > joint.upper) throw ModelError(where + ": lower limit exceeds upper limit");
@@ -333,6 +336,9 @@ Joint& ModelBuilder::jointNamed(const std::string& name) {
 ModelBuilder& ModelBuilder::setRotorInertia(const std::string& joint, double value) {
   if (!std::isfinite(value) || value < 0.0)
     throw ModelError("joint '" + joint + "': rotor inertia must be finite and non-negative");
+  if (value > validate::kMaxJointCoefficient)
+    throw ModelError("joint '" + joint + "': rotor inertia " + number(value) + " is above " +
+                     number(validate::kMaxJointCoefficient) + ", the largest zwang accepts (a typo?)");
   jointNamed(joint).rotor_inertia = value;
   return *this;
 }
@@ -342,6 +348,10 @@ ModelBuilder& ModelBuilder::setFriction(const std::string& joint, double breakaw
     if (!std::isfinite(v) || v < 0.0)
       throw ModelError("joint '" + joint +
                        "': breakaway, kinetic and viscous friction must be finite and non-negative");
+  for (double v : {breakaway, kinetic, viscous})
+    if (v > validate::kMaxJointCoefficient)
+      throw ModelError("joint '" + joint + "': friction " + number(v) + " is above " +
+                       number(validate::kMaxJointCoefficient) + ", the largest zwang accepts (a typo?)");
   Joint& j = jointNamed(joint);
   j.breakaway_friction = breakaway;
   j.kinetic_friction = kinetic;

@@ -10,6 +10,8 @@ namespace zwang::validate {
 // The heaviest link and the largest moment of inertia zwang accepts [kg, kg·m²].
 constexpr double kMaxMass = 1e12;
 constexpr double kMaxMoment = 1e12;  // the largest moment of inertia [kg·m²]
+// The largest rotor inertia, friction and viscous friction: beyond it a solve's products (b·q̇) leave double's range.
+constexpr double kMaxJointCoefficient = 1e12;
 
 // Throws `ModelError("<where>: <what>")` when the inertia cannot be a body's:
 // negative or non-finite mass, a mass above kMaxMass, non-finite or huge

@@ -153,6 +153,15 @@ struct Loading {
   void unmapped(const std::string& message) { warnings.push_back({WarningCode::Unmapped, message}); }
 };
 
+// A compiled quaternion rotation() can use: MuJoCo keeps a zero or non-finite one as written (and its kinematics
+// turns one below mjMINVAL into the identity, which Eigen's normalisation would not).
+void requireQuaternion(const Loading& L, const mjtNum* quat, const std::string& what) {
+  const Eigen::Map<const Eigen::Vector4d> q(quat);
+  if (!q.allFinite() || q.norm() < mjMINVAL)
+    L.report.fail(what + ": the quaternion (" + fmt(q[0]) + ", " + fmt(q[1]) + ", " + fmt(q[2]) + ", " + fmt(q[3]) +
+                  ") is zero or not finite");
+}
+
 RigidInertia bodyInertia(const mjModel* m, int b) {
   const Mat3 R = rotation(m->body_iquat + 4 * b);
   const Mat3 I = R * vec3(m->body_inertia + 3 * b).asDiagonal() * R.transpose();
@@ -243,6 +252,8 @@ void addBody(Loading& L, ModelBuilder& builder, int b) {
   const std::string parent = L.frame_of_body[static_cast<std::size_t>(m->body_parentid[b])];
   if (parent.empty())
     L.report.fail("body '" + name + "' hangs from the world of a floating-base model: zwang's world is no frame then");
+  requireQuaternion(L, m->body_quat + 4 * b, "body '" + name + "': its orientation");
+  requireQuaternion(L, m->body_iquat + 4 * b, "body '" + name + "': its inertia's orientation");
   const Transform X_body = Transform::fromPose(rotation(m->body_quat + 4 * b), vec3(m->body_pos + 3 * b));
   const RigidInertia inertia = bodyInertia(m, b);
   const int count = m->body_jntnum[b];
@@ -285,6 +296,8 @@ void addFloatingBase(Loading& L, ModelBuilder& builder) {
                  "unactuated and frictionless)");
       break;
     }
+  requireQuaternion(L, m->body_iquat + 4 * b,
+                    "body '" + objectName(m, mjOBJ_BODY, b, "body") + "': its inertia's orientation");
   try {
     builder.setBase(BaseType::Free);
     builder.addBaseLinkInertia(bodyInertia(m, b));
@@ -301,6 +314,7 @@ void addSites(Loading& L, ModelBuilder& builder) {
   for (int s = 0; s < m->nsite; ++s) {
     const std::string name = objectName(m, mjOBJ_SITE, s, "site");
     const std::string& body = L.frame_of_body[static_cast<std::size_t>(m->site_bodyid[s])];
+    requireQuaternion(L, m->site_quat + 4 * s, "site '" + name + "': its orientation");
     const Transform X = Transform::fromPose(rotation(m->site_quat + 4 * s), vec3(m->site_pos + 3 * s));
     if (body.empty() || mj_name2id(m, mjOBJ_BODY, name.c_str()) >= 0) {
       skipped.push_back(name);
@@ -396,6 +410,9 @@ MjcfModel build(const Reporter& report, const mjModel* m, const std::vector<std:
                 const MjcfOptions& options) {
   Loading L = settings(m, report);
   if (m->nv == 0) report.fail("the model has no joint: nothing moves");
+  if (!(m->opt.disableflags & mjDSBL_GRAVITY) && !vec3(m->opt.gravity).allFinite())
+    report.fail("<option gravity> (" + fmt(m->opt.gravity[0]) + ", " + fmt(m->opt.gravity[1]) + ", " +
+                fmt(m->opt.gravity[2]) + ") is not finite");
   const std::string world = objectName(m, mjOBJ_BODY, 0, "body");
   const std::string model_name = m->names[0] ? std::string(m->names) : "robot";  // <mujoco model> is names' first
   ModelBuilder builder(model_name, L.base_body < 0 ? world : objectName(m, mjOBJ_BODY, L.base_body, "body"));

@@ -72,6 +72,7 @@ bool sweepPattern(const Model& model, const Task& task, const Eigen::Ref<const E
 // The box QP's optimality conditions at the pattern's motion, strictly: μ* into fs.mu when they hold.
 bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::VectorXd& qdd, FrictionScratch& fs,
                   double& acc_tolerance) {
+  if (!qdd.allFinite()) return false;  // an overflow is the full solve's to report
   const int base_velocity_size = model.baseVelocitySize();
   double acc_max = 0.0;
   for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(qdd[base_velocity_size + j]));

@@ -536,6 +536,16 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
     checkQuaternionVerdict(model, q, status.code, where);
     if (status.ok() || status.code == StatusCode::Infeasible) checkFriction(ws, options, where);
   }
+  // Warm start: the call again from the pattern the last one kept (the pattern's pass when it holds).
+  options.warm_start = true;
+  for (int call = 0; call < 2; ++call) {
+    status = solveWithFriction(model, ws, q, qd, tau, task, options);
+    if (!documented(status.code)) fuzz::failure("undocumented status", "solveWithFriction (warm start)");
+    if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "solveWithFriction (warm start)");
+    if (status.ok() || status.code == StatusCode::Infeasible)
+      checkFriction(ws, options, "solveWithFriction (warm start)");
+  }
+  options.warm_start = false;
 
   if (finite_inputs) {
     status = inverseDynamics(model, ws, q, qd, tau, task);

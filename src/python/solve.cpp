@@ -484,10 +484,11 @@ void bindFriction(py::module_& m) {
   py::class_<Friction>(m, "Friction",
                        "Options of the friction-aware solve (zwang::FrictionOptions). margin: when mu* is not\n"
                        "unique, the effort-minimising choice uses at most margin*f_j. breakaway/kinetic/viscous:\n"
-                       "optional per-joint overrides of the model's values.")
+                       "optional per-joint overrides of the model's values. warm_start: try the workspace's last\n"
+                       "stick/slip pattern first (a control loop; docs/friction.md 'Warm start').")
       .def(py::init([](double margin, double velocity_tolerance, double limit_tolerance, bool joint_limits,
                        const std::string& method, int max_iterations, double kkt_tolerance, py::handle breakaway,
-                       py::handle kinetic, py::handle viscous) {
+                       py::handle kinetic, py::handle viscous, bool warm_start) {
              Friction f;
              f.options.margin = margin;
              f.options.velocity_tolerance = velocity_tolerance;
@@ -505,13 +506,14 @@ void bindFriction(py::module_& m) {
              f.options.breakaway = optionalOverride("breakaway", breakaway);
              f.options.kinetic = optionalOverride("kinetic", kinetic);
              f.options.viscous = optionalOverride("viscous", viscous);
+             f.options.warm_start = warm_start;
              checked("", [&] { problem::checkFriction(f.options); });
              return f;
            }),
            py::kw_only(), py::arg("margin") = 1.0, py::arg("velocity_tolerance") = 1e-6,
            py::arg("limit_tolerance") = 1e-9, py::arg("joint_limits") = true, py::arg("method") = "active_set",
            py::arg("max_iterations") = 500, py::arg("kkt_tolerance") = 1e-12, py::arg("breakaway") = py::none(),
-           py::arg("kinetic") = py::none(), py::arg("viscous") = py::none())
+           py::arg("kinetic") = py::none(), py::arg("viscous") = py::none(), py::arg("warm_start") = false)
       .def_property_readonly("margin", [](const Friction& f) { return f.options.margin; })
       .def_property_readonly("velocity_tolerance", [](const Friction& f) { return f.options.velocity_tolerance; })
       .def_property_readonly("limit_tolerance", [](const Friction& f) { return f.options.limit_tolerance; })
@@ -526,6 +528,7 @@ void bindFriction(py::module_& m) {
       .def_property_readonly("breakaway", [](const Friction& f) { return overrideArray(f.options.breakaway); })
       .def_property_readonly("kinetic", [](const Friction& f) { return overrideArray(f.options.kinetic); })
       .def_property_readonly("viscous", [](const Friction& f) { return overrideArray(f.options.viscous); })
+      .def_property_readonly("warm_start", [](const Friction& f) { return f.options.warm_start; })
       .def("__repr__", [](const Friction& f) {
         return "<zwang.Friction margin=" + std::string(py::str(py::float_(f.options.margin))) + ">";
       });
@@ -705,6 +708,8 @@ void addFrictionProperties(py::class_<Result>& cls) {
                              [](const Result& r) { return r.with_friction ? r.friction().kkt_residual : 0.0; })
       .def_property_readonly("indeterminate",
                              [](const Result& r) { return r.with_friction && r.friction().indeterminate; })
+      .def_property_readonly("warm_started",
+                             [](const Result& r) { return r.with_friction && r.friction().warm_started; })
       .def_property_readonly("limit_impact",
                              [](const Result& r) { return r.with_friction && r.friction().limit_impact; })
       .def_property_readonly(

@@ -1,5 +1,6 @@
 // Shared by the libFuzzer targets: a finite-output check that aborts with a
-// message naming the output (libFuzzer then saves the input as a crash).
+// message naming the output (libFuzzer then saves the input as a crash), and
+// the statuses a solve may return.
 #pragma once
 
 #include <cmath>
@@ -7,6 +8,8 @@
 #include <cstdlib>
 
 #include <Eigen/Core>
+
+#include "zwang/status.hpp"
 
 namespace zwang::fuzz {
 
@@ -31,6 +34,24 @@ inline void requireFinite(double x, const char* what, const char* context) {
     std::fprintf(stderr, "zwang fuzz failure: %s = %g after %s\n", what, x, context);
     std::abort();
   }
+}
+
+// The codes docs/errors.md lists for a solve (NotComputed is a query's: no solve returns it).
+inline bool documented(StatusCode code) {
+  switch (code) {
+    case StatusCode::Ok:
+    case StatusCode::SizeMismatch:
+    case StatusCode::NonFinite:
+    case StatusCode::WorkspaceTooSmall:
+    case StatusCode::ModelMismatch:
+    case StatusCode::Degenerate:
+    case StatusCode::BadOption:
+    case StatusCode::Infeasible:
+    case StatusCode::MimicMismatch:
+    case StatusCode::BadConfiguration: return true;
+    case StatusCode::NotComputed: return false;
+  }
+  return false;
 }
 
 }  // namespace zwang::fuzz

@@ -246,23 +246,6 @@ struct Generator {
 // ---------------------------------------------------------------------------
 // The checks
 
-bool documented(StatusCode code) {
-  switch (code) {
-    case StatusCode::Ok:
-    case StatusCode::SizeMismatch:
-    case StatusCode::NonFinite:
-    case StatusCode::WorkspaceTooSmall:
-    case StatusCode::ModelMismatch:
-    case StatusCode::Degenerate:
-    case StatusCode::BadOption:
-    case StatusCode::Infeasible:
-    case StatusCode::MimicMismatch:
-    case StatusCode::BadConfiguration: return true;
-    case StatusCode::NotComputed: return false;  // a query's code: no solve returns it
-  }
-  return false;
-}
-
 void requireFiniteTransform(const Transform& X, const char* what) {
   fuzz::requireFinite(X.E, what, "readMjcfString");
   fuzz::requireFinite(X.r, what, "readMjcfString");
@@ -299,7 +282,7 @@ void checkSolution(const Workspace& ws, const char* where) {
 }
 
 void checkStatus(const Status& status, const Workspace& ws, const char* where) {
-  if (!documented(status.code)) fuzz::failure("undocumented status", where);
+  if (!fuzz::documented(status.code)) fuzz::failure("undocumented status", where);
   if (status.code == StatusCode::NonFinite) fuzz::failure("NonFinite for finite inputs", status.message);
   if (status.ok()) checkSolution(ws, where);
 }

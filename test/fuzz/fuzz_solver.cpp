@@ -187,23 +187,6 @@ void checkFriction(const Workspace& ws, const FrictionOptions& options, const ch
     fuzz::failure("maximiser iterations outside [0, max_iterations]", where);
 }
 
-bool documented(StatusCode code) {
-  switch (code) {
-    case StatusCode::Ok:
-    case StatusCode::SizeMismatch:
-    case StatusCode::NonFinite:
-    case StatusCode::WorkspaceTooSmall:
-    case StatusCode::ModelMismatch:
-    case StatusCode::Degenerate:
-    case StatusCode::BadOption:
-    case StatusCode::Infeasible:
-    case StatusCode::MimicMismatch:
-    case StatusCode::BadConfiguration: return true;
-    case StatusCode::NotComputed: return false;  // a query's code: no solve returns it
-  }
-  return false;
-}
-
 // Every quaternion of the state (a spherical or free joint's, the root's
 // included) against docs/conventions.md ("Joint types"): any one off unit
 // length by more than kQuaternionNormTolerance ⇒ BadConfiguration; all within
@@ -509,7 +492,7 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
                const Eigen::VectorXd& tau, FrictionOptions& options, Workspace& ws) {
   const bool finite_inputs = q.allFinite() && qd.allFinite() && tau.allFinite();
   Status status = solveHybridDynamics(model, ws, q, qd, tau, task);
-  if (!documented(status.code)) fuzz::failure("undocumented status", "solveHybridDynamics");
+  if (!fuzz::documented(status.code)) fuzz::failure("undocumented status", "solveHybridDynamics");
   if (finite_inputs && status.code == StatusCode::NonFinite)
     fuzz::failure("NonFinite for finite inputs", status.message);
   if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "solveHybridDynamics");
@@ -522,7 +505,7 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
   if ((task.constraintRows() > 0) != (status.code == StatusCode::BadOption))
     fuzz::failure("forwardDynamics: BadOption exactly for a task with rows", status.message);
   status = forwardDynamics(model, ws, q, qd, tau);
-  if (!documented(status.code)) fuzz::failure("undocumented status", "forwardDynamics");
+  if (!fuzz::documented(status.code)) fuzz::failure("undocumented status", "forwardDynamics");
   if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "forwardDynamics");
   if (status.ok()) checkSolution(ws, "forwardDynamics");
 
@@ -531,7 +514,7 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
     const char* where = method == FrictionMethod::ActiveSet ? "solveWithFriction (active set)"
                                                             : "solveWithFriction (projected gradient)";
     status = solveWithFriction(model, ws, q, qd, tau, task, options);
-    if (!documented(status.code)) fuzz::failure("undocumented status", where);
+    if (!fuzz::documented(status.code)) fuzz::failure("undocumented status", where);
     if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", where);
     checkQuaternionVerdict(model, q, status.code, where);
     if (status.ok() || status.code == StatusCode::Infeasible) checkFriction(ws, options, where);
@@ -540,7 +523,7 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
   options.warm_start = true;
   for (int call = 0; call < 2; ++call) {
     status = solveWithFriction(model, ws, q, qd, tau, task, options);
-    if (!documented(status.code)) fuzz::failure("undocumented status", "solveWithFriction (warm start)");
+    if (!fuzz::documented(status.code)) fuzz::failure("undocumented status", "solveWithFriction (warm start)");
     if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "solveWithFriction (warm start)");
     if (status.ok() || status.code == StatusCode::Infeasible)
       checkFriction(ws, options, "solveWithFriction (warm start)");
@@ -551,7 +534,7 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
     status = inverseDynamics(model, ws, q, qd, tau, task);
     if (status.ok())
       fuzz::requireFinite(ws.tau, "tau (RNEA)", "inverseDynamics");
-    else if (!documented(status.code))
+    else if (!fuzz::documented(status.code))
       fuzz::failure("undocumented status", "inverseDynamics");
     status = jointSpaceInertia(model, ws, q);
     if (status.ok()) fuzz::requireFinite(ws.H, "H", "jointSpaceInertia");

@@ -9,10 +9,16 @@
 //   ours_rnea, ours_crba   zwang::inverseDynamics, zwang::jointSpaceInertia
 //   kdl_hd_m{0,1,6}        KDL::ChainHdSolver_Vereshchagin on the same chain (m = 0: one zero column)
 //   kdl_rne                KDL::ChainIdSolver_RNE
-//   fric_{as,pg}_{free,ee6}_k{0,1,2,half,all}
-//                          zwang::solveWithFriction, active set / projected gradient, no constraint /
-//                          the 6-row end-effector task, k = 0, 1, 2, N/2, N stuck joints (q̇_j = 0;
-//                          k = 2 is the grid method's case)
+//   fric_{as,pg,auto,sp}_{free,ee6}_k{0,1,2,half,all}
+//                          zwang::solveWithFriction, active set / projected gradient / the automatic choice /
+//                          the pattern search forced (FrictionMethod), no constraint / the 6-row end-effector
+//                          task, k = 0, 1, 2, N/2, N stuck joints (q̇_j = 0; k = 2 is the grid method's case)
+//   fric_warm_{free,ee6}_kall
+//                          every joint stuck, the pattern kept from the call before (warm_start)
+//   hd_traj/<model>, fric_warm_traj/<model>
+//                          along a trajectory of a 1 kHz loop (makeTrajectory; <model> = panda, N=64,
+//                          humanoid): the plain solve on each state, the friction solve warm-started from the
+//                          state before; worst_warm_traj/panda: 10⁶ of those calls, each timed
 //   grid_{free,ee6}_k{1,2} the report's method: 21 friction values per stuck joint, one full
 //                          solveHybridDynamics per grid point, keep the largest g(μ)
 //   naivepg_{free,ee6}_k{1,2}
@@ -696,30 +702,36 @@ void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int
 // guarantees). Each call is timed on its own with steady_clock (its overhead,
 // some 20 ns, is included); counters give the maximum and the tail.
 
+void setQuantileCounters(benchmark::State& state, std::vector<double>& ns) {
+  std::sort(ns.begin(), ns.end());
+  auto quantile = [&](double q) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * ns.size()))]; };
+  state.counters["calls"] = static_cast<double>(ns.size());
+  state.counters["median_ns"] = quantile(0.5);
+  state.counters["p99_ns"] = quantile(0.99);
+  state.counters["p99.99_ns"] = quantile(0.9999);
+  state.counters["max_ns"] = ns.back();
+}
+
 void benchWorstCase(benchmark::State& state, const Problem* p, TaskKind kind, int calls) {
   const std::vector<int> stuck = stuckSet(p->n, p->n);
   const Eigen::VectorXd qd = stuckVelocities(*p, stuck);
   const Task task = taskFromInput(p->model, makeInput(*p, kind, qd));
   Workspace ws(p->model, task);
+  FrictionOptions options;
+  options.method = FrictionMethod::ActiveSet;
   std::vector<double> ns(static_cast<std::size_t>(calls));
   for (auto _ : state) {
     for (int c = 0; c < calls; ++c) {
       const auto t0 = std::chrono::steady_clock::now();
-      const Status s = solveWithFriction(p->model, ws, p->q, qd, p->tau, task);
+      const Status s = solveWithFriction(p->model, ws, p->q, qd, p->tau, task, options);
       const auto t1 = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(s.code);
       benchmark::DoNotOptimize(ws.solution.qdd.data());
       ns[static_cast<std::size_t>(c)] = std::chrono::duration<double, std::nano>(t1 - t0).count();
     }
   }
-  std::sort(ns.begin(), ns.end());
-  auto quantile = [&](double q) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * ns.size()))]; };
   setCounters(state, *p, task.constraintRows(), p->n);
-  state.counters["calls"] = calls;
-  state.counters["median_ns"] = quantile(0.5);
-  state.counters["p99_ns"] = quantile(0.99);
-  state.counters["p99.99_ns"] = quantile(0.9999);
-  state.counters["max_ns"] = ns.back();
+  setQuantileCounters(state, ns);
 }
 
 // ---------------------------------------------------------------------------
@@ -751,10 +763,11 @@ void benchFloatingHybrid(benchmark::State& state, const Problem* p, bool held) {
   state.counters["rank"] = rank;
 }
 
-void benchFloatingFriction(benchmark::State& state, const Problem* p, bool held) {
+void benchFloatingFriction(benchmark::State& state, const Problem* p, bool held, FrictionMethod method) {
   const Task task = floatingTask(*p, held);
   Workspace ws(p->model, task);
-  const FrictionOptions options;
+  FrictionOptions options;
+  options.method = method;
   if (!firstSolveSucceeded(state, solveWithFriction(p->model, ws, p->q, p->qd, p->tau, task, options))) return;
   // Every joint stuck (q̇ = 0) and staying stuck: what the benchmark is about.
   if (static_cast<int>(ws.friction.stuck.size()) != p->n ||
@@ -767,6 +780,142 @@ void benchFloatingFriction(benchmark::State& state, const Problem* p, bool held)
   setFloatingCounters(state, *p, task.constraintRows(), p->n);
   state.counters["iterations"] = ws.friction.iterations;
   state.counters["indeterminate"] = ws.friction.indeterminate ? 1 : 0;
+}
+
+// ---------------------------------------------------------------------------
+// Along a trajectory (#28): the states a 1 kHz control loop visits, simulated once with the friction solve
+// (semi-implicit Euler; a joint whose velocity crosses zero stops there, as an event would put it), then replayed
+// state by state. The fixed-base arms hold their starting pose with gravity compensation while sinusoidal torques of
+// 1.3 boxes at 0.3–1 Hz make joints break away and stop again: the pattern changes now and then. The humanoid
+// stands on both feet, its motors adding 20 N·m swings to the load friction holds (every joint sticks).
+
+struct Trajectory {
+  explicit Trajectory(const Problem& p) : task(floatingTask(p, !p.feet.empty())) {}
+  Task task;
+  FrictionOptions options;  // the loop's friction: the automatic method, warm-started
+  std::vector<Eigen::VectorXd> q, qd, tau;
+  int stuck_changes = 0, pattern_changes = 0;
+};
+
+constexpr int kTrajectorySteps = 2000;  // 2 s at 1 kHz
+
+std::unique_ptr<Trajectory> makeTrajectory(const Problem& p) {
+  auto t = std::make_unique<Trajectory>(p);
+  const Model& model = p.model;
+  const int n = model.dof(), base_velocity_size = model.baseVelocitySize();
+  const double h = 1e-3;
+  Workspace ws(model, t->task);
+  Eigen::VectorXd hold = Eigen::VectorXd::Zero(model.nv()), amplitude = hold, omega = hold, phase = hold;
+  t->options.warm_start = true;
+  t->options.joint_limits = false;  // the arms drift a little: a limit is not what this measures
+  std::mt19937_64 rng(kSeed);
+  std::uniform_real_distribution<double> frequency(0.3, 1.0), angle(0.0, 2.0 * M_PI);
+  if (p.feet.empty()) {  // hold the pose with gravity compensation; friction a fifth of that load plus 1 N·m
+    if (!inverseDynamics(model, ws, p.q, Eigen::VectorXd::Zero(model.nv()), Eigen::VectorXd::Zero(model.nv()), t->task))
+      throw std::runtime_error(p.label + ": inverse dynamics failed");
+    hold = ws.solution.tau_control;
+    t->options.breakaway = 0.2 * hold.tail(n).cwiseAbs().array() + 1.0;
+    t->options.kinetic = 0.8 * t->options.breakaway;
+    t->options.viscous = Eigen::VectorXd::Constant(n, 0.1);
+    for (int k = 0; k < n; ++k) amplitude[base_velocity_size + k] = 1.3 * t->options.breakaway[k];
+  } else {
+    hold = p.tau;
+    amplitude.tail(n).setConstant(20.0);
+  }
+  for (int k = base_velocity_size; k < model.nv(); ++k) {
+    omega[k] = 2.0 * M_PI * frequency(rng);
+    phase[k] = angle(rng);
+  }
+  Eigen::VectorXd q = p.q, qd = Eigen::VectorXd::Zero(model.nv());
+  std::vector<int> last_stuck;
+  std::vector<JointState> last_state;
+  for (int step = 0; step < kTrajectorySteps; ++step) {
+    const Eigen::VectorXd tau = hold + amplitude.cwiseProduct((omega * (step * h) + phase).array().sin().matrix());
+    t->q.push_back(q);
+    t->qd.push_back(qd);
+    t->tau.push_back(tau);
+    const Status s = solveWithFriction(model, ws, q, qd, tau, t->task, t->options);
+    if (!s) throw std::runtime_error(p.label + " trajectory: " + s.message);
+    if (step > 0) {
+      t->stuck_changes += ws.friction.stuck != last_stuck ? 1 : 0;
+      t->pattern_changes += ws.friction.stuck == last_stuck && ws.friction.state != last_state ? 1 : 0;
+    }
+    last_stuck = ws.friction.stuck;
+    last_state = ws.friction.state;
+    const Eigen::VectorXd qd_before = qd;
+    qd += h * ws.solution.qdd;
+    for (int k = base_velocity_size; k < model.nv(); ++k)
+      if (qd_before[k] * qd[k] < 0.0) qd[k] = 0.0;
+    if (!integrate(model, q, qd, h, q)) throw std::runtime_error(p.label + " trajectory: integrate failed");
+  }
+  return t;
+}
+
+void setTrajectoryCounters(benchmark::State& state, const Problem& p, const Trajectory& t) {
+  state.counters["N"] = p.n;
+  state.counters["m"] = t.task.constraintRows();
+  state.counters["steps"] = kTrajectorySteps;
+  state.counters["stuck_changes"] = t.stuck_changes;
+  state.counters["pattern_changes"] = t.pattern_changes;
+}
+
+void benchTrajectoryHybrid(benchmark::State& state, const Problem* p, const Trajectory* t) {
+  Workspace ws(p->model, t->task);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Status s = solveHybridDynamics(p->model, ws, t->q[i], t->qd[i], t->tau[i], t->task);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+    i = i + 1 == t->q.size() ? 0 : i + 1;
+  }
+  setTrajectoryCounters(state, *p, *t);
+}
+
+// One pass over the trajectory first: how many of its calls the warm start answers.
+double warmShare(const Problem& p, const Trajectory& t, Workspace& ws) {
+  int warm = 0;
+  for (std::size_t i = 0; i < t.q.size(); ++i) {
+    if (!solveWithFriction(p.model, ws, t.q[i], t.qd[i], t.tau[i], t.task, t.options)) return -1.0;
+    warm += ws.friction.warm_started ? 1 : 0;
+  }
+  return static_cast<double>(warm) / static_cast<double>(t.q.size());
+}
+
+void benchTrajectoryFriction(benchmark::State& state, const Problem* p, const Trajectory* t) {
+  Workspace ws(p->model, t->task);
+  const double warm = warmShare(*p, *t, ws);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Status s = solveWithFriction(p->model, ws, t->q[i], t->qd[i], t->tau[i], t->task, t->options);
+    benchmark::DoNotOptimize(s.code);
+    benchmark::DoNotOptimize(ws.solution.qdd.data());
+    benchmark::ClobberMemory();
+    i = i + 1 == t->q.size() ? 0 : i + 1;
+  }
+  setTrajectoryCounters(state, *p, *t);
+  state.counters["warm_share"] = warm;
+}
+
+void benchTrajectoryWorstCase(benchmark::State& state, const Problem* p, const Trajectory* t, int calls) {
+  Workspace ws(p->model, t->task);
+  const double warm = warmShare(*p, *t, ws);
+  std::vector<double> ns(static_cast<std::size_t>(calls));
+  for (auto _ : state) {
+    std::size_t i = 0;
+    for (int c = 0; c < calls; ++c) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const Status s = solveWithFriction(p->model, ws, t->q[i], t->qd[i], t->tau[i], t->task, t->options);
+      const auto t1 = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(s.code);
+      benchmark::DoNotOptimize(ws.solution.qdd.data());
+      ns[static_cast<std::size_t>(c)] = std::chrono::duration<double, std::nano>(t1 - t0).count();
+      i = i + 1 == t->q.size() ? 0 : i + 1;
+    }
+  }
+  setTrajectoryCounters(state, *p, *t);
+  state.counters["warm_share"] = warm;
+  setQuantileCounters(state, ns);
 }
 
 // ---------------------------------------------------------------------------
@@ -969,6 +1118,17 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // The trajectories: made once, before anything is timed.
+  std::vector<std::pair<const Problem*, std::unique_ptr<Trajectory>>> trajectories;
+  try {
+    for (const auto& p : problems)
+      if (p->label == "panda" || p->label == "N=64") trajectories.emplace_back(p.get(), makeTrajectory(*p));
+    trajectories.emplace_back(floating.front().get(), makeTrajectory(*floating.front()));  // the humanoid
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "zwang_bench: %s\n", e.what());
+    return 1;
+  }
+
   std::string checks;
   for (const auto& p : problems) {
     const Check c = checkAgainstKdl(*p);
@@ -993,7 +1153,9 @@ int main(int argc, char** argv) {
       {TaskKind::None, "m0"}, {TaskKind::Ee1, "m1"}, {TaskKind::Ee6, "m6"}, {TaskKind::Split6, "m6x2"}};
   const std::pair<TaskKind, const char*> fric_tasks[] = {{TaskKind::None, "free"}, {TaskKind::Ee6, "ee6"}};
   const std::pair<FrictionMethod, const char*> methods[] = {{FrictionMethod::ActiveSet, "as"},
-                                                            {FrictionMethod::ProjectedGradient, "pg"}};
+                                                            {FrictionMethod::ProjectedGradient, "pg"},
+                                                            {FrictionMethod::Automatic, "auto"},
+                                                            {FrictionMethod::StickPatterns, "sp"}};
 
   for (const auto& [kind, name] : hd_tasks)
     for (const auto& p : problems)
@@ -1074,9 +1236,23 @@ int main(int argc, char** argv) {
     const std::string rows = held ? "m12" : "m0";
     for (const auto& p : floating)
       reg("floating_hd_" + rows, *p, [q = p.get(), held](benchmark::State& s) { benchFloatingHybrid(s, q, held); });
-    for (const auto& p : floating)
-      reg("floating_fric_as_" + rows + "_kall", *p,
-          [q = p.get(), held](benchmark::State& s) { benchFloatingFriction(s, q, held); });
+    for (const auto& [method, method_name] :
+         {std::pair{FrictionMethod::ActiveSet, "as"}, std::pair{FrictionMethod::Automatic, "auto"}})
+      for (const auto& p : floating)
+        reg("floating_fric_" + std::string(method_name) + "_" + rows + "_kall", *p,
+            [q = p.get(), held, method = method](benchmark::State& s) { benchFloatingFriction(s, q, held, method); });
+  }
+
+  // Along the trajectories: the plain solve and the warm-started friction solve on the same states.
+  for (const auto& [p, t] : trajectories) {
+    reg("hd_traj", *p, [p = p, t = t.get()](benchmark::State& s) { benchTrajectoryHybrid(s, p, t); });
+    reg("fric_warm_traj", *p, [p = p, t = t.get()](benchmark::State& s) { benchTrajectoryFriction(s, p, t); });
+    if (p->label == "panda")
+      benchmark::RegisterBenchmark(
+          ("worst_warm_traj/" + p->label).c_str(),
+          [p = p, t = t.get()](benchmark::State& s) { benchTrajectoryWorstCase(s, p, t, 1000000); })
+          ->Iterations(1)
+          ->Unit(benchmark::kMillisecond);
   }
 
   // Worst case over 10⁶ calls, Panda with every joint stuck (plain and 6 rows).

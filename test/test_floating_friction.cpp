@@ -326,6 +326,9 @@ void countDraw(const FloatingFrictionDraw& d, const FrictionReference& ref, Tall
 
 TEST_CASE("floating trees: friction matches the brute-force enumeration of stick/slip patterns",
           "[floating][friction]") {
+  // The automatic choice (the active set for most of these small stuck sets) and the pattern search forced.
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
   std::mt19937_64 rng(15015);
   Tally t;
   while (t.compared < 400) {
@@ -342,6 +345,7 @@ TEST_CASE("floating trees: friction matches the brute-force enumeration of stick
       ++t.ambiguous;
       continue;
     }
+    d.options.method = method;
     const LibraryRun run(d);
     const Model& model = run.model;
     const Task& task = run.task;
@@ -634,14 +638,14 @@ FloatingProblem randomHeldOnLimits(std::mt19937_64& rng) {
 
 // What the held-on-limits cases tally over the draws, per maximiser.
 struct HeldTally {
-  int compared = 0;                   // draws with a maximiser (reference feasible)
-  int infeasible = 0;                 // draws without one (a stop the task really pushes into)
-  int false_infeasible[2] = {0, 0};   // per method: Infeasible where the reference has a maximiser
-  int missed_infeasible[2] = {0, 0};  // per method: not Infeasible where it has none
+  int compared = 0;                      // draws with a maximiser (reference feasible)
+  int infeasible = 0;                    // draws without one (a stop the task really pushes into)
+  int false_infeasible[3] = {0, 0, 0};   // per method: Infeasible where the reference has a maximiser
+  int missed_infeasible[3] = {0, 0, 0};  // per method: not Infeasible where it has none
   double e_qdd = 0.0;
 };
 
-// One held-on-limits problem against brute force, with both maximisers. The
+// One held-on-limits problem against brute force, with both maximisers and the pattern search. The
 // reference is told the limit sides the solver reads from q (a stuck joint
 // within FrictionOptions::limit_tolerance of a limit, or beyond it, rests
 // on it): randomChain's q may put j2 and j3 beyond theirs, where a stop the
@@ -662,14 +666,14 @@ void compareHeldOnLimits(const FloatingProblem& p, HeldTally& t) {
   const Model model = floatingModelFromSpec(p.spec, p.base);
   const Task task = floatingTaskFromInput(model, p.input);
   Workspace ws(model, task);
-  for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
+  const FrictionMethod methods[] = {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient,
+                                    FrictionMethod::StickPatterns};
+  for (int m = 0; m < 3; ++m) {
     FrictionOptions options;
-    options.method = method;
+    options.method = methods[m];
     const Status status = solveWithFriction(model, ws, p.input.q, p.input.v, p.input.tau, task, options);
-    const int m = method == FrictionMethod::ActiveSet ? 0 : 1;
-    INFO((m == 0 ? "active set" : "projected gradient")
-         << ": " << status.message << "; reference pattern " << ref.pattern << ", mu " << ref.mu.transpose()
-         << "; zwang mu " << ws.friction.mu.transpose());
+    INFO(toString(methods[m]) << ": " << status.message << "; reference pattern " << ref.pattern << ", mu "
+                              << ref.mu.transpose() << "; zwang mu " << ws.friction.mu.transpose());
     if (!ref.feasible) {
       t.missed_infeasible[m] += status.code == StatusCode::Infeasible ? 0 : 1;
       continue;
@@ -723,14 +727,16 @@ TEST_CASE("held stuck joints on limits, a scan: Infeasible exactly where brute f
   for (const HeldTally* t : {&all_stuck, &held_only}) {
     std::printf(
         "held stuck joints on limits (%s stuck): %d draws, %d with a maximiser, %d without; false Infeasible: "
-        "active set %d, projected gradient %d; missed Infeasible: %d, %d; max rel. error qdd %.2e\n",
+        "active set %d, projected gradient %d, stick patterns %d; missed Infeasible: %d, %d, %d; max rel. error qdd "
+        "%.2e\n",
         t == &all_stuck ? "all joints" : "only the held joints", draws, t->compared, t->infeasible,
-        t->false_infeasible[0], t->false_infeasible[1], t->missed_infeasible[0], t->missed_infeasible[1], t->e_qdd);
+        t->false_infeasible[0], t->false_infeasible[1], t->false_infeasible[2], t->missed_infeasible[0],
+        t->missed_infeasible[1], t->missed_infeasible[2], t->e_qdd);
     CHECK(t->compared >= 100);
-    CHECK(t->false_infeasible[0] == 0);
-    CHECK(t->false_infeasible[1] == 0);
-    CHECK(t->missed_infeasible[0] == 0);
-    CHECK(t->missed_infeasible[1] == 0);
+    for (int m = 0; m < 3; ++m) {
+      CHECK(t->false_infeasible[m] == 0);
+      CHECK(t->missed_infeasible[m] == 0);
+    }
   }
   CHECK(all_stuck.infeasible > 10);  // the true Infeasible cases (j2 or j3 pushed into a stop) are there, and kept
 }

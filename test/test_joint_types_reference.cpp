@@ -156,6 +156,9 @@ TEST_CASE("joint types: solveHybridDynamics against the dense reference on trees
 
 TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumeration on trees with spherical joints",
           "[joint_types][friction]") {
+  // The automatic choice (the active set for most of these small stuck sets) and the pattern search forced.
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
   std::mt19937_64 rng(stressSeedOr(2025112602ULL));
   Census census;
   int compared = 0, draws = 0, unique = 0, constrained = 0, spherical_stuck = 0, own_friction = 0;
@@ -219,6 +222,7 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
     REQUIRE(model.dof() == n);
     const Task task = floatingTaskFromInput(model, in);
     FrictionOptions fo;
+    fo.method = method;
     fo.joint_limits = false;  // multi-DOF joints have none; the one-DOF ones are drawn inside theirs
     if (!own) {
       fo.breakaway = setup.breakaway;
@@ -312,6 +316,9 @@ TEST_CASE("joint types: friction (a box per DOF) matches the brute-force enumera
 // such joints, against the brute force (q̈ and g(μ*), which are unique).
 TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the brute-force enumeration",
           "[joint_types][friction]") {
+  // The automatic choice (the active set for most of these small stuck sets) and the pattern search forced.
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
   std::mt19937_64 rng(stressSeedOr(2025112701ULL));
   int compared = 0, draws = 0, stuck_in_row_joint = 0;
   double e_qdd = 0, e_g = 0;
@@ -348,6 +355,7 @@ TEST_CASE("joint types: friction with joint rows on multi-DOF joints matches the
     const FrictionReference ref = bruteForceFloatingFriction(spec, base, in, setup);
     if (!ref.feasible || ref.qdd_spread > 1e-9) continue;  // a pinned DOF can leave every pattern or several valid
     FrictionOptions fo;
+    fo.method = method;
     fo.joint_limits = false;
     fo.breakaway = setup.breakaway;
     fo.kinetic = setup.kinetic;

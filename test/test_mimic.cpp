@@ -635,6 +635,9 @@ TEST_CASE("balance report: rows and rank are the task's, not the mimic rows (Bax
 // ===========================================================================
 
 TEST_CASE("mimic trees: friction matches the brute-force enumeration of stick/slip patterns (150+ trees)", "[mimic]") {
+  // The automatic choice (the active set for most of these small stuck sets) and the pattern search forced.
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
   std::mt19937_64 rng(161803);
   RandomMimicOptions mimic_options;
   mimic_options.max_mimics = 2;
@@ -651,7 +654,9 @@ TEST_CASE("mimic trees: friction matches the brute-force enumeration of stick/sl
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
-    const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task);
+    FrictionOptions options;
+    options.method = method;
+    const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task, options);
     INFO("tree " << accepted << " (draw " << attempts << "): " << d.spec.dof() << " joints, "
                  << d.input.constraintRows() << " rows, pattern " << ref.pattern << ": " << statusText(status));
     REQUIRE(status);
@@ -774,6 +779,9 @@ bool limitDraw(std::mt19937_64& rng, LimitDraw& out) {
 }  // namespace
 
 TEST_CASE("mimic trees: friction with per-solve overrides and a stuck leader on its position limit", "[mimic]") {
+  // The automatic choice (the active set for most of these small stuck sets) and the pattern search forced.
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
   // Half the draws override the model's friction per solve (FrictionOptions:
   // the mimic joints' entries fold like the model's); in every draw a stuck
   // leader of a mimic joint rests on one of its limits (a one-sided reaction,
@@ -794,6 +802,7 @@ TEST_CASE("mimic trees: friction with per-solve overrides and a stuck leader on 
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
+    draw.options.method = method;
     const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task, draw.options);
     INFO("tree " << accepted << " (draw " << attempts << "): " << d.spec.dof() << " joints, leader " << draw.limited
                  << " on its " << (draw.side < 0 ? "lower" : "upper") << " limit, pattern " << ref.pattern << ": "
@@ -850,6 +859,9 @@ TEST_CASE("mimic trees: friction with per-solve overrides and a stuck leader on 
 // the joint is zero exactly, here only to rounding, ~1e-14).
 TEST_CASE("friction: a task that drives a stuck leader into its limit through two relative rows is Infeasible",
           "[mimic][friction]") {
+  // The automatic choice (the active set for most of these small stuck sets) and the pattern search forced.
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
   std::mt19937_64 rng(57721);
   LimitDraw draw;
   for (int attempt = 1; attempt <= 164; ++attempt) limitDraw(rng, draw);
@@ -871,6 +883,7 @@ TEST_CASE("friction: a task that drives a stuck leader into its limit through tw
     const Model model = modelFromSpec(d.spec);
     const Task task = taskFromInput(model, d.input);
     Workspace ws(model, task);
+    draw.options.method = method;
     const Status status = solveWithFriction(model, ws, d.input.q, d.input.qd, d.input.tau, task, draw.options);
     INFO((with_mimic ? "with" : "without")
          << " the mimic joint: status " << static_cast<int>(status.code) << " '" << status.message

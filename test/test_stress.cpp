@@ -183,6 +183,7 @@ struct Worst {
   int draws = 0, solves = 0, singular = 0, degenerate = 0, regular_constrained = 0;
   int stuck_joints_max = 0, stuck_hist[9] = {};
   int active_iterations_max = 0, gradient_iterations_max = 0, gradient_not_converged = 0;
+  int pattern_solves = 0, pattern_answers = 0;  // StickPatterns forced; answered without the active set
   int stick = 0, slip = 0;
   int constraint_failures = 0;         // regular tasks beyond kConstraintTolerance
   int singular_residual_failures = 0;  // closure or tau_c beyond tolerance (singular tasks only in the default run)
@@ -307,14 +308,16 @@ void runStress(unsigned long long seed, const std::vector<Draw>& only = {}) {
       const Eigen::VectorXd no_friction = Eigen::VectorXd::Zero(n);
       checkResiduals(residuals(model, task, in, dense, ws.solution, no_friction, scratch), singular, worst);
 
-      // --- static friction, both maximisers
+      // --- static friction, both maximisers and the pattern search
       Eigen::VectorXd qdd_active;
-      for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
+      double scale_active = 0.0;  // the problem's acceleration scale, from the active set's K μ* (the search has no K)
+      for (const FrictionMethod method :
+           {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient, FrictionMethod::StickPatterns}) {
         FrictionOptions options;
         options.method = method;
         options.joint_limits = false;  // limits: test_friction_limits; here q is anywhere
         const bool active = method == FrictionMethod::ActiveSet;
-        INFO((active ? "active set" : "projected gradient"));
+        INFO(toString(method));
         status = solveWithFriction(model, ws, in.q, in.qd, in.tau, task, options);
         ++worst.solves;
         INFO("status: " << status.message);
@@ -332,9 +335,12 @@ void runStress(unsigned long long seed, const std::vector<Draw>& only = {}) {
           CHECK(fr.converged);
           if (!fr.converged) ++worst.active_not_converged;
           worst.stuck_hist[stuck]++;
-        } else {
+        } else if (method == FrictionMethod::ProjectedGradient) {
           worst.gradient_iterations_max = std::max(worst.gradient_iterations_max, fr.iterations);
           if (!fr.converged) ++worst.gradient_not_converged;
+        } else {
+          ++worst.pattern_solves;
+          if (fr.method == FrictionMethod::StickPatterns) ++worst.pattern_answers;
         }
         checkResiduals(residuals(model, task, in, dense, ws.solution, fr.tau_friction, scratch), singular, worst);
 
@@ -380,9 +386,16 @@ void runStress(unsigned long long seed, const std::vector<Draw>& only = {}) {
         }
         if (active) {
           qdd_active = qdd;
+          scale_active = scale;
         } else if (fr.converged) {
-          const double d = ratio(inf(Eigen::VectorXd(qdd - qdd_active)), inf(qdd_active) + scale);
-          const double agreement_tolerance = singular ? kSingularAgreementTolerance : kAgreementTolerance;
+          const double d =
+              ratio(inf(Eigen::VectorXd(qdd - qdd_active)), inf(qdd_active) + std::max(scale, scale_active));
+          // The pattern search's q̈ comes from other sweeps (the sticking joints locked) than q̈(0) − K μ*: where
+          // constraint forces cancel to the q̈ a row holds (seed 17, chain 4: 1e12 rad/s² on 1e-10 kg·m²), each
+          // carries ε of them differently.
+          const bool other_sweeps = fr.method == FrictionMethod::StickPatterns;
+          const double agreement_tolerance =
+              singular || other_sweeps ? kSingularAgreementTolerance : kAgreementTolerance;
           CHECK(d <= agreement_tolerance);
           if (d > agreement_tolerance) ++worst.disagreements;
           worst.agreement = std::max(worst.agreement, d);
@@ -394,15 +407,16 @@ void runStress(unsigned long long seed, const std::vector<Draw>& only = {}) {
       "numerical stress: %d draws on %d chains (%d solves): %d singular tasks, %d regular constrained, %d degenerate\n"
       "  worst relative residuals, regular tasks: closure %.1e (tol %.0e), constraint %.1e (tol %.0e),"
       " tau_c vs G^T nu %.1e (tol %.0e); singular tasks: closure or tau_c %.1e\n"
-      "  friction: max dissipation violation %.1e (tol %.0e, singular tasks %.0e), |mu| beyond f %.1e, active set vs gradient %.1e (tol %.0e, singular tasks %.0e)\n"
+      "  friction: max dissipation violation %.1e (tol %.0e, singular tasks %.0e), |mu| beyond f %.1e, active set vs the others %.1e (tol %.0e, singular tasks %.0e)\n"
       "  maximiser iterations: active set max %d, projected gradient max %d (%d not converged at the cap);"
-      " stuck joints stick %d, slip %d\n"
+      " stuck joints stick %d, slip %d; the pattern search answered %d of %d\n"
       "  draws per stuck-set size 0..7:",
       worst.draws, chains, worst.solves, worst.singular, worst.regular_constrained, worst.degenerate, worst.closure,
       kClosureTolerance, worst.constraint, kConstraintTolerance, worst.tau_c, kTauConstraintTolerance,
       worst.closure_singular, worst.dissipation, kDissipationTolerance, kSingularDissipationTolerance,
       worst.feasibility, worst.agreement, kAgreementTolerance, kSingularAgreementTolerance, worst.active_iterations_max,
-      worst.gradient_iterations_max, worst.gradient_not_converged, worst.stick, worst.slip);
+      worst.gradient_iterations_max, worst.gradient_not_converged, worst.stick, worst.slip, worst.pattern_answers,
+      worst.pattern_solves);
   for (int k = 0; k <= 7; ++k) std::printf(" %d", worst.stuck_hist[k]);
   std::printf(
       "\n  beyond tolerance: %d solves of singular tasks miss closure or tau_c = G^T nu (asserted);"

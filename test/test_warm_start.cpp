@@ -147,28 +147,41 @@ TEST_CASE("warm start: the last pattern gives the brute-force answer, in a loop 
   CHECK(prescribed_draws > 20);
 }
 
-TEST_CASE("warm start: not for another task, a changed stuck set or without the option", "[warm_start][friction]") {
+TEST_CASE("warm start: from the kept pattern of the same task, across a change of the stuck set; not another task's",
+          "[warm_start][friction]") {
   const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
   const Task task(model), other(model);
-  Workspace ws(model, task);
+  Workspace ws(model, task), reference(model, task);
   const Eigen::VectorXd q = Eigen::VectorXd::Constant(model.nq(), 0.3), rest = Eigen::VectorXd::Zero(model.nv());
   const Eigen::VectorXd tau = Eigen::VectorXd::Constant(model.nv(), 0.5);
   FrictionOptions fo;
   fo.breakaway = Eigen::VectorXd::Constant(model.dof(), 100.0);  // every joint holds
   fo.warm_start = true;
   REQUIRE(solveWithFriction(model, ws, q, rest, tau, task, fo));
-  CHECK_FALSE(ws.friction.warm_started);
-  CHECK_FALSE(ws.friction.dqdd_dmu.isZero(0.0));  // the full solve computes it
+  CHECK_FALSE(ws.friction.warm_started);  // nothing kept yet, and 7 stuck DOFs are too few to search from sticking
+  CHECK(ws.friction.method == FrictionMethod::ActiveSet);
+  CHECK_FALSE(ws.friction.dqdd_dmu.isZero(0.0));  // the K-based solve computes it
   REQUIRE(solveWithFriction(model, ws, q, rest, tau, task, fo));
   CHECK(ws.friction.warm_started);
+  CHECK(ws.friction.method == FrictionMethod::StickPatterns);
+  CHECK(ws.friction.iterations == 1);  // the kept pattern holds: one pass
   CHECK(ws.solution.qdd.isZero(0.0));  // every joint locked: exactly at rest
   CHECK(ws.friction.dqdd_dmu.isZero(0.0));
   REQUIRE(solveWithFriction(model, ws, q, rest, tau, other, fo));
   CHECK_FALSE(ws.friction.warm_started);  // another task object
+  // Another stuck set, the same task: the kept pattern mapped onto it (joint 3 moving, the others sticking).
   Eigen::VectorXd one_moving = rest;
   one_moving[3] = 0.5;
   REQUIRE(solveWithFriction(model, ws, q, one_moving, tau, other, fo));
-  CHECK_FALSE(ws.friction.warm_started);  // another stuck set
+  CHECK(ws.friction.warm_started);
+  FrictionOptions active_set = fo;
+  active_set.method = FrictionMethod::ActiveSet;
+  active_set.warm_start = false;
+  REQUIRE(solveWithFriction(model, reference, q, one_moving, tau, other, active_set));
+  CHECK(reference.friction.method == FrictionMethod::ActiveSet);
+  CHECK_FALSE(reference.friction.dqdd_dmu.isZero(0.0));                   // the K-based solve computes it
+  CHECK(relativeError(ws.solution.qdd, reference.solution.qdd) < 1e-12);  // rounding of one solve
+  CHECK((ws.friction.mu - reference.friction.mu).cwiseAbs().maxCoeff() < 1e-10);
   fo.warm_start = false;
   REQUIRE(solveWithFriction(model, ws, q, one_moving, tau, other, fo));
   CHECK_FALSE(ws.friction.warm_started);
@@ -195,4 +208,128 @@ TEST_CASE("warm start: when μ* is not unique the full solve chooses, every time
     CHECK(warm.friction.mu == cold.friction.mu);
     CHECK(warm.solution.tau_control == cold.solution.tau_control);
   }
+}
+
+namespace {
+
+// What the trajectories below went through, and how far the warm answers were from the cold ones.
+struct TrajectoryTally {
+  int steps = 0, solved = 0, infeasible = 0, indeterminate = 0, with_stuck = 0, warm = 0, by_patterns = 0;
+  int stuck_set_changes = 0, pattern_changes = 0, limit_stops = 0, stale = 0;
+  double qdd = 0, mu = 0, tau_control = 0;
+};
+
+// The next state of a crude 1 kHz-like loop (semi-implicit Euler): a DOF whose velocity crosses zero stops there
+// (it is stuck at the next solve), a one-DOF joint that passes a limit stops on it.
+void stepState(const Model& model, const Eigen::VectorXd& qdd, double h, Eigen::VectorXd& q, Eigen::VectorXd& v,
+               TrajectoryTally& t) {
+  const Eigen::VectorXd v_before = v;
+  v += h * qdd;
+  for (int k = model.baseVelocitySize(); k < model.nv(); ++k)
+    if (v_before[k] * v[k] < 0.0) v[k] = 0.0;
+  REQUIRE(integrate(model, q, v, h, q));
+  for (int k = model.baseVelocitySize(); k < model.nv(); ++k) {
+    const Dof& dof = model.dofs()[static_cast<std::size_t>(k)];
+    const int at = model.joint(dof.joint).q_index;
+    if (model.joint(dof.joint).nv() != 1 || !(q[at] < dof.lower || q[at] > dof.upper)) continue;
+    q[at] = std::clamp(q[at], dof.lower, dof.upper);
+    v[k] = 0.0;
+    ++t.limit_stops;
+  }
+}
+
+}  // namespace
+
+TEST_CASE(
+    "warm start along trajectories: the cold solve's answer at every step, through pattern changes, limit "
+    "stops and a stale workspace",
+    "[warm_start][friction]") {
+  std::mt19937_64 rng(stressSeedOr(2026112811ULL));
+  TrajectoryTally t;
+  constexpr int kTrajectories = 40, kSteps = 150;
+  constexpr double h = 2e-3;  // s: 0.3 s per trajectory, long enough for joints to break away and stop again
+  for (int trajectory = 0; trajectory < kTrajectories; ++trajectory) {
+    auto [spec, base, in, model] = drawLoadedTree(rng, 3, 8, 0.3, rowOptions(2, 0.2));
+    const Task task = floatingTaskFromInput(model, in), other(model);
+    const int n = model.dof(), base_velocity_size = model.baseVelocitySize();
+    FrictionOptions warm_options;
+    warm_options.breakaway.resize(n);
+    for (int k = 0; k < n; ++k) warm_options.breakaway[k] = uniform(rng, 0.0, 8.0);
+    warm_options.kinetic = 0.6 * warm_options.breakaway;
+    warm_options.viscous = Eigen::VectorXd::Constant(n, 0.1);
+    warm_options.warm_start = true;
+    FrictionOptions cold_options = warm_options;
+    cold_options.warm_start = false;
+    cold_options.method = FrictionMethod::ActiveSet;
+    // τ swings by 1.5 boxes about the drawn load at 2–6 Hz: the joints stick, break away and stop again.
+    const Eigen::VectorXd tau0 = in.tau;
+    Eigen::VectorXd amplitude = Eigen::VectorXd::Zero(model.nv()), omega = amplitude, phase = amplitude;
+    for (int k = 0; k < n; ++k) {
+      amplitude[base_velocity_size + k] = 1.5 * warm_options.breakaway[k] + 0.5;
+      omega[base_velocity_size + k] = 2.0 * M_PI * uniform(rng, 2.0, 6.0);
+      phase[base_velocity_size + k] = uniform(rng, 0.0, 2.0 * M_PI);
+    }
+    Eigen::VectorXd q = in.q, v = in.v, tau = tau0;
+    v.tail(n).setZero();  // at rest: every joint DOF stuck
+    Workspace warm(model, task), cold(model, task);
+    std::vector<JointState> last_state;
+    std::vector<int> last_stuck;
+    for (int step = 0; step < kSteps; ++step) {
+      const double time = step * h;
+      tau = tau0 + amplitude.cwiseProduct((omega * time + phase).array().sin().matrix());
+      if (step % 50 == 25) {  // the workspace is used for another task in between: its pattern is not this task's
+        const Status so = solveWithFriction(model, warm, q, v, tau, other, warm_options);
+        CHECK((so.ok() || so.code == StatusCode::Infeasible));
+        ++t.stale;
+      }
+      INFO("trajectory " << trajectory << " (" << toString(base.kind) << " base, " << n << " DOFs, "
+                         << task.constraintRows() << " rows), step " << step);
+      const Status sw = solveWithFriction(model, warm, q, v, tau, task, warm_options);
+      const Status sc = solveWithFriction(model, cold, q, v, tau, task, cold_options);
+      INFO("warm: " << sw.message << "; cold: " << sc.message);
+      ++t.steps;
+      REQUIRE(sw.code == sc.code);
+      if (!sc) {
+        t.infeasible += sc.code == StatusCode::Infeasible ? 1 : 0;
+        break;  // a stop the task pushes into: this trajectory ends
+      }
+      ++t.solved;
+      const FrictionResult& fw = warm.friction;
+      const FrictionResult& fc = cold.friction;
+      t.with_stuck += fw.stuck.empty() ? 0 : 1;
+      t.warm += fw.warm_started ? 1 : 0;
+      t.by_patterns += fw.method == FrictionMethod::StickPatterns ? 1 : 0;
+      const double eq = relativeError(warm.solution.qdd, cold.solution.qdd);
+      CHECK(eq < 1e-9);  // rounding of two solves of the same problem, condition ≤ 1e6
+      t.qdd = std::max(t.qdd, eq);
+      if (fc.indeterminate) {
+        ++t.indeterminate;
+      } else {
+        const double em = (fw.mu - fc.mu).cwiseAbs().maxCoeff() / (1.0 + warm_options.breakaway.maxCoeff());
+        const double et = relativeError(warm.solution.tau_control, cold.solution.tau_control);
+        CHECK(em < 1e-9);
+        CHECK(et < 1e-9);
+        t.mu = std::max(t.mu, em);
+        t.tau_control = std::max(t.tau_control, et);
+      }
+      if (step > 0) {
+        t.stuck_set_changes += fw.stuck != last_stuck ? 1 : 0;
+        t.pattern_changes += fw.stuck == last_stuck && fw.state != last_state ? 1 : 0;
+      }
+      last_stuck = fw.stuck;
+      last_state = fw.state;
+      stepState(model, warm.solution.qdd, h, q, v, t);
+    }
+  }
+  std::printf(
+      "warm start along %d trajectories: %d steps (%d solved, %d Infeasible ends, %d indeterminate, %d with a stuck "
+      "DOF), answered by the pattern search %d, of them warm %d; stuck set changed %d times, the pattern on the same "
+      "set %d times, %d limit stops, %d stale workspaces\n"
+      "  max difference to the cold active set: qdd %.2e, mu %.2e, tau_control %.2e\n",
+      kTrajectories, t.steps, t.solved, t.infeasible, t.indeterminate, t.with_stuck, t.by_patterns, t.warm,
+      t.stuck_set_changes, t.pattern_changes, t.limit_stops, t.stale, t.qdd, t.mu, t.tau_control);
+  CHECK(t.warm > t.with_stuck * 3 / 4);  // a control loop is mostly answered from the last pattern
+  CHECK(t.stuck_set_changes > 50);
+  CHECK(t.pattern_changes > 20);
+  CHECK(t.limit_stops > 5);
 }

@@ -26,10 +26,6 @@
 
 namespace zwang {
 
-/// The maximiser of g over the box (docs/friction.md, "The maximiser").
-enum class FrictionMethod { ActiveSet, ProjectedGradient };
-
-/// Options of solveWithFriction; the defaults suit most uses.
 struct FrictionOptions {
   double velocity_tolerance = 1e-6;  ///< |q̇| at or below it: stuck [rad/s or m/s]
   double limit_tolerance = 1e-9;     ///< |q − limit| at or below it: on the limit [rad or m]
@@ -37,20 +33,18 @@ struct FrictionOptions {
   /// When μ* is not unique, the maximiser that minimises ‖τ_control‖² using at
   /// most margin·f_j of each breakaway torque (where the task allows).
   double margin = 1.0;
-  /// Active set (exact, the default) or projected gradient.
-  FrictionMethod method = FrictionMethod::ActiveSet;
-  /// Try the stick/slip pattern of the last solveWithFriction in this
-  /// workspace first (a control loop or a simulation, whose next state is
-  /// close to the last): for the same model, task object and stuck set, one
-  /// pass of the sweeps with the sticking DOFs locked and the slipping ones at
-  /// their friction bound, accepted when its μ lies inside the boxes, the
-  /// slipping DOFs move the way their friction allows and μ* is unique (the
-  /// balance with the sticking DOFs locked is regular); otherwise, or with no
-  /// pattern to try, the full solve (docs/friction.md, "Warm start"). The
-  /// answer is the same either way; FrictionResult::warm_started tells which
-  /// ran, and dqdd_dmu is left zero when the pattern's pass did.
+  /// The pattern search where it is cheaper, else the active set (exact either way).
+  FrictionMethod method = FrictionMethod::Automatic;
+  /// Start the pattern search from the stick/slip pattern of the last
+  /// solveWithFriction in this workspace (a control loop or a simulation,
+  /// whose next state is close to the last), for the same model and task
+  /// object, mapped onto this solve's stuck set (a newly stuck DOF starts
+  /// sticking): one pass of the sweeps when it still holds (docs/friction.md,
+  /// "Warm start"). Also with ActiveSet or ProjectedGradient, which then run
+  /// when the search fails. The answer is the same either way;
+  /// FrictionResult::warm_started and method tell which path answered.
   bool warm_start = false;
-  int max_iterations = 500;      ///< of the maximiser
+  int max_iterations = 500;      ///< of the maximiser, or passes of the pattern search
   double kkt_tolerance = 1e-12;  ///< relative to 1 + the largest |q̈(0)| on Θ₀
   ///@{
   /// Per-solve overrides of the model's values (empty: use the model's).

@@ -41,6 +41,16 @@ const char* toString(JointState state) {
   return "unknown";
 }
 
+const char* toString(FrictionMethod method) {
+  switch (method) {
+    case FrictionMethod::Automatic: return "automatic";
+    case FrictionMethod::ActiveSet: return "active_set";
+    case FrictionMethod::ProjectedGradient: return "projected_gradient";
+    case FrictionMethod::StickPatterns: return "stick_patterns";
+  }
+  return "unknown";
+}
+
 namespace {
 
 using namespace internal;
@@ -181,14 +191,12 @@ void stuckSetAndKineticFriction(const Model& model, const Task& task, const Eige
 }
 
 // ---- ∂q̈/∂μ in the same sweeps: the motion at μ = 0 (q̈(0), ν(0)) and, per
-// stuck joint, the columns δq̈, δν of a unit torque there.
-Status sweepsWithSensitivities(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
-                               const Eigen::Ref<const Eigen::VectorXd>& qd, const std::vector<int>& stuck,
-                               Workspace& ws, FrictionScratch& fs) {
+// stuck joint, the columns δq̈, δν of a unit torque there (the kinematics done).
+Status sweepsWithSensitivities(const Model& model, const Task& task, const std::vector<int>& stuck, Workspace& ws,
+                               FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
   const int m = task.solverColumns();
   const auto stuck_count = static_cast<Eigen::Index>(stuck.size());
-  outwardSweep(model, task, q, qd, ws);
   if (Status s = inwardSweep(model, task, fs.tau_effective, ws); !s) return s;
   balance(task, ws);
   outwardAccelerations(model, task, ws, fs.qdd0);
@@ -296,7 +304,7 @@ QpReport maximiseDual(const Model& model, const Task& task, const Workspace& ws,
   if (stuck_count == 0) return {};
   const TermSizes terms{curvature_scale, Eigen::Map<const Eigen::VectorXd>(fs.curvature_terms.data(), stuck_count),
                         Eigen::Map<const Eigen::VectorXd>(fs.slope_terms.data(), stuck_count)};
-  return options.method == FrictionMethod::ActiveSet
+  return options.method != FrictionMethod::ProjectedGradient
              ? boxQpActiveSet(K, fs.qdd0_stuck.head(stuck_count), fs.lo.head(stuck_count), fs.hi.head(stuck_count), mu,
                               fs.qp, options.max_iterations, tolerance, terms)
              : boxQpProjectedGradient(K, fs.qdd0_stuck.head(stuck_count), fs.lo.head(stuck_count),
@@ -440,17 +448,40 @@ void publishSolution(const Model& model, const Task& task, const Eigen::Ref<cons
   out.gauss = fr.gauss_dual - mu_dot_qdd;
 }
 
-// ---- Warm start: the last solve's pattern held (src/friction/stick_pattern.cpp). What only the full solve
-// computes: no iterations, no ∂q̈/∂μ (zeroed once after a full solve wrote it).
-void publishWarmSolution(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& tau,
-                         double acc_tolerance, Workspace& ws, FrictionScratch& fs, FrictionResult& fr) {
+// ---- The pattern search answered (src/friction/stick_pattern.cpp): its passes for iterations, no ∂q̈/∂μ (zeroed
+// once after a full solve wrote it).
+void publishPatternSolution(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& tau,
+                            double acc_tolerance, int passes, bool from_kept, Workspace& ws, FrictionScratch& fs,
+                            FrictionResult& fr) {
   publishSolution(model, task, tau, acc_tolerance, ws, fs, fr);
-  fr.iterations = 0;
+  fr.method = FrictionMethod::StickPatterns;
+  fr.warm_started = from_kept;
+  fr.iterations = passes;
   fr.converged = true;
   fr.indeterminate = false;
   fr.kkt_residual = 0.0;  // q̈ = 0 on the locked DOFs by construction, μ inside the boxes, the slips' signs checked
   if (fs.sensitivities_written) fr.dqdd_dmu.setZero();
   fs.sensitivities_written = false;
+}
+
+// ---- Which method: how many passes of the pattern search are tried before the K-based solve. A pass costs about
+// half the plain solve (the sweeps without the kinematics); the K-based solve some 0.15 of it per stuck DOF and
+// O(k³) on top. From every DOF sticking the search takes 4–8 passes whatever k (block pivoting changes every broken
+// DOF at once), which pays from some 24 stuck DOFs on; from a kept pattern one pass mostly answers (docs/friction.md,
+// "Which method": the crossover measured).
+int patternPassBudget(const FrictionOptions& options, Eigen::Index stuck_count, bool from_kept) {
+  constexpr Eigen::Index kColdSearchFrom = 24;  // stuck DOFs; fewer: the K-based solve costs less than the passes
+  const int k = static_cast<int>(stuck_count);
+  const int from_kept_passes = 2 + k / 6, cold_passes = 8 + k / 16;
+  switch (options.method) {
+    case FrictionMethod::StickPatterns: return options.max_iterations;
+    case FrictionMethod::Automatic:
+      if (from_kept) return from_kept_passes;
+      return stuck_count >= kColdSearchFrom ? cold_passes : 0;
+    case FrictionMethod::ActiveSet:
+    case FrictionMethod::ProjectedGradient: return from_kept ? from_kept_passes : 0;
+  }
+  return 0;
 }
 
 // ---- Joint position limits: a stop the task pushes into makes g unbounded.
@@ -480,14 +511,21 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
 
   jointsOutsideLimits(model, q, out);  // a warning: solved as given
   stuckSetAndKineticFriction(model, task, q, qd, tau, options, fs, fr);
-  double acc_tolerance = 0.0;  // what counts as q̈_j = 0 (a sticking joint): set by the path that runs
-  fr.warm_started = options.warm_start && solveLastPattern(model, task, q, qd, fr, ws, fs, acc_tolerance);
-  if (fr.warm_started) {
-    publishWarmSolution(model, task, tau, acc_tolerance, ws, fs, fr);
+  outwardSweep(model, task, q, qd, ws);  // the kinematics, whichever method runs
+  const auto stuck_count = static_cast<Eigen::Index>(fr.stuck.size());
+  double acc_tolerance = 0.0;  // what counts as q̈_j = 0 (a sticking joint): set by the method that answers
+  const bool from_kept = options.warm_start && keptPatternApplies(model, task, fs);
+  int passes = 0;
+  if (searchPatterns(model, task, fr, from_kept, patternPassBudget(options, stuck_count, from_kept), ws, fs,
+                     acc_tolerance, passes)) {
+    publishPatternSolution(model, task, tau, acc_tolerance, passes, from_kept, ws, fs, fr);
+    rememberPattern(model, task, fr, true, fs);
     return {};
   }
-  const auto stuck_count = static_cast<Eigen::Index>(fr.stuck.size());
-  if (Status s = sweepsWithSensitivities(model, task, q, qd, fr.stuck, ws, fs); !s) return s;
+  fr.method = options.method == FrictionMethod::ProjectedGradient ? FrictionMethod::ProjectedGradient
+                                                                  : FrictionMethod::ActiveSet;
+  fr.warm_started = false;
+  if (Status s = sweepsWithSensitivities(model, task, fr.stuck, ws, fs); !s) return s;
   if (stuck_count < model.dof()) fr.dqdd_dmu.setZero();  // a moving joint has no μ (all stuck: every column is written)
   for (Eigen::Index a = 0; a < stuck_count; ++a)         // μ_j enters as the torque −μ_j
     fr.dqdd_dmu.col(fr.stuck[static_cast<std::size_t>(a)]) = -fs.dqdd.col(a);

@@ -41,6 +41,8 @@ struct FrictionScratch {
     stuck_dofs.reserve(static_cast<std::size_t>(dof));
     pattern_stuck.reserve(static_cast<std::size_t>(dof));
     pattern_state.reserve(static_cast<std::size_t>(dof));
+    trial_state.reserve(static_cast<std::size_t>(dof));
+    pattern_breaks.assign(static_cast<std::size_t>(dof), 0);
     pattern_modes.assign(static_cast<std::size_t>(nv), DofMode::Torque);
     pattern_qdd.setZero(nv);
     pattern_tau.setZero(nv);
@@ -77,11 +79,14 @@ struct FrictionScratch {
   Eigen::VectorXd tau_control_first;     // τ + τ_c there, mimic joints' carried by their leaders
   MaximiserChoiceScratch choice;
 
-  // The last solve's stick pattern, tried first with FrictionOptions::warm_start (src/friction/stick_pattern.cpp)
+  // The pattern search (src/friction/stick_pattern.cpp); the last solve's pattern, where it starts with
+  // FrictionOptions::warm_start
   const Model* pattern_model = nullptr;  // what it was found for: nullptr when there is none to try
   const Task* pattern_task = nullptr;
   std::vector<int> pattern_stuck;         // Θ₀ then
-  std::vector<JointState> pattern_state;  // per stuck index: Stick, SlipPositive, SlipNegative or AtLimit
+  std::vector<JointState> pattern_state;  // per stuck index then: Stick, SlipPositive, SlipNegative or AtLimit
+  std::vector<JointState> trial_state;    // per stuck index: the pattern of the search's pass
+  std::vector<char> pattern_breaks;       // per stuck index: the pass broke its condition
   std::vector<DofMode> pattern_modes;     // nv: the task's modes with the sticking DOFs locked
   Eigen::VectorXd pattern_qdd;            // nv: the task's prescribed accelerations, 0 on the locked DOFs
   Eigen::VectorXd pattern_tau;            // nv: τ_effective with the slipping DOFs' friction bound applied

@@ -1,19 +1,25 @@
-// Warm start: the last solve's stick/slip pattern, tried first (FrictionOptions::warm_start; docs/friction.md,
-// "Warm start"; issue #28).
+// The pattern search: μ* by one pass of the sweeps per stick/slip pattern, no K formed (FrictionMethod::
+// StickPatterns, the automatic choice, FrictionOptions::warm_start; docs/friction.md, "The pattern search";
+// issue #28).
 //
 // For a pattern — each stuck DOF sticking (q̈ = 0, μ free), at a limit stop (likewise) or slipping (μ at its box's
 // bound) — the motion is a joint-level hybrid dynamics problem: the sticking DOFs locked (the prescribed-joint
 // machinery, q̈ = 0), the slipping ones driven by τ ∓ f, the task's rows as they are. One pass of the sweeps gives
-// q̈ and ν, and each locked DOF's friction is what its joint's equation leaves over (prescribedDofResiduals): no K
-// formed, O(N). The pattern holds when these are the box QP's optimality conditions: every locked DOF's μ inside its
-// box, every slipping DOF moving the way its friction allows. It is then the maximiser; the only one when the
-// sticking DOFs' block of K is regular, which is the balance with them locked being regular (its rows and the locks
+// q̈ and ν, and each locked DOF's friction is what its joint's equation leaves over (prescribedDofResiduals): O(N).
+// The pattern holds when these are the box QP's optimality conditions: every locked DOF's μ inside its box, every
+// slipping DOF moving the way its friction allows. It is then the maximiser; the only one when the sticking DOFs'
+// block of K is regular, which is the balance with them locked being regular (its rows and the locks
 // independent), and strict complementarity on the slipping DOFs. Anything less certain goes to the full solve,
 // which chooses among maximisers by least effort: so the answer never depends on which path ran.
+//
+// Between passes the DOFs whose conditions the pass broke change their part of the pattern — Júdice and Pires's
+// block principal pivoting for the box LCP (q̈_Θ = q̈_Θ(0) − K_ΘΘ μ), the Newton-like step that changes every broken
+// DOF at once, with Murty's one-at-a-time rule as its backup, which cannot cycle when K_ΘΘ is positive definite.
 #include "friction/stick_pattern.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace zwang::internal {
 
@@ -23,15 +29,35 @@ namespace {
 // pattern this close to changing is left to the full solve.
 constexpr double kBoxMargin = 1e-9;   // of 1 + f: μ this close to a bound may be at it
 constexpr double kSlipMargin = 1e-6;  // of 1 + the largest |q̈| on Θ₀: a slip this slow may be a stick
+// Passes without fewer broken conditions before the search changes one DOF at a time (Júdice and Pires's p̄).
+constexpr int kBlockTries = 3;
 
 bool locked(JointState state) { return state == JointState::Stick || state == JointState::AtLimit; }
 
-// The kept pattern is for this model, this task object and this stuck set.
-bool patternApplies(const Model& model, const Task& task, const FrictionResult& fr, const FrictionScratch& fs) {
-  return fs.pattern_model == &model && fs.pattern_task == &task && !fr.stuck.empty() && fs.pattern_stuck == fr.stuck;
+// The kept states mapped onto Θ₀ (both ascending): a DOF stuck then keeps its state, a newly stuck one sticks, and
+// a slip towards a side a limit stop now holds without bound locks instead.
+void startFromKept(const FrictionResult& fr, FrictionScratch& fs) {
+  fs.trial_state.clear();  // reserved for every DOF: no allocation
+  std::size_t b = 0;
+  for (std::size_t a = 0; a < fr.stuck.size(); ++a) {
+    const int j = fr.stuck[a];
+    while (b < fs.pattern_stuck.size() && fs.pattern_stuck[b] < j) ++b;
+    JointState state =
+        b < fs.pattern_stuck.size() && fs.pattern_stuck[b] == j ? fs.pattern_state[b] : JointState::Stick;
+    const auto e = static_cast<Eigen::Index>(a);
+    if ((state == JointState::SlipPositive && !std::isfinite(fs.hi[e])) ||
+        (state == JointState::SlipNegative && !std::isfinite(fs.lo[e])))
+      state = JointState::Stick;
+    fs.trial_state.push_back(state);
+  }
 }
 
-// The task's modes with the sticking DOFs locked, and τ_effective with the slipping DOFs' friction bound.
+void startSticking(const FrictionResult& fr, FrictionScratch& fs) {
+  fs.trial_state.assign(fr.stuck.size(), JointState::Stick);
+}
+
+// The task's modes with the sticking DOFs locked, and τ_effective with the slipping DOFs' friction bound; returns
+// how many DOFs are prescribed then.
 int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, FrictionScratch& fs) {
   const int base_velocity_size = model.baseVelocitySize();
   std::copy(task.dofModes().begin(), task.dofModes().end(), fs.pattern_modes.begin());
@@ -41,7 +67,7 @@ int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, 
   for (std::size_t a = 0; a < fr.stuck.size(); ++a) {
     const int v = base_velocity_size + fr.stuck[a];
     const auto e = static_cast<Eigen::Index>(a);
-    const JointState state = fs.pattern_state[a];
+    const JointState state = fs.trial_state[a];
     if (locked(state)) {
       fs.pattern_modes[static_cast<std::size_t>(v)] = DofMode::Prescribed;
       fs.pattern_qdd[v] = 0.0;
@@ -53,12 +79,10 @@ int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, 
   return prescribed;
 }
 
-// The sweeps with the pattern's modes: false when a joint has no inertia to move or the balance is not regular
-// with the sticking DOFs locked (μ* may not be unique: the full solve chooses).
-bool sweepPattern(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
-                  const Eigen::Ref<const Eigen::VectorXd>& qd, Workspace& ws, FrictionScratch& fs) {
+// One pass of the sweeps with the pattern's modes, the kinematics done: false when a joint has no inertia to move or
+// the balance is not regular with the sticking DOFs locked (μ* may not be unique: the full solve chooses).
+bool passOfSweeps(const Model& model, const Task& task, Workspace& ws, FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
-  outwardSweep(model, task, q, qd, ws);
   if (!inwardSweep(model, task, fs.pattern_tau, ws)) return false;  // Degenerate: the full solve reports it
   balance(task, ws);
   const BalanceReport& report = ws.solution.balance;
@@ -69,10 +93,48 @@ bool sweepPattern(const Model& model, const Task& task, const Eigen::Ref<const E
   return true;
 }
 
-// The box QP's optimality conditions at the pattern's motion, strictly: μ* into fs.mu when they hold.
+// Marks each DOF whose condition the pass broke — a locked DOF's μ (into fs.mu) beyond its box, a slipping DOF
+// moving against its friction — and returns how many; −1 when the pass overflowed (the full solve reports it).
+int brokenConditions(const Model& model, const FrictionResult& fr, const Eigen::VectorXd& qdd, FrictionScratch& fs) {
+  const int base_velocity_size = model.baseVelocitySize();
+  int broken = 0;
+  for (std::size_t a = 0; a < fr.stuck.size(); ++a) {
+    const int v = base_velocity_size + fr.stuck[a];
+    const auto e = static_cast<Eigen::Index>(a);
+    const JointState state = fs.trial_state[a];
+    bool breaks = false;
+    if (locked(state)) {
+      const double mu = -fs.pattern_residual[v];
+      if (!std::isfinite(mu)) return -1;
+      fs.mu[e] = mu;
+      breaks = mu > fs.hi[e] || mu < fs.lo[e];
+    } else {
+      if (!std::isfinite(qdd[v])) return -1;
+      breaks = state == JointState::SlipPositive ? qdd[v] < 0.0 : qdd[v] > 0.0;
+    }
+    fs.pattern_breaks[a] = breaks ? 1 : 0;
+    broken += breaks ? 1 : 0;
+  }
+  return broken;
+}
+
+// The next pattern: each marked DOF (with last_only, the last of them) changes — a locked one slips the way its μ
+// left its box, a slipping one locks.
+void changeMarked(const FrictionResult& fr, bool last_only, FrictionScratch& fs) {
+  for (std::size_t b = fr.stuck.size(); b-- > 0;) {
+    if (!fs.pattern_breaks[b]) continue;
+    JointState& state = fs.trial_state[b];
+    const auto e = static_cast<Eigen::Index>(b);
+    state = !locked(state) ? JointState::Stick
+                           : (fs.mu[e] > fs.hi[e] ? JointState::SlipPositive : JointState::SlipNegative);
+    if (last_only) return;
+  }
+}
+
+// The box QP's optimality conditions at the pattern's motion, strictly (nothing broken, every condition with its
+// margin): μ* into fs.mu when they hold.
 bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::VectorXd& qdd, FrictionScratch& fs,
                   double& acc_tolerance) {
-  if (!qdd.allFinite()) return false;  // an overflow is the full solve's to report
   const int base_velocity_size = model.baseVelocitySize();
   double acc_max = 0.0;
   for (const int j : fr.stuck) acc_max = std::max(acc_max, std::abs(qdd[base_velocity_size + j]));
@@ -80,16 +142,15 @@ bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::Vec
   for (std::size_t a = 0; a < fr.stuck.size(); ++a) {
     const int j = fr.stuck[a], v = base_velocity_size + j;
     const auto e = static_cast<Eigen::Index>(a);
-    const JointState state = fs.pattern_state[a];
-    if (locked(state)) {
-      const double mu = -fs.pattern_residual[v], margin = kBoxMargin * (1.0 + fs.breakaway[j]);
-      if (!(mu > fs.lo[e] + margin && mu < fs.hi[e] - margin)) return false;
-      fs.mu[e] = mu;
+    const JointState state = fs.trial_state[a];
+    if (locked(state)) {  // μ already in fs.mu
+      const double margin = kBoxMargin * (1.0 + fs.breakaway[j]);
+      if (!(fs.mu[e] > fs.lo[e] + margin && fs.mu[e] < fs.hi[e] - margin)) return false;
     } else if (state == JointState::SlipPositive) {
-      if (!(std::isfinite(fs.hi[e]) && qdd[v] > slip_margin)) return false;
+      if (!(qdd[v] > slip_margin)) return false;
       fs.mu[e] = fs.hi[e];
     } else {
-      if (!(std::isfinite(fs.lo[e]) && qdd[v] < -slip_margin)) return false;
+      if (!(qdd[v] < -slip_margin)) return false;
       fs.mu[e] = fs.lo[e];
     }
   }
@@ -97,19 +158,49 @@ bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::Vec
   return true;
 }
 
-}  // namespace
-
-bool solveLastPattern(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
-                      const Eigen::Ref<const Eigen::VectorXd>& qd, const FrictionResult& fr, Workspace& ws,
-                      FrictionScratch& fs, double& acc_tolerance) {
-  if (!patternApplies(model, task, fr, fs)) return false;
+// The passes from the start pattern: true when one holds.
+bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& fr, int max_passes, Workspace& ws,
+                    FrictionScratch& fs, double& acc_tolerance, int& passes) {
   WorkspaceScratch& sw = scratchOf(ws);
-  sw.prescribed_count = lockPattern(model, task, fr, fs);
   sw.dof_modes = fs.pattern_modes.data();
   sw.prescribed_qdd = fs.pattern_qdd.data();
-  const bool held =
-      sweepPattern(model, task, q, qd, ws, fs) && patternHolds(model, fr, ws.solution.qdd, fs, acc_tolerance);
-  bindTaskModes(task, sw);  // the stages after it (the task's prescribed torques) read the task's
+  int fewest = std::numeric_limits<int>::max(), block_tries = kBlockTries;
+  while (passes < max_passes) {
+    sw.prescribed_count = lockPattern(model, task, fr, fs);
+    // More rows and locks than the motion has coordinates: the balance would be singular (μ* not unique).
+    if (sw.prescribed_count + task.balanceRows() > model.nv()) return false;
+    ++passes;
+    if (!passOfSweeps(model, task, ws, fs)) return false;
+    const int broken = brokenConditions(model, fr, ws.solution.qdd, fs);
+    if (broken < 0) return false;
+    if (broken == 0) return patternHolds(model, fr, ws.solution.qdd, fs, acc_tolerance);
+    if (broken < fewest) {
+      fewest = broken;
+      block_tries = kBlockTries;
+    } else if (block_tries > 0) {
+      --block_tries;
+    }
+    changeMarked(fr, block_tries == 0, fs);
+  }
+  return false;
+}
+
+}  // namespace
+
+bool keptPatternApplies(const Model& model, const Task& task, const FrictionScratch& fs) {
+  return fs.pattern_model == &model && fs.pattern_task == &task;
+}
+
+bool searchPatterns(const Model& model, const Task& task, const FrictionResult& fr, bool from_kept, int max_passes,
+                    Workspace& ws, FrictionScratch& fs, double& acc_tolerance, int& passes) {
+  passes = 0;
+  if (fr.stuck.empty() || max_passes < 1) return false;
+  if (from_kept)
+    startFromKept(fr, fs);
+  else
+    startSticking(fr, fs);
+  const bool held = pivotToOptimum(model, task, fr, max_passes, ws, fs, acc_tolerance, passes);
+  bindTaskModes(task, scratchOf(ws));  // the stages after it (the task's prescribed torques, the full solve) read them
   return held;
 }
 

@@ -1,18 +1,23 @@
-// Warm start (FrictionOptions::warm_start; docs/friction.md, "Warm start"): the last solve's stick/slip pattern
-// tried before the full solve. src/friction/stick_pattern.cpp.
+// The pattern search (FrictionMethod::StickPatterns, the automatic choice and FrictionOptions::warm_start;
+// docs/friction.md, "The pattern search"): μ* found by one pass of the sweeps per stick/slip pattern, no K formed.
+// src/friction/stick_pattern.cpp.
 #pragma once
 
 #include "friction/friction_scratch.hpp"
 
 namespace zwang::internal {
 
-// The pattern kept from the last solve, for this solve's stuck set Θ₀ (fr.stuck, fs.lo, fs.hi and
-// fs.tau_effective set): on success q̈* in ws.solution.qdd, ν in the sweep's ν columns, the bodies' accelerations
-// in the sweep, μ* in fs.mu and the acceleration tolerance the states are told by; false when there is none to
-// try or it does not hold (the sweep's results are then scratch for the full solve).
-bool solveLastPattern(const Model& model, const Task& task, const Eigen::Ref<const Eigen::VectorXd>& q,
-                      const Eigen::Ref<const Eigen::VectorXd>& qd, const FrictionResult& fr, Workspace& ws,
-                      FrictionScratch& fs, double& acc_tolerance);
+// A pattern kept by the last solve for this model and this task object (another stuck set is mapped onto it).
+bool keptPatternApplies(const Model& model, const Task& task, const FrictionScratch& fs);
+
+// The search for this solve's stuck set Θ₀ (fr.stuck, fs.lo, fs.hi and fs.tau_effective set, the kinematics done by
+// outwardSweep), at most max_passes passes of the sweeps, from the kept pattern (from_kept: it applies) mapped onto
+// Θ₀ or from every stuck DOF sticking. On success: q̈* in ws.solution.qdd, ν in
+// the sweep's ν columns, the bodies' accelerations in the sweep, μ* in fs.mu, the acceleration tolerance the states
+// are told by, and true. False when no pattern holds within the passes or μ* may not be unique: the full solve
+// then runs on the same kinematics. `passes` counts the passes made.
+bool searchPatterns(const Model& model, const Task& task, const FrictionResult& fr, bool from_kept, int max_passes,
+                    Workspace& ws, FrictionScratch& fs, double& acc_tolerance, int& passes);
 
 // Keep the pattern of the solve just finished (the states on Θ₀) for the next call, or (keep false) forget it.
 void rememberPattern(const Model& model, const Task& task, const FrictionResult& fr, bool keep, FrictionScratch& fs);

@@ -479,13 +479,26 @@ void bindWrench(py::module_& m) {
            [](const Wrench& w) { return "<zwang.Wrench on '" + w.frame + "', " + expressedName(w.expressed) + ">"; });
 }
 
+// The method of its name (toString's), or ValueError.
+FrictionMethod frictionMethodNamed(const std::string& name) {
+  constexpr FrictionMethod kMethods[] = {FrictionMethod::Automatic, FrictionMethod::ActiveSet,
+                                         FrictionMethod::ProjectedGradient, FrictionMethod::StickPatterns};
+  std::string names;
+  for (const FrictionMethod method : kMethods) {
+    if (name == toString(method)) return method;
+    names += std::string(names.empty() ? "'" : ", '") + toString(method) + "'";
+  }
+  raise(PyExc_ValueError, "method: unknown value '" + name + "' (expected one of " + names + ")");
+}
+
 // Friction: the options of the friction-aware solve, checked by the problem layer.
 void bindFriction(py::module_& m) {
   py::class_<Friction>(m, "Friction",
                        "Options of the friction-aware solve (zwang::FrictionOptions). margin: when mu* is not\n"
                        "unique, the effort-minimising choice uses at most margin*f_j. breakaway/kinetic/viscous:\n"
-                       "optional per-joint overrides of the model's values. warm_start: try the workspace's last\n"
-                       "stick/slip pattern first (a control loop; docs/friction.md 'Warm start').")
+                       "optional per-joint overrides of the model's values. method: 'automatic', 'active_set',\n"
+                       "'projected_gradient' or 'stick_patterns' (docs/friction.md). warm_start: start from the\n"
+                       "workspace's last stick/slip pattern (a control loop; docs/friction.md 'Warm start').")
       .def(py::init([](double margin, double velocity_tolerance, double limit_tolerance, bool joint_limits,
                        const std::string& method, int max_iterations, double kkt_tolerance, py::handle breakaway,
                        py::handle kinetic, py::handle viscous, bool warm_start) {
@@ -494,13 +507,7 @@ void bindFriction(py::module_& m) {
              f.options.velocity_tolerance = velocity_tolerance;
              f.options.limit_tolerance = limit_tolerance;
              f.options.joint_limits = joint_limits;
-             if (method == "active_set")
-               f.options.method = FrictionMethod::ActiveSet;
-             else if (method == "projected_gradient")
-               f.options.method = FrictionMethod::ProjectedGradient;
-             else
-               raise(PyExc_ValueError,
-                     "method: unknown value '" + method + "' (expected 'active_set' or 'projected_gradient')");
+             f.options.method = frictionMethodNamed(method);
              f.options.max_iterations = max_iterations;
              f.options.kkt_tolerance = kkt_tolerance;
              f.options.breakaway = optionalOverride("breakaway", breakaway);
@@ -511,18 +518,14 @@ void bindFriction(py::module_& m) {
              return f;
            }),
            py::kw_only(), py::arg("margin") = 1.0, py::arg("velocity_tolerance") = 1e-6,
-           py::arg("limit_tolerance") = 1e-9, py::arg("joint_limits") = true, py::arg("method") = "active_set",
+           py::arg("limit_tolerance") = 1e-9, py::arg("joint_limits") = true, py::arg("method") = "automatic",
            py::arg("max_iterations") = 500, py::arg("kkt_tolerance") = 1e-12, py::arg("breakaway") = py::none(),
            py::arg("kinetic") = py::none(), py::arg("viscous") = py::none(), py::arg("warm_start") = false)
       .def_property_readonly("margin", [](const Friction& f) { return f.options.margin; })
       .def_property_readonly("velocity_tolerance", [](const Friction& f) { return f.options.velocity_tolerance; })
       .def_property_readonly("limit_tolerance", [](const Friction& f) { return f.options.limit_tolerance; })
       .def_property_readonly("joint_limits", [](const Friction& f) { return f.options.joint_limits; })
-      .def_property_readonly(
-          "method",
-          [](const Friction& f) {
-    return std::string(f.options.method == FrictionMethod::ActiveSet ? "active_set" : "projected_gradient");
-          })
+      .def_property_readonly("method", [](const Friction& f) { return std::string(toString(f.options.method)); })
       .def_property_readonly("max_iterations", [](const Friction& f) { return f.options.max_iterations; })
       .def_property_readonly("kkt_tolerance", [](const Friction& f) { return f.options.kkt_tolerance; })
       .def_property_readonly("breakaway", [](const Friction& f) { return overrideArray(f.options.breakaway); })
@@ -710,6 +713,11 @@ void addFrictionProperties(py::class_<Result>& cls) {
                              [](const Result& r) { return r.with_friction && r.friction().indeterminate; })
       .def_property_readonly("warm_started",
                              [](const Result& r) { return r.with_friction && r.friction().warm_started; })
+      .def_property_readonly("method",
+                             [](const Result& r) -> py::object {
+                               if (!r.with_friction) return py::none();
+                               return py::str(toString(r.friction().method));
+                             })
       .def_property_readonly("limit_impact",
                              [](const Result& r) { return r.with_friction && r.friction().limit_impact; })
       .def_property_readonly(

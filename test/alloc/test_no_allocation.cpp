@@ -333,6 +333,42 @@ TEST_CASE("the friction solve's warm start allocates nothing (the full solve, th
   CHECK(count == 0);
 }
 
+TEST_CASE("the pattern search allocates nothing: pivots, a changed stuck set, another task, the active set after it") {
+  const Model model = panda();
+  const Task task(model), other(model);
+  Task held(model);
+  held.addConstraint("tool0", ConstraintMatrix::Identity(6, 6), Expressed::World);  // 13 conditions: not searched
+  Workspace ws(model, task), ws_held(model, held);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(7, 0.3), rest = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd one_moving = rest, tau = Eigen::VectorXd::LinSpaced(7, -4.0, 5.0);
+  one_moving[2] = 0.4;
+  FrictionOptions options;
+  options.method = FrictionMethod::StickPatterns;
+  options.breakaway = Eigen::VectorXd::LinSpaced(7, 0.5, 3.0);  // some stick, some slip: passes with pivots
+  options.warm_start = true;
+  REQUIRE(solveWithFriction(model, ws, q, rest, tau, task, options));
+  FrictionOptions from_sticking = options;
+  from_sticking.warm_start = false;
+  REQUIRE(solveWithFriction(model, ws_held, q, rest, tau, held, from_sticking));
+  bool ok = true;
+  int searched = 0, pivots = 0;
+  const long count = allocationsDuring([&] {
+    for (int k = 0; k < 3; ++k) {
+      ok = solveWithFriction(model, ws, q, k == 1 ? one_moving : rest, tau, task, options).ok() && ok;
+      searched += ws.friction.method == FrictionMethod::StickPatterns ? 1 : 0;
+      pivots = std::max(pivots, ws.friction.iterations);
+      ok = solveWithFriction(model, ws, q, rest, tau, other, options).ok() && ok;  // the kept pattern: not its
+      ok = solveWithFriction(model, ws_held, q, rest, tau, held, from_sticking).ok() && ok;  // the active set answers
+      searched += ws_held.friction.method == FrictionMethod::StickPatterns ? 1 : 0;
+      tau[1] += 0.3;
+    }
+  });
+  CHECK(ok);
+  CHECK(searched == 3);
+  CHECK(pivots > 1);
+  CHECK(count == 0);
+}
+
 TEST_CASE("every error return of every entry point allocates nothing and throws nothing") {
   const Model model = panda(), other = zwang::testing::oneDofArmModel();
   Task task(model);

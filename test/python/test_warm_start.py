@@ -1,4 +1,4 @@
-"""Warm start of the friction solve (issue #28) from Python: zwang.Friction(warm_start=True) in a loop on one
+"""The friction methods and the warm start (issue #28) from Python: zwang.Friction(warm_start=True) in a loop on one
 workspace answers from the last stick/slip pattern (Result.warm_started) with the full solve's answer; the C++ test
 (test_warm_start) checks both against the brute-force enumeration."""
 import numpy as np
@@ -27,3 +27,23 @@ def test_control_loop_answers_warm_with_the_full_solves_answer(panda):
         np.testing.assert_allclose(res.tau_control, ref.tau_control, rtol=0, atol=1e-10)
         assert res.state == ref.state
     assert answered_warm == [False, True, True, True, True]
+
+
+def test_methods_by_name_and_the_method_that_answered(panda):
+    q = np.array(READY)
+    rest = np.zeros(7)
+    tau = np.linspace(-4.0, 5.0, 7)
+    breakaway = np.linspace(0.5, 3.0, 7)  # some joints stick, some slip
+    answers = {}
+    for method in ("automatic", "active_set", "projected_gradient", "stick_patterns"):
+        f = zwang.Friction(method=method, breakaway=breakaway)
+        assert f.method == method
+        answers[method] = zwang.solve(panda, panda.workspace(), q, rest, tau, friction=f).copy()
+    assert answers["stick_patterns"].method == "stick_patterns"
+    assert answers["active_set"].method == "active_set"
+    assert answers["projected_gradient"].method == "projected_gradient"
+    assert answers["automatic"].method == "active_set"  # 7 stuck joints: too few to search from every one sticking
+    assert not answers["stick_patterns"].dqdd_dmu.any()  # the search forms no K
+    for res in answers.values():
+        np.testing.assert_allclose(res.qdd, answers["active_set"].qdd, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(res.mu, answers["active_set"].mu, rtol=0, atol=1e-9)

@@ -509,17 +509,17 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
   if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", "forwardDynamics");
   if (status.ok()) checkSolution(ws, "forwardDynamics");
 
-  for (const FrictionMethod method : {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient}) {
+  for (const FrictionMethod method :
+       {FrictionMethod::ActiveSet, FrictionMethod::ProjectedGradient, FrictionMethod::StickPatterns}) {
     options.method = method;
-    const char* where = method == FrictionMethod::ActiveSet ? "solveWithFriction (active set)"
-                                                            : "solveWithFriction (projected gradient)";
+    const char* where = toString(method);
     status = solveWithFriction(model, ws, q, qd, tau, task, options);
     if (!fuzz::documented(status.code)) fuzz::failure("undocumented status", where);
     if (!finite_inputs && status.ok()) fuzz::failure("Ok for a non-finite input", where);
     checkQuaternionVerdict(model, q, status.code, where);
     if (status.ok() || status.code == StatusCode::Infeasible) checkFriction(ws, options, where);
   }
-  // Warm start: the call again from the pattern the last one kept (the pattern's pass when it holds).
+  // Warm start: the call again from the pattern the last one kept (the search's first pass when it holds).
   options.warm_start = true;
   for (int call = 0; call < 2; ++call) {
     status = solveWithFriction(model, ws, q, qd, tau, task, options);

@@ -11,7 +11,9 @@
 /// sides (unit torques at the stuck joints), giving q̈(0) and K_Θ = ∂q̈/∂τ_Θ, so
 /// q̈(μ) = q̈(0) − K_Θ μ (the characteristic equation 5.10); g is the concave
 /// quadratic g(0) + μᵀ q̈_Θ(0) − ½ μᵀ K_ΘΘ μ, maximised over the box by an exact
-/// active-set method (or projected gradient).
+/// active-set method (or projected gradient). With many stuck joints, or from
+/// the last solve's pattern, a search over stick/slip patterns finds the same
+/// μ* at one pass of the sweeps per pattern, no K formed (FrictionMethod).
 ///
 /// A stuck joint resting on a position limit gets a one-sided reaction: at the
 /// lower limit μ_j ∈ (−∞, f_j], at the upper μ_j ∈ [−f_j, ∞) (docs/friction.md, "Joint position limits").

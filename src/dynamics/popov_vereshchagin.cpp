@@ -676,9 +676,10 @@ void outwardBodies(const Model& model, const Task& task, WorkspaceScratch& sw, E
       qdd[i - 1] = prescribedAcceleration(sw, i - 1);
     } else {
       const int first = solverOrder(task).firstColumn(i), column_count = solverOrder(task).columnsEnd(i) - first;
-      const double constraint =
-          sw.SA.col(i).segment(first, column_count).dot(sw.nu_columns.segment(first, column_count));  // Sᵀ A_i ν
-      qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];    // line 28
+      const double constraint =  // Sᵀ A_i ν; most bodies have no column
+          column_count == 0 ? 0.0
+                            : sw.SA.col(i).segment(first, column_count).dot(sw.nu_columns.segment(first, column_count));
+      qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];  // line 28
     }
     a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];  // line 29
   }
@@ -703,7 +704,8 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 
 Vec6 baseClassicalAcceleration(const Model& model, const Workspace& ws) {
   const WorkspaceScratch& sw = scratchOf(ws);
-  const auto b = at(model.baseBody());  // the world's, zero, on a fixed base
+  if (!model.hasFloatingBase()) return Vec6::Zero();  // the world's
+  const auto b = at(model.baseBody());
   return classicalAtPoint(sw.a[b] - sw.a_world, sw.v[b], sw.Xworld[b].r);
 }
 
@@ -1133,7 +1135,8 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
   // function; the gravity-shifted sweep's version differs by a constant):
   // Σ_i ½ aᵢᵀIᵢaᵢ + (F_bias,i − I_i[g; 0])ᵀaᵢ + Σ_j ½ d_j q̈_j² − τ_j q̈_j,
   // in 3-vector pieces: with y = ½a + [−g; 0] = [y_l; y_a] and a = [a_l; α],
-  // I y = [m y_l − h × y_a; h × y_l + Ī y_a].
+  // aᵀI y = m a_l·y_l + h·((a_l − g) × α) + ½ αᵀĪα (the two moments of h
+  // are one triple product; Ī symmetric).
   const Vec3& g = task.gravity;
   const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
   double Z = 0.0;
@@ -1143,10 +1146,13 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
     const Vec3 a_lin = a_sweep.head<3>() + g;  // true acceleration: sweep − [−g; 0]
     const Vec3 alpha = a_sweep.tail<3>();
     const Vec3 y_lin = 0.5 * a_lin - g;
-    const Vec3 y_ang = 0.5 * alpha;
     const Vec6& F = sw.Fbias[at(i)];
-    Z += a_lin.dot(I.mass * y_lin - I.h.cross(y_ang) + F.head<3>()) +
-         alpha.dot(I.h.cross(y_lin) + I.Ibar * y_ang + F.tail<3>());
+    const Mat3& J = I.Ibar;
+    const double half_aIa =
+        0.5 * (J(0, 0) * alpha[0] * alpha[0] + J(1, 1) * alpha[1] * alpha[1] + J(2, 2) * alpha[2] * alpha[2]) +
+        J(1, 0) * alpha[0] * alpha[1] + J(2, 0) * alpha[0] * alpha[2] + J(2, 1) * alpha[1] * alpha[2];
+    Z +=
+        a_lin.dot(I.mass * y_lin + F.head<3>()) + I.h.dot((a_lin - g).cross(alpha)) + half_aIa + alpha.dot(F.tail<3>());
     const double qdd_i = qdd[i - 1];
     Z += (0.5 * rotor_inertia[i - 1] * qdd_i - tau[i - 1]) * qdd_i;
   }

@@ -268,6 +268,17 @@ class Model {
   /// (named "root_joint", unactuated and frictionless), then joints(). What
   /// the kinematics visits.
   const std::vector<Joint>& allJoints() const { return all_joints_; }
+  /// What Joint::transform(double) of a revolute joint computes from the
+  /// placement alone, precomputed when the model is built: column k of E is
+  /// c·e_k − s·(a × e_k) + ((1 − c)·(a·e_k))·a with e_k column k of E_T, so
+  /// the sweeps evaluate the same expression (to the bit) without the cross
+  /// and dot products.
+  struct OneDofTransform {
+    Mat3 axis_cross = Mat3::Zero();  ///< column k: a × e_k
+    Vec3 axis_dot = Vec3::Zero();    ///< entry k: a · e_k
+  };
+  /// OneDofTransform of every joint of allJoints() (zero for other than revolute joints).
+  const std::vector<OneDofTransform>& oneDofTransforms() const { return one_dof_transforms_; }
   /// Every DOF in the order of v (nv() entries): DOF k moves body k + 1.
   const std::vector<Dof>& dofs() const { return dofs_; }
   /// d_k of every DOF in the order of v (nv() entries; 0 on a floating root):
@@ -342,8 +353,9 @@ class Model {
   Transform base_placement_;
   std::vector<ModelWarning> warnings_;
   // What build() lays out.
-  std::vector<Joint> root_;        // the root joint of a floating base (none on a fixed one)
-  std::vector<Joint> all_joints_;  // root_, then joints_
+  std::vector<Joint> root_;                          // the root joint of a floating base (none on a fixed one)
+  std::vector<Joint> all_joints_;                    // root_, then joints_
+  std::vector<OneDofTransform> one_dof_transforms_;  // per entry of all_joints_
   std::vector<Dof> dofs_;
   Eigen::VectorXd rotor_inertia_;  // per DOF, from dofs_
   int nq_ = 0, nv_ = 0;

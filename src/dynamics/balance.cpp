@@ -27,6 +27,14 @@ namespace zwang::internal {
 
 namespace {
 
+// Loops over a compile-time size of at most 6, unrolled whole: constant
+// offsets instead of loop counters on these short triangular loops.
+#if defined(__GNUC__)
+#define ZWANG_UNROLL _Pragma("GCC unroll 8")
+#else
+#define ZWANG_UNROLL
+#endif
+
 // ‖E A E‖_F of a symmetric matrix from its lower triangle, E = diag(e).
 double equilibratedFrobenius(const Eigen::Ref<const Eigen::MatrixXd>& A, const Eigen::Ref<const Eigen::VectorXd>& e) {
   double s = 0.0;
@@ -78,51 +86,65 @@ bool certifiedSolveFixed(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen
   using MatM = Eigen::Matrix<double, M, M>;
   // Divisions are slow and sit on the substitutions' dependency chains: each
   // pivot is inverted once and the rest multiply.
+  const MatM Lf = L;  // fixed size: constant offsets in the unrolled loops below (the upper triangle unused)
+  const Eigen::Matrix<double, M, 1> diagonal = Lf.diagonal();
   MatM C = MatM::Zero();  // 𝓛 = C Cᵀ
   Eigen::Matrix<double, M, 1> inverse_pivot, inverse_diagonal;
+  ZWANG_UNROLL
   for (int j = 0; j < M; ++j) {
-    double d = L(j, j);
+    double d = Lf(j, j);
+    ZWANG_UNROLL
     for (int k = 0; k < j; ++k) d -= C(j, k) * C(j, k);
     if (!(d > 0.0)) return false;
     C(j, j) = std::sqrt(d);
     inverse_pivot[j] = 1.0 / C(j, j);
-    inverse_diagonal[j] = 1.0 / L(j, j);  // L_jj ≥ d > 0
+    inverse_diagonal[j] = 1.0 / Lf(j, j);  // L_jj ≥ d > 0
+    ZWANG_UNROLL
     for (int i = j + 1; i < M; ++i) {
-      double x = L(i, j);
+      double x = Lf(i, j);
+      ZWANG_UNROLL
       for (int k = 0; k < j; ++k) x -= C(i, k) * C(j, k);
       C(i, j) = x * inverse_pivot[j];
     }
   }
   // κ̃_F² = ‖E𝓛E‖_F² ‖E⁻¹𝓛⁻¹E⁻¹‖_F² with E² = diag(1/𝓛_jj): no square roots needed.
   double norm2 = 0.0;
+  ZWANG_UNROLL
   for (int j = 0; j < M; ++j) {
     norm2 += 1.0;  // (E𝓛E)_jj = 1
-    for (int i = j + 1; i < M; ++i) norm2 += 2.0 * L(i, j) * L(i, j) * inverse_diagonal[i] * inverse_diagonal[j];
+    ZWANG_UNROLL
+    for (int i = j + 1; i < M; ++i) norm2 += 2.0 * Lf(i, j) * Lf(i, j) * inverse_diagonal[i] * inverse_diagonal[j];
   }
   MatM W = MatM::Zero();  // C⁻¹, lower
+  ZWANG_UNROLL
   for (int j = 0; j < M; ++j) {
     W(j, j) = inverse_pivot[j];
+    ZWANG_UNROLL
     for (int i = j + 1; i < M; ++i) {
       double x = 0.0;
+      ZWANG_UNROLL
       for (int k = j; k < i; ++k) x += C(i, k) * W(k, j);
       W(i, j) = -x * inverse_pivot[i];
     }
   }
   const MatM inverse = W.transpose() * W;  // 𝓛⁻¹, for κ̃_F only
-  double inverse_norm2 = 0.0;
-  for (int j = 0; j < M; ++j)
-    for (int i = 0; i < M; ++i) inverse_norm2 += inverse(i, j) * inverse(i, j) * L(i, i) * L(j, j);
+  // ‖E⁻¹𝓛⁻¹E⁻¹‖_F² = Σ_ij (𝓛⁻¹)_ij² 𝓛_ii 𝓛_jj, as one vectorised product.
+  const double inverse_norm2 = diagonal.dot(inverse.cwiseAbs2() * diagonal);
   kappa = std::sqrt(norm2 * inverse_norm2);
   if (!(std::isfinite(kappa) && kappa * threshold < 1.0)) return false;
   factor = C;
   // ν by forward and backward substitution with C (more accurate than the
   // explicit inverse when 𝓛 is ill-conditioned).
   Eigen::Matrix<double, M, 1> x = r;
+  ZWANG_UNROLL
   for (int i = 0; i < M; ++i) {
+    ZWANG_UNROLL
     for (int k = 0; k < i; ++k) x[i] -= C(i, k) * x[k];
     x[i] *= inverse_pivot[i];
   }
+  ZWANG_UNROLL
   for (int i = M - 1; i >= 0; --i) {
+    ZWANG_UNROLL
     for (int k = i + 1; k < M; ++k) x[i] -= C(k, i) * x[k];
     x[i] *= inverse_pivot[i];
   }

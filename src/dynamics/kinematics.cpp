@@ -1,5 +1,7 @@
 #include "zwang/kinematics.hpp"
 
+#include <cmath>
+
 #include "dynamics/checks.hpp"
 #include "dynamics/sweeps.hpp"
 
@@ -15,16 +17,29 @@ ZWANG_ALWAYS_INLINE void motionSubspace(bool rotation, const Vec3& a, const Vec3
   S.tail<3>() = rotation ? a : Vec3::Zero();
 }
 
+// ʲX_parent(q) of a one-DOF joint: Joint::transform(double)'s expression, with
+// the products of the placement the model precomputed (Model::OneDofTransform).
+ZWANG_ALWAYS_INLINE Transform jointTransform(const Joint& joint, const Model::OneDofTransform& form, double q) {
+  if (joint.type == JointType::Prismatic) return joint.transform(q);
+  const double s = std::sin(q), c = std::cos(q);
+  Transform X;
+  for (int k = 0; k < 3; ++k)
+    X.E.col(k) =
+        c * joint.placement.E.col(k) - s * form.axis_cross.col(k) + ((1.0 - c) * form.axis_dot[k]) * joint.axis;
+  X.r = joint.placement.r;
+  return X;
+}
+
 // A one-DOF joint (most joints, so the hot path): its body's pose, S,
 // inertia, velocity, bias acceleration and bias force in one step.
 template <bool kInertia, bool kVelocity>
-ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint,
+ZWANG_ALWAYS_INLINE void oneDofKinematics(const Model& model, const Joint& joint, const Model::OneDofTransform& form,
                                           const Eigen::Ref<const Eigen::VectorXd>& q,
                                           const Eigen::Ref<const Eigen::VectorXd>& qd, WorkspaceScratch& sw) {
   const int i = joint.v_index + 1;
   const auto b = static_cast<std::size_t>(i);
   const auto p = static_cast<std::size_t>(model.parent(i));
-  const Transform& X = sw.Xworld[b] = joint.transform(q[joint.q_index]) * sw.Xworld[p];  // line 4: ⁱX₀
+  const Transform& X = sw.Xworld[b] = jointTransform(joint, form, q[joint.q_index]) * sw.Xworld[p];  // line 4: ⁱX₀
   Vec6& S = sw.S[b];
   motionSubspace(joint.isRevolute(), X.E.transpose() * joint.axis, X.r, S);  // the axis in the world
   if (kInertia) sw.I[b] = spatial::inverseTransformInertia(X, model.inertia(i));
@@ -93,11 +108,13 @@ void multiDofKinematics(const Model& model, const Joint& joint, const Eigen::Ref
 template <bool kInertia, bool kVelocity>
 ZWANG_FLATTEN void kinematicsOfJoints(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                                       const Eigen::Ref<const Eigen::VectorXd>& qd, WorkspaceScratch& sw) {
+  const Model::OneDofTransform* form = model.oneDofTransforms().data();
   for (const Joint& joint : model.allJoints()) {
     if (joint.nv() == 1)
-      oneDofKinematics<kInertia, kVelocity>(model, joint, q, qd, sw);
+      oneDofKinematics<kInertia, kVelocity>(model, joint, *form, q, qd, sw);
     else
       multiDofKinematics<kInertia, kVelocity>(model, joint, q, qd, sw);
+    ++form;
   }
 }
 

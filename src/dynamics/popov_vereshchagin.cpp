@@ -270,19 +270,54 @@ void outwardSweep(const Model& model, const Task& task, const VectorRef& q, cons
 
 namespace {
 
-// Lines 19–21 for DOF body i, one constraint column of its subtree at a time:
+// constraintColumns on a block of K ≤ 6 columns [first, first + K), K fixed:
+// on so few columns, loops of run-time length cost more than their
+// arithmetic. 𝓛's block takes the whole outer product (its upper triangle is
+// never read), the same products as the loops'.
+template <int K, bool kBalance, bool kBias>
+ZWANG_ALWAYS_INLINE void constraintColumnsBlock(int i, int first, double u_D, WorkspaceScratch& sw) {
+  using ColumnK = Eigen::Matrix<double, K, 1>;
+  const Vec6& S = sw.S[at(i)];
+  const Vec6& IAS = sw.IAS[at(i)];
+  const Vec6& c = sw.c[at(i)];
+  const double inverse_D = sw.inverse_D[at(i)];
+  const double SS_D = S.squaredNorm() * inverse_D;
+  ColumnK sA;
+  for (int k = 0; k < K; ++k) {
+    const Eigen::Map<const Vec6> A(&sw.Ahat(0, first + k));
+    sA[k] = S.dot(A);                                                 // (Sᵀ A_i)ᵀ
+    sw.L_scale[first + k] += SS_D * A.squaredNorm();                  // what rounding of sA² / D is relative to
+    sw.U[first + k] += kBias ? A.dot(c) + sA[k] * u_D : sA[k] * u_D;  // line 20: Aᵀ Ẍ_bias + Aᵀ S D⁻¹ u
+  }
+  sw.SA.col(i).template segment<K>(first) = sA;
+  for (int k = 0; k < K; ++k) {
+    const double sA_D = sA[k] * inverse_D;
+    if (kBalance) sw.L.col(first + k).template segment<K>(first) += sA * sA_D;  // line 21 (sign: see top)
+    Eigen::Map<Vec6>(&sw.Ahat(0, first + k)) -= IAS * sA_D;                     // line 19: A_{parent} = P^A A_i
+  }
+}
+
+// Lines 19–21 for DOF body i, one constraint column of its subtree [first, columns_end) at a time:
 // (SᵀA_i)ᵀ, U (line 20), 𝓛 (line 21, lower triangle; without kBalance,
 // jointBalanceUpdate adds a joint's DOFs at once) and
 // A_parent = P^A A_i (line 19). Without kBias, Ẍ_bias,i = 0 (a multi-DOF
 // joint's bodies before its last) and line 20 skips Aᵀ Ẍ_bias.
 template <bool kBalance, bool kBias>
-inline void constraintColumnsStep(const Task& task, int i, double u_D, WorkspaceScratch& sw) {
+void constraintColumns(int i, int first, int columns_end, double u_D, WorkspaceScratch& sw) {
   ConstraintMatrix& A = sw.Ahat;
   const Vec6& S = sw.S[at(i)];
   const Vec6& IAS = sw.IAS[at(i)];
   const Vec6& c = sw.c[at(i)];
   const double inverse_D = sw.inverse_D[at(i)];
-  const int first = solverOrder(task).firstColumn(i), columns_end = solverOrder(task).columnsEnd(i);
+  switch (columns_end - first) {
+    case 1: return constraintColumnsBlock<1, kBalance, kBias>(i, first, u_D, sw);
+    case 2: return constraintColumnsBlock<2, kBalance, kBias>(i, first, u_D, sw);
+    case 3: return constraintColumnsBlock<3, kBalance, kBias>(i, first, u_D, sw);
+    case 4: return constraintColumnsBlock<4, kBalance, kBias>(i, first, u_D, sw);
+    case 5: return constraintColumnsBlock<5, kBalance, kBias>(i, first, u_D, sw);
+    case 6: return constraintColumnsBlock<6, kBalance, kBias>(i, first, u_D, sw);
+    default: break;
+  }
   double* sA = sw.SA.col(i).data();
   const double SS_D = S.squaredNorm() * inverse_D;
   for (int col = first; col < columns_end; ++col) {
@@ -297,6 +332,14 @@ inline void constraintColumnsStep(const Task& task, int i, double u_D, Workspace
       for (int r = col; r < columns_end; ++r) L_col[r] += sA[r] * sA_D;
     A.col(col) -= IAS * sA_D;  // line 19: A_{parent} = P^A A_i
   }
+}
+
+// Lines 19–21 for DOF body i: nothing to do on a body whose subtree has no
+// constraint column (most bodies of most tasks, so checked inline).
+template <bool kBalance, bool kBias>
+ZWANG_ALWAYS_INLINE void constraintColumnsStep(const Task& task, int i, double u_D, WorkspaceScratch& sw) {
+  const int first = solverOrder(task).firstColumn(i), columns_end = solverOrder(task).columnsEnd(i);
+  if (columns_end > first) constraintColumns<kBalance, kBias>(i, first, columns_end, u_D, sw);
 }
 
 // Line 21 for a joint of several DOFs, after its steps: 𝓛 += Σ_k (SᵀA_k)ᵀ
@@ -356,6 +399,28 @@ inline Status pivot(const Model& model, int i, WorkspaceScratch& sw) {
   return {};
 }
 
+// M += I's 6×6 matrix [m·1  −h×; h×  Ī], entry by entry (RigidInertia::addTo
+// forms the two skew matrices first).
+ZWANG_ALWAYS_INLINE void addInertia(const RigidInertia& I, Mat6& M) {
+  const double m = I.mass, hx = I.h.x(), hy = I.h.y(), hz = I.h.z();
+  M(0, 0) += m;
+  M(1, 1) += m;
+  M(2, 2) += m;
+  M(0, 4) += hz;
+  M(0, 5) -= hy;
+  M(1, 3) -= hz;
+  M(1, 5) += hx;
+  M(2, 3) += hy;
+  M(2, 4) -= hx;
+  M(3, 1) -= hz;
+  M(3, 2) += hy;
+  M(4, 0) += hz;
+  M(4, 2) -= hx;
+  M(5, 0) -= hy;
+  M(5, 1) += hx;
+  M.bottomRightCorner<3, 3>() += I.Ibar;
+}
+
 // Lines 16–18: the parent p gets I^a = I^A − Σ I^A S D⁻¹ Sᵀ I^A over the
 // joint's DOF bodies [first, last] and F^a = p^A + Σ I^A S D⁻¹ u. The first
 // child to arrive (the last in depth-first order: its subtree ends where p's
@@ -370,7 +435,7 @@ inline void passToParent(const Model& model, int first, int last, const Mat6& IA
   const Vec6 IAS_D = IAS * sw.inverse_D[at(last)];
   if (model.subtreeEnd(last) == model.subtreeEnd(p)) {
     IA_parent.noalias() = IA - IAS.lazyProduct(IAS_D.transpose());  // one fused pass
-    sw.I[at(p)].addTo(IA_parent);
+    addInertia(sw.I[at(p)], IA_parent);
     FA_parent = sw.Fbias[at(p)] + pA + IAS_D * sw.u[at(last)];
   } else {
     IA_parent.noalias() += IA - IAS.lazyProduct(IAS_D.transpose());
@@ -429,7 +494,7 @@ inline void passRigidly(const Model& model, int i, const Mat6& IA, const Vec6& p
   Vec6& FA_parent = sw.FA[at(p)];
   if (model.subtreeEnd(i) == model.subtreeEnd(p)) {
     IA_parent = IA;
-    sw.I[at(p)].addTo(IA_parent);
+    addInertia(sw.I[at(p)], IA_parent);
     FA_parent = sw.Fbias[at(p)] + pA;
   } else {
     IA_parent += IA;
@@ -475,7 +540,8 @@ Status inwardJoints(const Model& model, const Task& task, const VectorRef& tau, 
   for (int i = model.nv(); i >= 1;) {
     const int first = model.jointStart(i);
     if (model.subtreeEnd(i) == i + 1) {  // a leaf: lines 8–9, I^A = I, F^A = F_bias
-      sw.IA[at(i)] = sw.I[at(i)].matrix();
+      sw.IA[at(i)].setZero();
+      addInertia(sw.I[at(i)], sw.IA[at(i)]);
       sw.FA[at(i)] = sw.Fbias[at(i)];
     }
     if (kPrescribed && anyPrescribed(sw, first, i)) {
@@ -610,9 +676,10 @@ void outwardBodies(const Model& model, const Task& task, WorkspaceScratch& sw, E
       qdd[i - 1] = prescribedAcceleration(sw, i - 1);
     } else {
       const int first = solverOrder(task).firstColumn(i), column_count = solverOrder(task).columnsEnd(i) - first;
-      const double constraint =
-          sw.SA.col(i).segment(first, column_count).dot(sw.nu_columns.segment(first, column_count));  // Sᵀ A_i ν
-      qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];    // line 28
+      const double constraint =  // Sᵀ A_i ν; most bodies have no column
+          column_count == 0 ? 0.0
+                            : sw.SA.col(i).segment(first, column_count).dot(sw.nu_columns.segment(first, column_count));
+      qdd[i - 1] = (sw.u[at(i)] - sw.IAS[at(i)].dot(a_parent) + constraint) * sw.inverse_D[at(i)];  // line 28
     }
     a_previous = sw.a[at(i)] = a_parent + sw.S[at(i)] * qdd[i - 1] + sw.c[at(i)];  // line 29
   }
@@ -637,7 +704,8 @@ void bodyAccelerations(const Model& model, const Task& task, Workspace& ws, cons
 
 Vec6 baseClassicalAcceleration(const Model& model, const Workspace& ws) {
   const WorkspaceScratch& sw = scratchOf(ws);
-  const auto b = at(model.baseBody());  // the world's, zero, on a fixed base
+  if (!model.hasFloatingBase()) return Vec6::Zero();  // the world's
+  const auto b = at(model.baseBody());
   return classicalAtPoint(sw.a[b] - sw.a_world, sw.v[b], sw.Xworld[b].r);
 }
 
@@ -1067,7 +1135,8 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
   // function; the gravity-shifted sweep's version differs by a constant):
   // Σ_i ½ aᵢᵀIᵢaᵢ + (F_bias,i − I_i[g; 0])ᵀaᵢ + Σ_j ½ d_j q̈_j² − τ_j q̈_j,
   // in 3-vector pieces: with y = ½a + [−g; 0] = [y_l; y_a] and a = [a_l; α],
-  // I y = [m y_l − h × y_a; h × y_l + Ī y_a].
+  // aᵀI y = m a_l·y_l + h·((a_l − g) × α) + ½ αᵀĪα (the two moments of h
+  // are one triple product; Ī symmetric).
   const Vec3& g = task.gravity;
   const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
   double Z = 0.0;
@@ -1077,10 +1146,13 @@ double gaussFunction(const Model& model, const Task& task, const VectorRef& qdd,
     const Vec3 a_lin = a_sweep.head<3>() + g;  // true acceleration: sweep − [−g; 0]
     const Vec3 alpha = a_sweep.tail<3>();
     const Vec3 y_lin = 0.5 * a_lin - g;
-    const Vec3 y_ang = 0.5 * alpha;
     const Vec6& F = sw.Fbias[at(i)];
-    Z += a_lin.dot(I.mass * y_lin - I.h.cross(y_ang) + F.head<3>()) +
-         alpha.dot(I.h.cross(y_lin) + I.Ibar * y_ang + F.tail<3>());
+    const Mat3& J = I.Ibar;
+    const double half_aIa =
+        0.5 * (J(0, 0) * alpha[0] * alpha[0] + J(1, 1) * alpha[1] * alpha[1] + J(2, 2) * alpha[2] * alpha[2]) +
+        J(1, 0) * alpha[0] * alpha[1] + J(2, 0) * alpha[0] * alpha[2] + J(2, 1) * alpha[1] * alpha[2];
+    Z +=
+        a_lin.dot(I.mass * y_lin + F.head<3>()) + I.h.dot((a_lin - g).cross(alpha)) + half_aIa + alpha.dot(F.tail<3>());
     const double qdd_i = qdd[i - 1];
     Z += (0.5 * rotor_inertia[i - 1] * qdd_i - tau[i - 1]) * qdd_i;
   }

@@ -495,6 +495,20 @@ void appendDofs(const Joint& joint, int index, std::vector<Dof>& dofs) {
 }
 }  // namespace
 
+namespace {
+// The products of Joint::transform(double) that depend on the placement alone (Model::OneDofTransform).
+Model::OneDofTransform oneDofTransform(const Joint& joint) {
+  Model::OneDofTransform form;
+  if (!joint.isRevolute()) return form;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 e = joint.placement.E.col(k);
+    form.axis_cross.col(k) = joint.axis.cross(e);
+    form.axis_dot[k] = joint.axis.dot(e);
+  }
+  return form;
+}
+}  // namespace
+
 void ModelBuilder::layOutBodies(Model& model) {
   // The root joint of a floating base: unactuated, frictionless, no limits.
   model.root_.clear();
@@ -538,6 +552,8 @@ void ModelBuilder::layOutBodies(Model& model) {
   if (model.root_.empty()) model.inertias_[0] = model.link_inertias_[0];
   model.nq_ = nq;
   model.nv_ = nv;
+  model.one_dof_transforms_.clear();
+  for (const Joint& joint : model.all_joints_) model.one_dof_transforms_.push_back(oneDofTransform(joint));
   model.rotor_inertia_.resize(nv);
   for (int k = 0; k < nv; ++k) model.rotor_inertia_[k] = model.dofs_[static_cast<std::size_t>(k)].rotor_inertia;
   std::copy(model.all_joints_.begin() + static_cast<std::ptrdiff_t>(model.root_.size()), model.all_joints_.end(),

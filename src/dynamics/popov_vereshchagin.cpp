@@ -500,7 +500,7 @@ inline void passRigidly(const Model& model, int i, const Mat6& IA, const Vec6& p
     IA_parent += IA;
     FA_parent += pA;
   }
-  FA_parent.noalias() += IA * (sw.S[at(i)] * y);
+  if (y != 0.0) FA_parent.noalias() += IA * (sw.S[at(i)] * y);  // a locked DOF (y = 0: a sticking joint) adds none
 }
 
 // A joint some of whose DOFs are prescribed (bodies [first, last]): its DOF steps one at a time, from the last —

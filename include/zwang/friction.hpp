@@ -28,6 +28,7 @@
 
 namespace zwang {
 
+/// Options of solveWithFriction; the defaults suit most uses.
 struct FrictionOptions {
   double velocity_tolerance = 1e-6;  ///< |q̇| at or below it: stuck [rad/s or m/s]
   double limit_tolerance = 1e-9;     ///< |q − limit| at or below it: on the limit [rad or m]

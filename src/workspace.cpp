@@ -38,6 +38,7 @@ WorkspaceScratch::WorkspaceScratch(const Model& model, int columns, int m) {
   row_error.setZero(m);
   row_size.setZero(m);
   balance_factorisation.factor.setZero(m, m);
+  balance_factorisation.pivots.setZero(m);
   balance_factorisation.eigenvalues.setZero(m);
   balance_factorisation.gain.setZero(m);
   balance_factorisation.equilibration.setZero(m);

@@ -152,6 +152,54 @@ FloatingFrictionDraw randomFloatingFrictionDraw(std::mt19937_64& rng) {
   return d;
 }
 
+// Standing still on contacts with every joint stuck (the humanoid's case on a small tree): 2–6 joints, all stuck
+// (q̇ = 0 everywhere, inside the limits), friction as drawFriction, and two feet on distinct links (3 or 6 world rows
+// each, b = 0). Locked, the robot is one rigid body on 6–12 rows: the balance loses rank wherever the feet give more
+// rows than the base has coordinates, and μ is free along the ground's internal forces.
+FloatingFrictionDraw randomStandingDraw(std::mt19937_64& rng) {
+  RandomFloatingOptions options;
+  options.chain.min_moving_joints = 2;
+  options.chain.max_moving_joints = 6;
+  options.tree.min_moving_joints = 2;
+  options.tree.max_moving_joints = 6;
+  options.max_constraint_rows = 0;
+  FloatingFrictionDraw d;
+  d.problem = randomFloatingProblem(rng, options);
+  const ChainSpec& spec = d.problem.spec;
+  const int n = spec.dof();
+  if (n == 0 || spec.links.size() < 2) return d;
+  FloatingInput& in = d.problem.input;
+  in.constraints.clear();
+  drawJointState(rng, d);
+  const std::vector<int> moving = spec.movingJoints();
+  for (int j = 0; j < n; ++j) {  // off the limits drawJointState may have put it on
+    const JointSpec& joint = spec.joints[static_cast<std::size_t>(moving[static_cast<std::size_t>(j)])];
+    if (d.setup.limit_side(j) != 0)
+      in.q(d.problem.base.baseConfigurationSize() + j) = 0.5 * (joint.lower + joint.upper);
+  }
+  d.setup.limit_side.setZero();
+  d.on_limit = false;
+  d.setup.stuck.resize(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) d.setup.stuck[static_cast<std::size_t>(j)] = j;
+  in.v.setZero();
+  drawFriction(rng, d);
+  const int first = uniformInt(rng, 0, static_cast<int>(spec.links.size()) - 1);
+  int second = uniformInt(rng, 0, static_cast<int>(spec.links.size()) - 2);
+  second += second >= first ? 1 : 0;
+  for (const int link : {first, second}) {
+    ConstraintInput c;
+    c.link = spec.links[static_cast<std::size_t>(link)].name;
+    const int rows = uniform01(rng) < 0.5 ? 3 : 6;
+    c.A = Matrix6Xd::Identity(6, rows);
+    c.b = Eigen::VectorXd::Zero(rows);
+    c.axes = Axes::World;
+    c.contact = true;
+    in.constraints.push_back(c);
+    d.contact_rows += rows;
+  }
+  return d;
+}
+
 // The state a stuck joint must have, from the reference's q̈* (unique) and μ*
 // (when unique); -1 when the reference itself sits within rounding of a
 // boundary between two states (not compared).
@@ -186,13 +234,21 @@ struct Tally {
   int compared = 0, draws = 0, ill_posed = 0, ambiguous = 0, infeasible = 0, free = 0, planar = 0;
   int with_frame_rows = 0, with_joint_rows = 0, with_contacts = 0, without_rows = 0, on_limit = 0;
   int unique = 0, indeterminate = 0, indeterminate_flagged = 0, least_effort_compared = 0,
-      least_effort_with_contacts = 0, least_effort_shared = 0, stuck = 0, states_skipped = 0;
+      least_effort_with_contacts = 0, least_effort_shared = 0, least_norm_compared = 0, least_norm_by_search = 0,
+      stuck = 0, states_skipped = 0;
   int by_joints[7] = {0, 0, 0, 0, 0, 0, 0};
   int states[5] = {0, 0, 0, 0, 0};
   int most_patterns = 0;
   double e_qdd = 0, e_g = 0, e_mu = 0, e_nu = 0, e_tau = 0, e_kinetic = 0;
-  double e_maximiser_qdd = 0, e_maximiser_g = 0, e_box = 0, e_effort = 0, effort_excess = 0;
+  double e_maximiser_qdd = 0, e_maximiser_g = 0, e_box = 0, e_effort = 0, effort_excess = 0, e_least_norm = 0;
 };
+
+// Every row a contact: τ_control = τ on every maximiser, and the choice is the smallest μ.
+bool contactsOnly(const FloatingFrictionDraw& d) {
+  for (const ConstraintInput& c : d.problem.input.constraints)
+    if (!c.contact) return false;
+  return d.contact_rows > 0;
+}
 
 // What is unique when μ* is: μ*, ν, τ_control.
 void compareUnique(const Workspace& ws, const FrictionReference& ref, Tally& t) {
@@ -263,6 +319,14 @@ void compareIndeterminate(const FloatingFrictionDraw& d, const Workspace& ws, co
   t.indeterminate_flagged += ws.friction.indeterminate ? 1 : 0;
   if (d.on_limit) return;  // a limit leaves the set unbounded: no least-effort point to compare
   compareLeastEffort(d, ws, ref, t);
+  if (!contactsOnly(d)) return;
+  const LeastEffort smallest = leastNormMaximiser(ref, d.problem.base.baseVelocitySize());
+  INFO("smallest maximiser: zwang mu " << ws.friction.mu.transpose() << ", reference " << smallest.mu.transpose());
+  const double en = relativeError(ws.friction.mu, smallest.mu);
+  CHECK(en < 1e-7);  // as the least-effort pick: two small least-norm problems on quantities good to ~1e-12
+  t.e_least_norm = std::max(t.e_least_norm, en);
+  ++t.least_norm_compared;
+  t.least_norm_by_search += ws.friction.method == FrictionMethod::StickPatterns ? 1 : 0;
 }
 
 void compareStates(const FloatingFrictionDraw& d, const Workspace& ws, const FrictionReference& ref, bool mu_unique,
@@ -388,14 +452,15 @@ TEST_CASE("floating trees: friction matches the brute-force enumeration of stick
       "  mu* unique in %d: mu %.2e, nu %.2e, tau_control %.2e\n"
       "  mu* not unique (or pinned) in %d (flagged indeterminate %d): zwang's mu gives qdd* %.2e and g* %.2e in the dense reference, "
       "|mu| beyond f %.2e; least effort (%d bounded, %d with contacts, %d sharing the load): tau_control %.2e, norm "
-      "excess %.2e\n"
+      "excess %.2e; smallest mu where every row is a contact (%d, %d by the pattern search): %.2e\n"
       "  states: moving %d, stick %d, slip+ %d, slip- %d, at-limit %d (%d stuck, %d at a boundary not compared)\n",
       t.compared, t.draws, t.ill_posed, t.ambiguous, t.free, t.planar, t.by_joints[1], t.by_joints[2], t.by_joints[3],
       t.by_joints[4], t.by_joints[5], t.by_joints[6], t.with_frame_rows, t.with_joint_rows, t.with_contacts,
       t.without_rows, t.on_limit, t.infeasible, t.most_patterns, t.e_qdd, t.e_g, t.e_kinetic, t.unique, t.e_mu, t.e_nu,
       t.e_tau, t.indeterminate, t.indeterminate_flagged, t.e_maximiser_qdd, t.e_maximiser_g, t.e_box,
       t.least_effort_compared, t.least_effort_with_contacts, t.least_effort_shared, t.e_effort, t.effort_excess,
-      t.states[0], t.states[1], t.states[2], t.states[3], t.states[4], t.stuck, t.states_skipped);
+      t.least_norm_compared, t.least_norm_by_search, t.e_least_norm, t.states[0], t.states[1], t.states[2], t.states[3],
+      t.states[4], t.stuck, t.states_skipped);
   CHECK(t.free > 60);
   CHECK(t.planar > 60);
   CHECK(t.with_joint_rows > 30);
@@ -479,6 +544,58 @@ FloatingFrictionDraw sharedLoadDraw(std::mt19937_64& rng) {
 }
 
 }  // namespace
+
+TEST_CASE("floating trees standing on two feet, every joint stuck: the smallest maximiser, against brute force",
+          "[floating][friction]") {
+  // The automatic choice (the active set: few stuck joints) and the pattern search forced, which takes the smallest
+  // μ along the balance's null directions itself (docs/friction.md, "The pattern search").
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
+  std::mt19937_64 rng(2811);
+  Tally t;
+  while (t.compared < 150) {
+    REQUIRE(++t.draws < 3000);
+    FloatingFrictionDraw d = randomStandingDraw(rng);
+    if (d.contact_rows == 0) continue;
+    const FloatingResult dense = floatingDynamics(d.problem.spec, d.problem.base, d.problem.input);
+    if (!wellPosed(dense)) {
+      ++t.ill_posed;
+      continue;
+    }
+    const FrictionReference ref = bruteForceFloatingFriction(d.problem.spec, d.problem.base, d.problem.input, d.setup);
+    if (!ref.feasible || ref.qdd_spread > 1e-9) {  // no maximiser, or the reference cannot tell q̈* apart
+      ++t.ambiguous;
+      continue;
+    }
+    d.options.method = method;
+    const LibraryRun run(d);
+    INFO("draw " << t.draws << ": " << toString(d.problem.base.kind) << " base, " << run.model.dof() << " joints, "
+                 << d.contact_rows << " contact rows, reference pattern " << ref.pattern << " of " << ref.valid_patterns
+                 << " valid; status: " << run.status.message);
+    REQUIRE(run.status);
+    countDraw(d, ref, t);
+    const Workspace& ws = run.ws;
+    const double eq = relativeError(ws.solution.qdd, ref.qdd);
+    CHECK(eq < 1e-8);  // as the test above
+    t.e_qdd = std::max(t.e_qdd, eq);
+    const bool spread = ref.mu_spread > 1e-9 * (1.0 + d.setup.breakaway.maxCoeff());
+    const bool mu_unique = !spread && !ref.pinned;
+    if (spread) CHECK(ws.friction.indeterminate);
+    compareStates(d, ws, ref, mu_unique, t);
+    if (mu_unique)
+      compareUnique(ws, ref, t);
+    else
+      compareIndeterminate(d, ws, ref, t);
+  }
+  std::printf(
+      "floating trees standing on two feet, every joint stuck (%s): %d compared (%d draws; %d ill-posed, %d without a "
+      "maximiser or ambiguous); max rel. error qdd %.2e; mu* unique in %d (mu %.2e); not unique in %d (flagged %d): "
+      "the smallest mu in %d (%d by the pattern search) to %.2e\n",
+      toString(method), t.compared, t.draws, t.ill_posed, t.ambiguous, t.e_qdd, t.unique, t.e_mu, t.indeterminate,
+      t.indeterminate_flagged, t.least_norm_compared, t.least_norm_by_search, t.e_least_norm);
+  CHECK(t.least_norm_compared > 30);
+  if (method == FrictionMethod::StickPatterns) CHECK(t.least_norm_by_search > 20);
+}
 
 TEST_CASE("floating trees: the least-effort pick where contacts share the load, against brute force",
           "[floating][friction]") {

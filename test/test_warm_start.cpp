@@ -210,6 +210,88 @@ TEST_CASE("warm start: when μ* is not unique the full solve chooses, every time
   }
 }
 
+// The humanoid standing on both feet (contacts only) with every joint stuck: locked, the robot is one rigid body on
+// 12 contact rows, so the ground's split between the feet and with it μ is free along 6 directions. The pattern
+// search takes the smallest μ there (docs/friction.md, "The pattern search"); it must be the full solve's choice,
+// cold and warm, with the same report. The full solve's choice is checked against brute force on small floating
+// trees (test_floating_friction, "smallest mu where every row is a contact"); 29 stuck joints are beyond brute force.
+TEST_CASE("feet on the ground with every joint stuck: the pattern search's smallest μ is the full solve's",
+          "[warm_start][friction][floating]") {
+  UrdfOptions options;
+  options.base = BaseType::Free;
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/simple_humanoid.urdf", options);
+  REQUIRE(model.dof() == 29);
+  Task task(model);
+  for (const char* foot : {"l_ankle", "r_ankle"})
+    task.addContact(foot, ConstraintMatrix::Identity(6, 6), Expressed::World);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq());
+  q[3] = 1.0;  // upright; knees bent as the bench's humanoid (hip pitch + knee + ankle pitch = 0: soles level)
+  for (const char* side : {"RLEG_", "LLEG_"})
+    for (const auto& [joint, value] : {std::pair{"HIP_P", -0.3}, std::pair{"KNEE", 0.25}, std::pair{"ANKLE_P", 0.05}})
+      q[7 + model.jointIndex(std::string(side) + joint)] = value;
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(model.nv());
+  Workspace cold(model, task), full(model, task), warm(model, task);
+  std::mt19937_64 rng(2811);
+  int searched = 0, indeterminate = 0, slipping = 0, all_sticking = 0;
+  double e_qdd = 0.0, e_mu = 0.0, e_nu = 0.0, e_tau = 0.0;
+  Eigen::VectorXd tau = Eigen::VectorXd::Zero(model.nv());
+  for (int draw = 0; draw < 60; ++draw) {
+    INFO("draw " << draw);
+    FrictionOptions fo;  // mostly friction that holds every joint (gravity asks up to some 300 N·m); every fourth
+    // draw weak enough for some joints to slip
+    fo.breakaway = randomVector(rng, model.dof(), 1.0).cwiseAbs() * (draw % 4 == 3 ? 20.0 : 300.0);
+    fo.breakaway.array() += draw % 4 == 3 ? 2.0 : 300.0;
+    if (draw % 10 == 0) tau.tail(model.dof()) = randomVector(rng, model.dof(), 10.0);
+    tau.tail(model.dof()) += randomVector(rng, model.dof(), 0.5);  // the next cycle: τ moved a little
+    FrictionOptions reference = fo;
+    reference.method = FrictionMethod::ActiveSet;
+    REQUIRE(solveWithFriction(model, full, q, rest, tau, task, reference));
+    REQUIRE(solveWithFriction(model, cold, q, rest, tau, task, fo));
+    fo.warm_start = true;
+    REQUIRE(solveWithFriction(model, warm, q, rest, tau, task, fo));
+    searched += cold.friction.method == FrictionMethod::StickPatterns ? 1 : 0;
+    searched += warm.friction.method == FrictionMethod::StickPatterns ? 1 : 0;
+    indeterminate += full.friction.indeterminate ? 1 : 0;
+    const auto slips = std::count_if(full.friction.state.begin(), full.friction.state.end(), [](JointState s) {
+      return s == JointState::SlipPositive || s == JointState::SlipNegative;
+    });
+    slipping += slips > 0 ? 1 : 0;
+    all_sticking += slips == 0 ? 1 : 0;
+    for (const Workspace* ws : {&cold, &warm}) {
+      INFO((ws == &cold ? "cold" : "warm") << ", answered by " << toString(ws->friction.method));
+      const double eq = (ws->solution.qdd - full.solution.qdd).cwiseAbs().maxCoeff() /
+                        (1.0 + full.solution.qdd.cwiseAbs().maxCoeff());
+      const double em = relativeError(ws->friction.mu, full.friction.mu);
+      const double en = relativeError(ws->solution.nu, full.solution.nu);
+      const double et = relativeError(ws->solution.tau_control, full.solution.tau_control);
+      CHECK(eq < 1e-9);  // the sweeps' rounding of the same motion
+      CHECK(em < 1e-7);  // two least-norm problems on quantities good to ~1e-12, as test_floating_friction's
+      CHECK(en < 1e-7);
+      CHECK(et < 1e-7);
+      CHECK(ws->friction.indeterminate == full.friction.indeterminate);
+      CHECK(ws->friction.state == full.friction.state);
+      CHECK(ws->solution.balance.rank == full.solution.balance.rank);
+      CHECK(ws->solution.balance.nu_unique == full.solution.balance.nu_unique);
+      CHECK(ws->solution.balance.singular == full.solution.balance.singular);
+      CHECK(ws->solution.balance.consistent == full.solution.balance.consistent);
+      e_qdd = std::max(e_qdd, eq);
+      e_mu = std::max(e_mu, em);
+      e_nu = std::max(e_nu, en);
+      e_tau = std::max(e_tau, et);
+    }
+  }
+  std::printf(
+      "humanoid on both feet, every joint stuck: 60 draws (%d indeterminate, %d with a slipping joint, %d with none), %d "
+      "of 120 "
+      "cold and warm solves answered by the pattern search; against the active set: qdd %.2e, mu %.2e, nu %.2e, "
+      "tau_control %.2e\n",
+      indeterminate, slipping, all_sticking, searched, e_qdd, e_mu, e_nu, e_tau);
+  CHECK(indeterminate > 30);
+  CHECK(slipping > 5);
+  CHECK(all_sticking > 30);
+  CHECK(searched > 60);
+}
+
 namespace {
 
 // What the trajectories below went through, and how far the warm answers were from the cold ones.

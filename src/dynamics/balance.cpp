@@ -9,7 +9,12 @@
 //  * a regular 𝓛 (certified: Frobenius condition of 𝓛̃ below
 //    1/singular_threshold) is solved by Cholesky of 𝓛 itself, exactly as the
 //    report's inverse would be;
-//  * a singular 𝓛 is solved on the eigenpairs of 𝓛̃: exact along regular
+//  * a singular 𝓛 whose only loss is exact rank loss beside a certified
+//    regular part (feet on the ground with more rows than the coordinates
+//    that move them) is solved by a Cholesky of 𝓛̃ with diagonal pivoting
+//    (factorByPivots): the same classification and ν as the eigenpairs', at
+//    the cost of a Cholesky;
+//  * any other singular 𝓛 is solved on the eigenpairs of 𝓛̃: exact along regular
 //    directions; across the exact null space the minimum-norm least-squares
 //    solution in the rows' own units: r's component along null(𝓛) is what no
 //    force can meet (dropped before the solve), and ν gets no component along
@@ -172,6 +177,10 @@ bool certifiedSolve(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen::Ref
     default: break;
   }
   if (!cholesky(L, factor)) return false;
+  // A pivot of 𝓛̃'s factor at most the threshold fails the certificate before ‖𝓛̃⁻¹‖_F is formed: the j-th pivot
+  // is 1/(B⁻¹)_jj of the leading j × j block B, at least 1/(𝓛̃⁻¹)_jj, so κ̃_F ≥ ‖𝓛̃‖_F/pivot ≥ 1/pivot.
+  for (Eigen::Index j = 0; j < m; ++j)
+    if (factor(j, j) * factor(j, j) <= threshold * L(j, j)) return false;
   auto e = f.equilibration.head(m);
   for (Eigen::Index i = 0; i < m; ++i) e[i] = 1.0 / std::sqrt(L(i, i));  // positive: Cholesky succeeded
   kappa = equilibratedFrobenius(L, e) * equilibratedInverseFrobenius(factor, e, f.work.head(m));
@@ -236,8 +245,8 @@ BalanceReport factorByEigen(Eigen::Ref<Eigen::MatrixXd> L, BalanceFactorisation&
   BalanceReport report;
   report.rows = static_cast<int>(m);
   report.rank = static_cast<int>(m);
-  f.by_eigen = true;
-  double sum_sigma2 = 0.0, sum_inverse2 = 0.0;
+  f.kind = BalanceFactorisation::Kind::Eigen;
+  double sum_sigma2 = 0.0, sum_inverse2 = 0.0, kept_sigma2 = 0.0, kept_inverse2 = 0.0;
   for (Eigen::Index k = 0; k < m; ++k) {
     const double s = std::max(0.0, sigma[k]);  // a rounding-level negative eigenvalue is a zero one
     sigma[k] = s;
@@ -245,6 +254,8 @@ BalanceReport factorByEigen(Eigen::Ref<Eigen::MatrixXd> L, BalanceFactorisation&
     sum_inverse2 += s > 0.0 ? 1.0 / (s * s) : std::numeric_limits<double>::infinity();
     if (s >= options.singular_threshold) {
       f.gain[k] = 1.0 / s;
+      kept_sigma2 += s * s;
+      kept_inverse2 += 1.0 / (s * s);
       continue;
     }
     report.singular = true;
@@ -269,7 +280,116 @@ BalanceReport factorByEigen(Eigen::Ref<Eigen::MatrixXd> L, BalanceFactorisation&
   // when every σ̃ is zero (every row immovable), where the product is 0·∞.
   report.condition =
       std::isinf(sum_inverse2) ? std::numeric_limits<double>::infinity() : std::sqrt(sum_sigma2 * sum_inverse2);
+  f.regular_condition = std::sqrt(kept_sigma2 * kept_inverse2);
   return report;
+}
+
+// With PivotedCholesky: x (m) ← P-ordered solve on the pivoted rows, x's part on the dependent pivots 0; x holds
+// the equilibrated right-hand side in 𝓛's row order on entry and ν̃ in the same order on return.
+void pivotedSolve(const BalanceFactorisation& f, Eigen::Index m, Eigen::Ref<Eigen::VectorXd> x,
+                  Eigen::Ref<Eigen::VectorXd> work) {
+  const auto C = f.factor.topLeftCorner(m, m);
+  const int k = f.rank;
+  for (int i = 0; i < k; ++i) {  // C₁₁ y = x_P
+    double value = x[f.pivots[i]];
+    for (int l = 0; l < i; ++l) value -= C(i, l) * work[l];
+    work[i] = value / C(i, i);
+  }
+  for (int i = k - 1; i >= 0; --i) {  // C₁₁ᵀ z = y
+    double value = work[i];
+    for (int l = i + 1; l < k; ++l) value -= C(l, i) * work[l];
+    work[i] = value / C(i, i);
+  }
+  x.setZero();
+  for (int i = 0; i < k; ++i) x[f.pivots[i]] = work[i];
+}
+
+// Exact rank loss beside a certified regular part, without the eigenpairs. Cholesky of 𝓛̃ with diagonal pivoting
+// stops where the largest diagonal left is at most rank_tolerance/m: the Schur complement S left over is PSD with
+// ‖S‖ ≤ trace S < rank_tolerance, so (Weyl) the m − k directions it leaves are at most that, which the eigenpairs
+// call exact rank loss, while 𝓛̃ ⪰ the rank-k part keeps the other k at least λ_min(B) of the pivoted block B.
+// B is certified as the regular path certifies 𝓛̃ (κ̃_F(B)·threshold < 1, and ‖B‖ ≥ 1 with its unit diagonal): so
+// λ_min(B) > threshold and no direction is near-singular. Then ν = 𝓛⁺ r as the eigenpairs give it: r's part along
+// null(𝓛) dropped, the pivoted rows solved, ν's part along null(𝓛) removed (near_null_basis: E times the null
+// vectors [−C₁₁⁻ᵀC₂₁ᵀ; I] unpermuted, made orthonormal). False, nothing decided, when the pivots prove neither.
+bool factorByPivots(const Eigen::Ref<const Eigen::MatrixXd>& L, const Eigen::Ref<const Eigen::VectorXd>& r,
+                    Eigen::Ref<Eigen::VectorXd> nu, BalanceFactorisation& f, const BalanceOptions& options,
+                    BalanceReport& report) {
+  const Eigen::Index m = L.rows();
+  auto e = f.equilibration.head(m);
+  for (Eigen::Index i = 0; i < m; ++i) e[i] = L(i, i) > 0.0 ? 1.0 / std::sqrt(L(i, i)) : 1.0;  // a zeroed row: 1
+  auto A = f.factor.topLeftCorner(m, m);  // 𝓛̃ in full, pivoted and factored in place
+  for (Eigen::Index j = 0; j < m; ++j)
+    for (Eigen::Index i = j; i < m; ++i) A(j, i) = A(i, j) = L(i, j) * e[i] * e[j];
+  auto pivots = f.pivots.head(m);
+  for (Eigen::Index i = 0; i < m; ++i) pivots[i] = static_cast<int>(i);
+  const double floor = options.rank_tolerance / static_cast<double>(m);
+  Eigen::Index k = 0;
+  for (; k < m; ++k) {
+    Eigen::Index p = k;
+    for (Eigen::Index i = k + 1; i < m; ++i)
+      if (A(i, i) > A(p, p)) p = i;
+    if (!(A(p, p) > floor)) break;
+    A.row(k).swap(A.row(p));
+    A.col(k).swap(A.col(p));
+    std::swap(pivots[k], pivots[p]);
+    const double pivot = std::sqrt(A(k, k));
+    A(k, k) = pivot;
+    for (Eigen::Index i = k + 1; i < m; ++i) A(i, k) /= pivot;
+    for (Eigen::Index j = k + 1; j < m; ++j)
+      for (Eigen::Index i = j; i < m; ++i) A(j, i) = A(i, j) -= A(i, k) * A(j, k);
+  }
+  if (k == m) return false;  // no rank loss: the certificate failed on conditioning, which the eigenpairs damp
+  f.rank = static_cast<int>(k);
+  // κ̃_F(B): ‖B‖_F from 𝓛̃'s entries, ‖B⁻¹‖_F column by column through the factor.
+  double norm2 = 0.0, inverse_norm2 = 0.0;
+  for (Eigen::Index a = 0; a < k; ++a)
+    for (Eigen::Index b = 0; b < k; ++b) {
+      const Eigen::Index i = pivots[a], j = pivots[b];
+      const double entry = (i >= j ? L(i, j) : L(j, i)) * e[i] * e[j];
+      norm2 += entry * entry;
+    }
+  auto column = f.work.head(m);
+  for (Eigen::Index c = 0; c < k; ++c) {
+    for (Eigen::Index i = 0; i < k; ++i) {  // C₁₁ y = e_c
+      double value = i == c ? 1.0 : 0.0;
+      for (Eigen::Index l = c; l < i; ++l) value -= A(i, l) * column[l];
+      column[i] = i < c ? 0.0 : value / A(i, i);
+    }
+    for (Eigen::Index i = k - 1; i >= 0; --i) {  // C₁₁ᵀ x = y
+      double value = column[i];
+      for (Eigen::Index l = i + 1; l < k; ++l) value -= A(l, i) * column[l];
+      column[i] = value / A(i, i);
+    }
+    inverse_norm2 += column.head(k).squaredNorm();
+  }
+  const double kappa = std::sqrt(norm2 * inverse_norm2);
+  if (!(std::isfinite(kappa) && kappa * options.singular_threshold < 1.0)) return false;
+  f.kind = BalanceFactorisation::Kind::PivotedCholesky;
+  f.regular_condition = kappa;
+  // The null directions: for each dependent pivot d, x_d = 1, x on the pivoted rows −C₁₁⁻ᵀ C₂₁ᵀ e_d, ν = E P x.
+  f.near_null_count = static_cast<int>(m - k);
+  for (Eigen::Index d = k; d < m; ++d) {
+    for (Eigen::Index i = k - 1; i >= 0; --i) {
+      double value = -A(d, i);
+      for (Eigen::Index l = i + 1; l < k; ++l) value -= A(l, i) * column[l];
+      column[i] = value / A(i, i);
+    }
+    auto direction = f.near_null_basis.col(d - k).head(m);
+    direction.setZero();
+    for (Eigen::Index i = 0; i < k; ++i) direction[pivots[i]] = e[pivots[i]] * column[i];
+    direction[pivots[d]] = e[pivots[d]];
+    f.near_null_weight[d - k] = 1.0;
+  }
+  orthonormaliseColumns(f.near_null_basis.topLeftCorner(m, f.near_null_count), f.near_null_count);
+  report.rows = static_cast<int>(m);
+  report.rank = static_cast<int>(k);
+  report.nu_unique = false;  // 𝓛 has a null space: ν plus any of it gives the same motion
+  report.singular = true;
+  report.damping = 0.0;
+  report.condition = std::numeric_limits<double>::infinity();
+  balanceApply(f, r, nu, column);
+  return true;
 }
 
 }  // namespace
@@ -278,15 +398,17 @@ BalanceReport solveBalance(Eigen::Ref<Eigen::MatrixXd> L, const Eigen::Ref<const
                            Eigen::Ref<Eigen::VectorXd> nu, BalanceFactorisation& f, const BalanceOptions& options) {
   BalanceReport report;
   report.rows = static_cast<int>(L.rows());
-  f.by_eigen = false;
+  f.kind = BalanceFactorisation::Kind::Cholesky;
   f.near_null_count = 0;
   if (report.rows == 0) return report;
   double kappa = 0.0;
   if (certifiedSolve(L, r, nu, f, options.singular_threshold, kappa)) {
     report.rank = report.rows;
     report.condition = kappa;
+    f.regular_condition = kappa;
     return report;
   }
+  if (factorByPivots(L, r, nu, f, options, report)) return report;
   report = factorByEigen(L, f, options);
   balanceApply(f, r, nu, f.work.head(report.rows));
   return report;
@@ -296,12 +418,21 @@ void balanceApply(const BalanceFactorisation& f, const Eigen::Ref<const Eigen::V
                   Eigen::Ref<Eigen::VectorXd> out, Eigen::Ref<Eigen::VectorXd> work) {
   const Eigen::Index m = r.size();
   out = r;
-  if (!f.by_eigen) {
+  if (f.kind == BalanceFactorisation::Kind::Cholesky) {
     choleskySolveInPlace(f.factor.topLeftCorner(m, m), out);
     return;
   }
   const auto Z = f.near_null_basis.topLeftCorner(m, f.near_null_count);
   const auto w = f.near_null_weight.head(f.near_null_count);
+  if (f.kind == BalanceFactorisation::Kind::PivotedCholesky) {
+    const auto e = f.equilibration.head(m);
+    removeNearNullComponent(Z, w, out);  // r's part along null(𝓛): no force can meet it (least squares)
+    out.array() *= e.array();            // 𝓛̃'s right-hand side; ν = E ν̃
+    pivotedSolve(f, m, out, work);
+    out.array() *= e.array();
+    removeNearNullComponent(Z, w, out);  // minimum norm: no force along null(𝓛)
+    return;
+  }
   const auto V = f.factor.topLeftCorner(m, m);
   const auto e = f.equilibration.head(m);
   removeNearNullComponent(Z, w, out);  // r's part along null(𝓛): no force can meet it (least squares)
@@ -315,7 +446,7 @@ void balanceApply(const BalanceFactorisation& f, const Eigen::Ref<const Eigen::V
 
 void balanceApplyColumns(const BalanceFactorisation& f, const Eigen::Ref<const Eigen::MatrixXd>& R,
                          Eigen::Ref<Eigen::MatrixXd> out, Eigen::Ref<Eigen::VectorXd> work) {
-  if (f.by_eigen) {
+  if (f.kind != BalanceFactorisation::Kind::Cholesky) {
     for (Eigen::Index c = 0; c < R.cols(); ++c) balanceApply(f, R.col(c), out.col(c), work);
     return;
   }

@@ -11,9 +11,17 @@ namespace zwang::internal {
 // The factorisation of the last balance, kept so that further right-hand sides
 // (the friction extension's unit torques) reuse it (src/dynamics/balance.cpp).
 struct BalanceFactorisation {
-  bool by_eigen = false;          // false: 𝓛 = C Cᵀ (certified regular); true: eigenpairs of 𝓛̃
-  Eigen::MatrixXd factor;         // C (lower), or the eigenvectors V of 𝓛̃ (by_eigen)
-  Eigen::VectorXd eigenvalues;    // σ̃_k (by_eigen)
+  enum class Kind {
+    Cholesky,         // 𝓛 = C Cᵀ, certified regular
+    PivotedCholesky,  // Pᵀ 𝓛̃ P = C Cᵀ on its first `rank` pivots, the rest exact rank loss (factorByPivots)
+    Eigen,            // eigenpairs of 𝓛̃
+  };
+  Kind kind = Kind::Cholesky;
+  Eigen::MatrixXd factor;        // C (lower: with PivotedCholesky its first `rank` columns), or the eigenvectors V
+  Eigen::VectorXi pivots;        // PivotedCholesky: the row of 𝓛 at each pivot position
+  int rank = 0;                  // PivotedCholesky: the pivots taken
+  double regular_condition = 1;  // κ̃_F of 𝓛̃ on the directions it solves exactly (∞ never: damped ones excluded)
+  Eigen::VectorXd eigenvalues;    // σ̃_k (Eigen)
   Eigen::VectorXd gain;           // what each eigen-direction is multiplied by: 1/σ̃, damped, or 0
   Eigen::VectorXd equilibration;  // E_ii = 1/√𝓛_ii (1 on a row nothing moves)
   // Orthonormal basis of the directions E v_k with σ̃_k below singular_threshold
@@ -31,6 +39,9 @@ struct BalanceFactorisation {
 //  * Cholesky 𝓛 = C Cᵀ when 𝓛 is certified regular: the Frobenius condition
 //    number of the equilibrated 𝓛̃ = E 𝓛 E, an upper bound of σ̃_max/σ̃_min, is
 //    below 1/singular_threshold. The usual case, O(m³/3).
+//  * Cholesky of 𝓛̃ with diagonal pivoting when that proves exact rank loss
+//    with a certified rest (the rows of feet on the ground beyond the
+//    coordinates that move them): the eigenpairs' answer without them, O(m³/3).
 //  * otherwise the eigenpairs of 𝓛̃, each direction exact, damped or dropped
 //    by its eigenvalue (BalanceOptions), and the projections that make the
 //    solution the minimum-norm least-squares one in the rows' own units.

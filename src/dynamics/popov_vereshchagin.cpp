@@ -929,7 +929,8 @@ void unitTorqueColumns(const Model& model, const Task& task, Workspace& ws, cons
   }
   // A regular 𝓛 on the columns themselves (no relative rows) is solved in the
   // outward pass's lanes, a block of columns at a time; else here, all at once.
-  const bool solve_in_lanes = !solverOrder(task).balanceOnRows() && !sw.balance_factorisation.by_eigen;
+  const bool solve_in_lanes =
+      !solverOrder(task).balanceOnRows() && sw.balance_factorisation.kind == BalanceFactorisation::Kind::Cholesky;
   dU *= -1.0;                               // line 25: δν = 𝓛⁻¹(−δU₀) with the same factorisation
   if (solverOrder(task).balanceOnRows()) {  // on the balance's rows: each the sum of its columns
     const int rows = task.balanceRows();

@@ -458,7 +458,7 @@ void publishPatternSolution(const Model& model, const Task& task, const Eigen::R
   fr.warm_started = from_kept;
   fr.iterations = passes;
   fr.converged = true;
-  fr.indeterminate = false;
+  fr.indeterminate = fs.pattern_indeterminate;
   fr.kkt_residual = 0.0;  // q̈ = 0 on the locked DOFs by construction, μ inside the boxes, the slips' signs checked
   if (fs.sensitivities_written) fr.dqdd_dmu.setZero();
   fs.sensitivities_written = false;

@@ -41,12 +41,17 @@ struct FrictionScratch {
     stuck_dofs.reserve(static_cast<std::size_t>(dof));
     pattern_stuck.reserve(static_cast<std::size_t>(dof));
     pattern_state.reserve(static_cast<std::size_t>(dof));
+    locked_dofs.reserve(static_cast<std::size_t>(dof));
     trial_state.reserve(static_cast<std::size_t>(dof));
     pattern_breaks.assign(static_cast<std::size_t>(dof), 0);
     pattern_modes.assign(static_cast<std::size_t>(nv), DofMode::Torque);
     pattern_qdd.setZero(nv);
     pattern_tau.setZero(nv);
     pattern_residual.setZero(nv);
+    pattern_direction.setZero(nv);
+    free_lambda.setZero(dof, capacity);
+    free_factor.setZero(capacity, capacity);
+    free_step.setZero(capacity);
   }
 
   // The model of friction, per joint (the options' overrides, else the model's)
@@ -91,7 +96,14 @@ struct FrictionScratch {
   Eigen::VectorXd pattern_qdd;            // nv: the task's prescribed accelerations, 0 on the locked DOFs
   Eigen::VectorXd pattern_tau;            // nv: τ_effective with the slipping DOFs' friction bound applied
   Eigen::VectorXd pattern_residual;       // nv: λ of the locked DOFs (prescribedDofResiduals)
-  bool sensitivities_written = false;     // FrictionResult::dqdd_dmu holds columns of the last full solve
+  // Contacts the locks make dependent (smallestFriction): ν free along the balance's null directions n
+  Eigen::VectorXd pattern_direction;   // nv: λ of the locked DOFs from a unit ν along one n
+  Eigen::MatrixXd free_lambda;         // P: locked friction DOFs × nullity, those λ
+  Eigen::MatrixXd free_factor;         // nullity × nullity: R, PᵀP = R Rᵀ
+  Eigen::VectorXd free_step;           // nullity: z, ν moves by N z and λ by P z
+  std::vector<int> locked_dofs;        // the locked friction DOFs as entries of v, in Θ₀ order
+  bool pattern_indeterminate = false;  // the pass's μ was chosen among maximisers (smallestFriction)
+  bool sensitivities_written = false;  // FrictionResult::dqdd_dmu holds columns of the last full solve
 
   // Outputs
   Eigen::VectorXd tau_joint;  // τ − kinetic − μ*: what the joints feel (the Gauss function's torques)

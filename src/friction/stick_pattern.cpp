@@ -79,17 +79,108 @@ int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, 
   return prescribed;
 }
 
+// Whether ν may be left free by the locks (smallestFriction): every row a contact, so that τ_control = τ whatever ν
+// (the full solve's EffortChange::Fixed) and the balance is on the solver's columns (its null basis is ν's).
+bool contactsOnly(const Task& task) {
+  const std::vector<char>& contact = solverOrder(task).contactColumns();
+  if (solverOrder(task).balanceOnRows() || task.solverColumns() == 0) return false;
+  return std::all_of(contact.begin(), contact.begin() + task.solverColumns(), [](char c) { return c != 0; });
+}
+
 // One pass of the sweeps with the pattern's modes, the kinematics done: false when a joint has no inertia to move or
-// the balance is not regular with the sticking DOFs locked (μ* may not be unique: the full solve chooses).
-bool passOfSweeps(const Model& model, const Task& task, Workspace& ws, FrictionScratch& fs) {
+// the balance is not regular with the sticking DOFs locked (μ* may not be unique: the full solve chooses) — except,
+// with free_nu, exact rank loss with every row met (smallestFriction then chooses).
+bool passOfSweeps(const Model& model, const Task& task, bool free_nu, Workspace& ws, FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
   if (!inwardSweep(model, task, fs.pattern_tau, ws)) return false;  // Degenerate: the full solve reports it
   balance(task, ws);
   const BalanceReport& report = ws.solution.balance;
-  if (report.singular || !report.nu_unique) return false;
+  if ((report.singular || !report.nu_unique) && !(free_nu && !report.nu_unique && report.damping == 0.0)) return false;
   outwardAccelerations(model, task, ws, ws.solution.qdd);
+  if (!report.nu_unique) {  // rows the locks made dependent must still be met, or the pattern cannot hold
+    taskResidual(task, ws);
+    if (!report.consistent) return false;
+  }
   const int m = task.solverColumns();
   prescribedDofResiduals(model, task, ws, sw.nu_columns.head(m), ws.solution.qdd, fs.pattern_tau, fs.pattern_residual);
+  return true;
+}
+
+// Contacts the locks make dependent (feet on the ground, every joint sticking: the rigid robot stands on more rows
+// than it has coordinates). The pattern's motion is unique, but ν is free along the balance's null directions n,
+// and with it the locked DOFs' friction: λ = λ₀ + P z, P's columns the λ a unit ν along each n gives (−Sᵀ Σ A n over
+// the subtree). These are the maximisers with this motion, and with every row a contact every one costs the same
+// effort (τ_control = τ): the full solve's choice is the smallest μ = −λ on the sticking DOFs, λ₀'s projection off
+// range(P): λ ← λ₀ + P z, ν ← ν + N z, z = −(PᵀP)⁻¹Pᵀλ₀. False when P's columns are nearly dependent
+// (a contact direction the joints hardly feel: the full solve decides).
+bool smallestFriction(const Model& model, const Task& task, const FrictionResult& fr, Workspace& ws,
+                      FrictionScratch& fs) {
+  // A column of P this close to the span of the others: the balance with the DOFs free would see its rows as
+  // near-singular (σ̃ ~ the square of it against singular_threshold = 1e-6), which the full solve damps.
+  constexpr double kIndependent = 1e-3;
+  WorkspaceScratch& sw = scratchOf(ws);
+  const BalanceFactorisation& f = sw.balance_factorisation;
+  const int m = task.solverColumns(), base_velocity_size = model.baseVelocitySize();
+  const Eigen::Index nullity = f.near_null_count;
+  fs.locked_dofs.clear();  // reserved for every DOF: no allocation
+  for (std::size_t a = 0; a < fr.stuck.size(); ++a)
+    if (locked(fs.trial_state[a])) fs.locked_dofs.push_back(base_velocity_size + fr.stuck[a]);
+  const auto locked_count = static_cast<Eigen::Index>(fs.locked_dofs.size());
+  const int* rows = fs.locked_dofs.data();
+  auto P = fs.free_lambda.topLeftCorner(locked_count, nullity);
+  for (Eigen::Index e = 0; e < nullity; ++e) {
+    prescribedContactTorques(model, task, ws, f.near_null_basis.col(e).head(m), fs.pattern_direction);
+    for (Eigen::Index t = 0; t < locked_count; ++t) P(t, e) = fs.pattern_direction[rows[t]];
+  }
+  // z = −(PᵀP)⁻¹ Pᵀλ₀ by the Cholesky factor R of PᵀP (P's columns are independent to kIndependent, so squaring
+  // their condition costs at most 1e-6 of the rounding the least-norm λ can have), then λ ← λ₀ + P z.
+  auto R = fs.free_factor.topLeftCorner(nullity, nullity);
+  auto z = fs.free_step.head(nullity);
+  for (Eigen::Index c = 0; c < nullity; ++c) {
+    const double* p_c = P.col(c).data();
+    for (Eigen::Index d = 0; d <= c; ++d) {
+      const double* p_d = P.col(d).data();
+      double dot = 0.0;
+      for (Eigen::Index t = 0; t < locked_count; ++t) dot += p_c[t] * p_d[t];
+      R(c, d) = dot;
+    }
+    double along = 0.0;
+    for (Eigen::Index t = 0; t < locked_count; ++t) along += p_c[t] * fs.pattern_residual[rows[t]];
+    z[c] = -along;
+  }
+  for (Eigen::Index c = 0; c < nullity; ++c) {  // R Rᵀ = PᵀP in place (lower); R_cc² is P_c's distance² from the
+    const double length2 = R(c, c);             // span of the columns before it
+    for (Eigen::Index d = 0; d <= c; ++d) {
+      double value = R(c, d);
+      for (Eigen::Index l = 0; l < d; ++l) value -= R(c, l) * R(d, l);
+      if (d < c) {
+        R(c, d) = value / R(d, d);
+      } else {
+        if (!(value > kIndependent * kIndependent * length2)) return false;
+        R(c, c) = std::sqrt(value);
+      }
+    }
+  }
+  for (Eigen::Index c = 0; c < nullity; ++c) {  // R y = −Pᵀλ₀
+    for (Eigen::Index l = 0; l < c; ++l) z[c] -= R(c, l) * z[l];
+    z[c] /= R(c, c);
+  }
+  for (Eigen::Index c = nullity - 1; c >= 0; --c) {  // Rᵀ z = y
+    for (Eigen::Index l = c + 1; l < nullity; ++l) z[c] -= R(l, c) * z[l];
+    z[c] /= R(c, c);
+  }
+  for (Eigen::Index c = 0; c < nullity; ++c) {
+    const double* p_c = P.col(c).data();
+    for (Eigen::Index t = 0; t < locked_count; ++t) fs.pattern_residual[rows[t]] += z[c] * p_c[t];
+  }
+  sw.nu_columns.head(m).noalias() += f.near_null_basis.topLeftCorner(m, nullity) * z;
+  // Given μ, ν is the only one (P's columns independent): the report says so, as the full solve's does.
+  BalanceReport& report = ws.solution.balance;
+  report.rank = report.rows;
+  report.nu_unique = true;
+  report.singular = false;
+  report.condition = f.regular_condition;
+  fs.pattern_indeterminate = true;
   return true;
 }
 
@@ -162,15 +253,19 @@ bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::Vec
 bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& fr, int max_passes, Workspace& ws,
                     FrictionScratch& fs, double& acc_tolerance, int& passes) {
   WorkspaceScratch& sw = scratchOf(ws);
+  const bool free_nu = contactsOnly(task);
   sw.dof_modes = fs.pattern_modes.data();
   sw.prescribed_qdd = fs.pattern_qdd.data();
   int fewest = std::numeric_limits<int>::max(), block_tries = kBlockTries;
   while (passes < max_passes) {
     sw.prescribed_count = lockPattern(model, task, fr, fs);
-    // More rows and locks than the motion has coordinates: the balance would be singular (μ* not unique).
-    if (sw.prescribed_count + task.balanceRows() > model.nv()) return false;
+    // More rows and locks than the motion has coordinates: the balance is singular (μ* not unique), which
+    // smallestFriction resolves only for contacts.
+    if (!free_nu && sw.prescribed_count + task.balanceRows() > model.nv()) return false;
     ++passes;
-    if (!passOfSweeps(model, task, ws, fs)) return false;
+    fs.pattern_indeterminate = false;
+    if (!passOfSweeps(model, task, free_nu, ws, fs)) return false;
+    if (!ws.solution.balance.nu_unique && !smallestFriction(model, task, fr, ws, fs)) return false;
     const int broken = brokenConditions(model, fr, ws.solution.qdd, fs);
     if (broken < 0) return false;
     if (broken == 0) return patternHolds(model, fr, ws.solution.qdd, fs, acc_tolerance);

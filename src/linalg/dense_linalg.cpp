@@ -8,7 +8,7 @@
 namespace zwang::internal {
 
 namespace {
-constexpr int kSmallEigen = 8;  // up to this size symmetricEigen uses a fixed-capacity QR solver
+constexpr int kSmallEigen = 16;  // up to this size symmetricEigen uses a fixed-capacity QR solver
 }  // namespace
 
 void symmetricEigen(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::VectorXd> lambda, Eigen::Ref<Eigen::MatrixXd> V) {

@@ -15,7 +15,7 @@ bool cholesky(const Eigen::Ref<const Eigen::MatrixXd>& A, Eigen::Ref<Eigen::Matr
 void choleskySolveInPlace(const Eigen::Ref<const Eigen::MatrixXd>& C, Eigen::Ref<Eigen::MatrixXd> X);
 
 // Symmetric eigen-decomposition A = V diag(λ) Vᵀ of the full symmetric A: up
-// to 8×8 by tridiagonalisation and QR in fixed-capacity storage, beyond by
+// to 16×16 by tridiagonalisation and QR in fixed-capacity storage, beyond by
 // cyclic Jacobi rotations. A is overwritten; the eigenvalues are not sorted.
 void symmetricEigen(Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::VectorXd> lambda, Eigen::Ref<Eigen::MatrixXd> V);
 

@@ -669,6 +669,39 @@ TEST_CASE("floating bases: humanoid, solo12 and random trees allocate nothing (p
   }
 }
 
+// Every joint stuck on two feet (contacts only): the pattern search's smallest μ along the locked balance's null
+// directions (pivoted Cholesky, the contacts' torques per direction), cold and from the kept pattern.
+TEST_CASE("floating bases: the humanoid on two feet with every joint stuck, the pattern search, allocates nothing",
+          "[floating]") {
+  UrdfOptions options;
+  options.base = BaseType::Free;
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/simple_humanoid.urdf", options);
+  Task task(model);
+  task.addContact("l_ankle", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  task.addContact("r_ankle", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq());
+  q[3] = 1.0;
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(model.nv()), tau = Eigen::VectorXd::Zero(model.nv());
+  FrictionOptions cold, warm;
+  cold.breakaway = Eigen::VectorXd::Constant(model.dof(), 500.0);  // holds every joint
+  warm = cold;
+  warm.warm_start = true;
+  Workspace ws(model, task);
+  Status status[2];
+  const auto both = [&] {
+    status[0] = solveWithFriction(model, ws, q, rest, tau, task, cold);
+    status[1] = solveWithFriction(model, ws, q, rest, tau, task, warm);
+  };
+  both();  // the workspace's first task
+  CHECK(allocationsDuring(both) == 0);
+  CHECK(status[0].ok());
+  CHECK(status[1].ok());
+  CHECK(ws.friction.method == FrictionMethod::StickPatterns);
+  CHECK(ws.friction.warm_started);
+  CHECK(ws.friction.indeterminate);
+  CHECK(ws.solution.balance.nu_unique);
+}
+
 TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the base's errors allocate nothing",
           "[floating]") {
   FloatingCase c = humanoidOnTwoFeet(BaseType::Free);

@@ -421,26 +421,24 @@ void wolfeMinorCycle(const Eigen::MatrixXd& points, std::vector<int>& set, Eigen
   }
 }
 
-}  // namespace
-
-LeastEffort leastEffortMaximiser(const FrictionReference& reference, Eigen::Index first) {
-  if (!reference.feasible) throw std::invalid_argument("leastEffortMaximiser: no valid pattern");
+// The point of least norm in the hull of the valid patterns' `point(p)` (repeats merged), and the τ_control
+// coordinates from `first` on and μ of the same combination.
+template <class Point>
+LeastEffort leastNormOfHull(const FrictionReference& reference, Eigen::Index first, Point point) {
+  if (!reference.feasible) throw std::invalid_argument("leastNormOfHull: no valid pattern");
   const Eigen::Index counted = reference.tau_control.size() - first;
-  // The hull's points, repeats merged (two patterns at one vertex).
   double scale = 1.0;
-  for (const FrictionPattern& p : reference.valid)
-    scale = std::max(scale, p.tau_control.tail(counted).cwiseAbs().maxCoeff());
+  for (const FrictionPattern& p : reference.valid) scale = std::max(scale, point(p).cwiseAbs().maxCoeff());
   std::vector<const FrictionPattern*> distinct;
   for (const FrictionPattern& p : reference.valid) {
     bool repeat = false;
     for (const FrictionPattern* d : distinct)
-      repeat = repeat || (p.tau_control - d->tau_control).tail(counted).cwiseAbs().maxCoeff() <= 1e-12 * scale;
+      repeat = repeat || (point(p) - point(*d)).cwiseAbs().maxCoeff() <= 1e-12 * scale;
     if (!repeat) distinct.push_back(&p);
   }
   const auto count = static_cast<Eigen::Index>(distinct.size());
-  Eigen::MatrixXd points(counted, count);
-  for (Eigen::Index i = 0; i < count; ++i)
-    points.col(i) = distinct[static_cast<std::size_t>(i)]->tau_control.tail(counted);
+  Eigen::MatrixXd points(point(reference.valid.front()).size(), count);
+  for (Eigen::Index i = 0; i < count; ++i) points.col(i) = point(*distinct[static_cast<std::size_t>(i)]);
 
   // Wolfe (1976): start at the point of least norm; add the point that most
   // lowers xᵀp while it lowers it by more than rounding; re-solve on the set.
@@ -462,11 +460,26 @@ LeastEffort leastEffortMaximiser(const FrictionReference& reference, Eigen::Inde
   }
   LeastEffort out;
   out.distinct_points = static_cast<int>(count);
-  out.tau_control = columns(points, set) * w;
+  out.tau_control = Eigen::VectorXd::Zero(counted);
   out.mu = Eigen::VectorXd::Zero(reference.mu.size());
-  for (std::size_t i = 0; i < set.size(); ++i)
-    out.mu += w(static_cast<Eigen::Index>(i)) * distinct[static_cast<std::size_t>(set[i])]->mu;
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    const FrictionPattern& p = *distinct[static_cast<std::size_t>(set[i])];
+    out.tau_control += w(static_cast<Eigen::Index>(i)) * p.tau_control.tail(counted);
+    out.mu += w(static_cast<Eigen::Index>(i)) * p.mu;
+  }
   return out;
+}
+
+}  // namespace
+
+LeastEffort leastEffortMaximiser(const FrictionReference& reference, Eigen::Index first) {
+  const Eigen::Index counted = reference.tau_control.size() - first;
+  return leastNormOfHull(
+      reference, first, [counted](const FrictionPattern& p) -> Eigen::VectorXd { return p.tau_control.tail(counted); });
+}
+
+LeastEffort leastNormMaximiser(const FrictionReference& reference, Eigen::Index first) {
+  return leastNormOfHull(reference, first, [](const FrictionPattern& p) -> Eigen::VectorXd { return p.mu; });
 }
 
 FrictionDual denseFrictionDual(const ChainSpec& spec, const DynamicsInput& input, const FrictionSetup& setup,

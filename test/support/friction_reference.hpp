@@ -174,6 +174,11 @@ struct LeastEffort {
   int distinct_points = 0;  // the hull's points after merging repeats
 };
 LeastEffort leastEffortMaximiser(const FrictionReference& reference, Eigen::Index first = 0);
+// The smallest maximiser: the point of least ‖μ‖ in the hull of the valid
+// patterns' μ (the maximisers' set, as above), and its τ_control from `first`
+// on. The library's choice where τ_control cannot change on the set (every row
+// a contact: docs/friction.md, "When μ* is not unique", Fixed).
+LeastEffort leastNormMaximiser(const FrictionReference& reference, Eigen::Index first = 0);
 // q̈(μ) and g(μ) for a given μ (per dof; entries off Θ₀ ignored) by one full
 // dense solve with τ + τ_kinetic − Wᵀμ.
 struct FrictionDual {

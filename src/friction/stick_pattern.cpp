@@ -56,13 +56,18 @@ void startSticking(const FrictionResult& fr, FrictionScratch& fs) {
   fs.trial_state.assign(fr.stuck.size(), JointState::Stick);
 }
 
-// The task's modes with the sticking DOFs locked, and τ_effective with the slipping DOFs' friction bound; returns
-// how many DOFs are prescribed then.
-int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, FrictionScratch& fs) {
-  const int base_velocity_size = model.baseVelocitySize();
+// The task's modes, prescribed accelerations and τ_effective, copied once per search: each pass changes only the
+// stuck DOFs' entries (lockPattern).
+void copyTaskModes(const Task& task, FrictionScratch& fs) {
   std::copy(task.dofModes().begin(), task.dofModes().end(), fs.pattern_modes.begin());
   fs.pattern_qdd = task.prescribedAccelerations();
   fs.pattern_tau = fs.tau_effective;
+}
+
+// The stuck DOFs' entries for the pattern: the sticking ones locked (q̈ = 0), the slipping ones driven by their
+// friction bound; returns how many DOFs are prescribed then.
+int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, FrictionScratch& fs) {
+  const int base_velocity_size = model.baseVelocitySize();
   int prescribed = task.prescribedCount();
   for (std::size_t a = 0; a < fr.stuck.size(); ++a) {
     const int v = base_velocity_size + fr.stuck[a];
@@ -71,9 +76,11 @@ int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, 
     if (locked(state)) {
       fs.pattern_modes[static_cast<std::size_t>(v)] = DofMode::Prescribed;
       fs.pattern_qdd[v] = 0.0;
+      fs.pattern_tau[v] = fs.tau_effective[v];
       ++prescribed;
     } else {  // μ enters as the torque −μ
-      fs.pattern_tau[v] -= state == JointState::SlipPositive ? fs.hi[e] : fs.lo[e];
+      fs.pattern_modes[static_cast<std::size_t>(v)] = DofMode::Torque;
+      fs.pattern_tau[v] = fs.tau_effective[v] - (state == JointState::SlipPositive ? fs.hi[e] : fs.lo[e]);
     }
   }
   return prescribed;
@@ -92,11 +99,20 @@ bool contactsOnly(const Task& task) {
 // with free_nu, exact rank loss with every row met (smallestFriction then chooses).
 bool passOfSweeps(const Model& model, const Task& task, bool free_nu, Workspace& ws, FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
-  if (!inwardSweep(model, task, fs.pattern_tau, ws)) return false;  // Degenerate: the full solve reports it
-  balance(task, ws);
   const BalanceReport& report = ws.solution.balance;
-  if ((report.singular || !report.nu_unique) && !(free_nu && !report.nu_unique && report.damping == 0.0)) return false;
-  outwardAccelerations(model, task, ws, ws.solution.qdd);
+  if (sw.prescribed_count == model.nv() && task.solverColumns() == 0) {
+    // Every DOF locked or prescribed and no rows (a cold search's first pass on a fixed base, a robot held by its
+    // friction): q̈ is given, nothing for the inward sweep and the balance to solve.
+    ws.solution.qdd = fs.pattern_qdd;
+    bodyAccelerations(model, task, ws, ws.solution.qdd);
+    ws.solution.balance = BalanceReport{};
+  } else {
+    if (!inwardSweep(model, task, fs.pattern_tau, ws)) return false;  // Degenerate: the full solve reports it
+    balance(task, ws);
+    if ((report.singular || !report.nu_unique) && !(free_nu && !report.nu_unique && report.damping == 0.0))
+      return false;
+    outwardAccelerations(model, task, ws, ws.solution.qdd);
+  }
   if (!report.nu_unique) {  // rows the locks made dependent must still be met, or the pattern cannot hold
     taskResidual(task, ws);
     if (!report.consistent) return false;
@@ -254,6 +270,7 @@ bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& 
                     FrictionScratch& fs, double& acc_tolerance, int& passes) {
   WorkspaceScratch& sw = scratchOf(ws);
   const bool free_nu = contactsOnly(task);
+  copyTaskModes(task, fs);
   sw.dof_modes = fs.pattern_modes.data();
   sw.prescribed_qdd = fs.pattern_qdd.data();
   int fewest = std::numeric_limits<int>::max(), block_tries = kBlockTries;

@@ -38,6 +38,7 @@ struct FloatingFrictionDraw {
   FrictionOptions options;  // overrides when the draw does not use the model's own friction
   int joint_rows = 0;
   int contact_rows = 0;
+  int frame_rows = 0;     // randomStandingDraw's rows when they are not contacts
   bool on_limit = false;  // some stuck joint rests on a limit
 };
 
@@ -156,7 +157,9 @@ FloatingFrictionDraw randomFloatingFrictionDraw(std::mt19937_64& rng) {
 // (q̇ = 0 everywhere, inside the limits), friction as drawFriction, and two feet on distinct links (3 or 6 world rows
 // each, b = 0). Locked, the robot is one rigid body on 6–12 rows: the balance loses rank wherever the feet give more
 // rows than the base has coordinates, and μ is free along the ground's internal forces.
-FloatingFrictionDraw randomStandingDraw(std::mt19937_64& rng) {
+// With `contact` false the same rows are the motors' (frame rows, their force in τ_control): the least-effort
+// choice then trades friction against the motors (EffortChange::Own).
+FloatingFrictionDraw randomStandingDraw(std::mt19937_64& rng, bool contact) {
   RandomFloatingOptions options;
   options.chain.min_moving_joints = 2;
   options.chain.max_moving_joints = 6;
@@ -193,9 +196,9 @@ FloatingFrictionDraw randomStandingDraw(std::mt19937_64& rng) {
     c.A = Matrix6Xd::Identity(6, rows);
     c.b = Eigen::VectorXd::Zero(rows);
     c.axes = Axes::World;
-    c.contact = true;
+    c.contact = contact;
     in.constraints.push_back(c);
-    d.contact_rows += rows;
+    (contact ? d.contact_rows : d.frame_rows) += rows;
   }
   return d;
 }
@@ -235,7 +238,7 @@ struct Tally {
   int with_frame_rows = 0, with_joint_rows = 0, with_contacts = 0, without_rows = 0, on_limit = 0;
   int unique = 0, indeterminate = 0, indeterminate_flagged = 0, least_effort_compared = 0,
       least_effort_with_contacts = 0, least_effort_shared = 0, least_norm_compared = 0, least_norm_by_search = 0,
-      stuck = 0, states_skipped = 0;
+      least_effort_by_search = 0, stuck = 0, states_skipped = 0;
   int by_joints[7] = {0, 0, 0, 0, 0, 0, 0};
   int states[5] = {0, 0, 0, 0, 0};
   int most_patterns = 0;
@@ -298,6 +301,7 @@ void compareLeastEffort(const FloatingFrictionDraw& d, const Workspace& ws, cons
   t.e_effort = std::max(t.e_effort, ee);
   t.effort_excess = std::max(t.effort_excess, excess);
   ++t.least_effort_compared;
+  t.least_effort_by_search += ws.friction.method == FrictionMethod::StickPatterns ? 1 : 0;
   t.least_effort_with_contacts += d.contact_rows > 0 ? 1 : 0;
   t.least_effort_shared += contactShareMoves(d, ref) ? 1 : 0;
 }
@@ -451,16 +455,17 @@ TEST_CASE("floating trees: friction matches the brute-force enumeration of stick
       "  max rel. error qdd %.2e, g(mu*) %.2e, kinetic friction %.2e\n"
       "  mu* unique in %d: mu %.2e, nu %.2e, tau_control %.2e\n"
       "  mu* not unique (or pinned) in %d (flagged indeterminate %d): zwang's mu gives qdd* %.2e and g* %.2e in the dense reference, "
-      "|mu| beyond f %.2e; least effort (%d bounded, %d with contacts, %d sharing the load): tau_control %.2e, norm "
+      "|mu| beyond f %.2e; least effort (%d bounded, %d by the pattern search, %d with contacts, %d sharing the load): "
+      "tau_control %.2e, norm "
       "excess %.2e; smallest mu where every row is a contact (%d, %d by the pattern search): %.2e\n"
       "  states: moving %d, stick %d, slip+ %d, slip- %d, at-limit %d (%d stuck, %d at a boundary not compared)\n",
       t.compared, t.draws, t.ill_posed, t.ambiguous, t.free, t.planar, t.by_joints[1], t.by_joints[2], t.by_joints[3],
       t.by_joints[4], t.by_joints[5], t.by_joints[6], t.with_frame_rows, t.with_joint_rows, t.with_contacts,
       t.without_rows, t.on_limit, t.infeasible, t.most_patterns, t.e_qdd, t.e_g, t.e_kinetic, t.unique, t.e_mu, t.e_nu,
       t.e_tau, t.indeterminate, t.indeterminate_flagged, t.e_maximiser_qdd, t.e_maximiser_g, t.e_box,
-      t.least_effort_compared, t.least_effort_with_contacts, t.least_effort_shared, t.e_effort, t.effort_excess,
-      t.least_norm_compared, t.least_norm_by_search, t.e_least_norm, t.states[0], t.states[1], t.states[2], t.states[3],
-      t.states[4], t.stuck, t.states_skipped);
+      t.least_effort_compared, t.least_effort_by_search, t.least_effort_with_contacts, t.least_effort_shared,
+      t.e_effort, t.effort_excess, t.least_norm_compared, t.least_norm_by_search, t.e_least_norm, t.states[0],
+      t.states[1], t.states[2], t.states[3], t.states[4], t.stuck, t.states_skipped);
   CHECK(t.free > 60);
   CHECK(t.planar > 60);
   CHECK(t.with_joint_rows > 30);
@@ -545,18 +550,20 @@ FloatingFrictionDraw sharedLoadDraw(std::mt19937_64& rng) {
 
 }  // namespace
 
-TEST_CASE("floating trees standing on two feet, every joint stuck: the smallest maximiser, against brute force",
+TEST_CASE("floating trees standing on two feet, every joint stuck: the least-effort maximiser, against brute force",
           "[floating][friction]") {
   // The automatic choice (the active set: few stuck joints) and the pattern search forced, which takes the smallest
-  // μ along the balance's null directions itself (docs/friction.md, "The pattern search").
+  // μ along the balance's null directions itself where the feet are contacts (docs/friction.md, "The pattern
+  // search"); where the same rows are the motors', the least ‖τ_control‖² is the active set's.
   const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
-  INFO("method " << toString(method));
+  const bool contact = GENERATE(true, false);
+  INFO("method " << toString(method) << (contact ? ", contacts" : ", frame rows"));
   std::mt19937_64 rng(2811);
   Tally t;
   while (t.compared < 150) {
     REQUIRE(++t.draws < 3000);
-    FloatingFrictionDraw d = randomStandingDraw(rng);
-    if (d.contact_rows == 0) continue;
+    FloatingFrictionDraw d = randomStandingDraw(rng, contact);
+    if (d.contact_rows + d.frame_rows == 0) continue;
     const FloatingResult dense = floatingDynamics(d.problem.spec, d.problem.base, d.problem.input);
     if (!wellPosed(dense)) {
       ++t.ill_posed;
@@ -570,8 +577,8 @@ TEST_CASE("floating trees standing on two feet, every joint stuck: the smallest 
     d.options.method = method;
     const LibraryRun run(d);
     INFO("draw " << t.draws << ": " << toString(d.problem.base.kind) << " base, " << run.model.dof() << " joints, "
-                 << d.contact_rows << " contact rows, reference pattern " << ref.pattern << " of " << ref.valid_patterns
-                 << " valid; status: " << run.status.message);
+                 << d.contact_rows + d.frame_rows << (contact ? " contact" : " frame") << " rows, reference pattern "
+                 << ref.pattern << " of " << ref.valid_patterns << " valid; status: " << run.status.message);
     REQUIRE(run.status);
     countDraw(d, ref, t);
     const Workspace& ws = run.ws;
@@ -588,13 +595,16 @@ TEST_CASE("floating trees standing on two feet, every joint stuck: the smallest 
       compareIndeterminate(d, ws, ref, t);
   }
   std::printf(
-      "floating trees standing on two feet, every joint stuck (%s): %d compared (%d draws; %d ill-posed, %d without a "
-      "maximiser or ambiguous); max rel. error qdd %.2e; mu* unique in %d (mu %.2e); not unique in %d (flagged %d): "
-      "the smallest mu in %d (%d by the pattern search) to %.2e\n",
-      toString(method), t.compared, t.draws, t.ill_posed, t.ambiguous, t.e_qdd, t.unique, t.e_mu, t.indeterminate,
-      t.indeterminate_flagged, t.least_norm_compared, t.least_norm_by_search, t.e_least_norm);
-  CHECK(t.least_norm_compared > 30);
-  if (method == FrictionMethod::StickPatterns) CHECK(t.least_norm_by_search > 20);
+      "floating trees standing on two feet, every joint stuck (%s, %s): %d compared (%d draws; %d ill-posed, %d "
+      "without a maximiser or ambiguous); max rel. error qdd %.2e; mu* unique in %d (mu %.2e); not unique in %d "
+      "(flagged %d): least effort in %d (%d by the pattern search) to %.2e, the smallest mu in %d (%d by the pattern "
+      "search) to %.2e\n",
+      toString(method), contact ? "contacts" : "frame rows", t.compared, t.draws, t.ill_posed, t.ambiguous, t.e_qdd,
+      t.unique, t.e_mu, t.indeterminate, t.indeterminate_flagged, t.least_effort_compared, t.least_effort_by_search,
+      t.e_effort, t.least_norm_compared, t.least_norm_by_search, t.e_least_norm);
+  CHECK(t.least_effort_compared > 30);
+  if (contact) CHECK(t.least_norm_compared > 30);
+  if (method == FrictionMethod::StickPatterns && contact) CHECK(t.least_norm_by_search > 20);
 }
 
 TEST_CASE("floating trees: the least-effort pick where contacts share the load, against brute force",

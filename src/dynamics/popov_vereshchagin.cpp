@@ -1124,6 +1124,11 @@ void prescribedContactTorques(const Model& model, const Task& task, Workspace& w
   prescribedDofTorques<false>(model, task, ws, nu_solver, nullptr, nullptr, tau_c);
 }
 
+void prescribedConstraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                                 Eigen::Ref<Eigen::VectorXd> tau_c) {
+  prescribedDofTorques<false, true>(model, task, ws, nu_solver, nullptr, nullptr, tau_c);
+}
+
 void prescribedDofResiduals(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                             const VectorRef& qdd, const VectorRef& tau, Eigen::Ref<Eigen::VectorXd> residual) {
   prescribedDofTorques<true, true>(model, task, ws, nu_solver, qdd.data(), tau.data(), residual);

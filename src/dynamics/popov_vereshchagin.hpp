@@ -127,6 +127,10 @@ void prescribedTorques(const Model& model, const Task& task, Workspace& ws, cons
 // fixed motion (the friction's flat directions).
 void prescribedContactTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
                               Eigen::Ref<Eigen::VectorXd> tau_c);
+// Every column's part, −Sᵀ Σ A ν over the subtree: how a prescribed DOF's residual (prescribedDofResiduals) moves
+// with ν at a fixed motion.
+void prescribedConstraintTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                                 Eigen::Ref<Eigen::VectorXd> tau_c);
 // For each DOF the sweeps held prescribed (the modes bound in sw), what the rest of its joint's equation leaves
 // over with every constraint force acting: λ = d q̈ + Sᵀ Σ_subtree (I a + F_bias − A ν) − τ, the generalized force
 // something else must give it (a locked DOF of a stick pattern: its friction, −λ). Other entries untouched.

@@ -52,6 +52,11 @@ struct FrictionScratch {
     free_lambda.setZero(dof, capacity);
     free_factor.setZero(capacity, capacity);
     free_step.setZero(capacity);
+    free_target.setZero(dof);
+    margin_lo.setZero(dof);
+    margin_hi.setZero(dof);
+    pattern_nu.setZero(capacity);
+    pattern_rhs.setZero(capacity);
   }
 
   // The model of friction, per joint (the options' overrides, else the model's)
@@ -96,14 +101,17 @@ struct FrictionScratch {
   Eigen::VectorXd pattern_qdd;            // nv: the task's prescribed accelerations, 0 on the locked DOFs
   Eigen::VectorXd pattern_tau;            // nv: τ_effective with the slipping DOFs' friction bound applied
   Eigen::VectorXd pattern_residual;       // nv: λ of the locked DOFs (prescribedDofResiduals)
-  // Contacts the locks make dependent (smallestFriction): ν free along the balance's null directions n
-  Eigen::VectorXd pattern_direction;   // nv: λ of the locked DOFs from a unit ν along one n
-  Eigen::MatrixXd free_lambda;         // P: locked friction DOFs × nullity, those λ
-  Eigen::MatrixXd free_factor;         // nullity × nullity: R, PᵀP = R Rᵀ
-  Eigen::VectorXd free_step;           // nullity: z, ν moves by N z and λ by P z
-  std::vector<int> locked_dofs;        // the locked friction DOFs as entries of v, in Θ₀ order
-  bool pattern_indeterminate = false;  // the pass's μ was chosen among maximisers (smallestFriction)
-  bool sensitivities_written = false;  // FrictionResult::dqdd_dmu holds columns of the last full solve
+  // Contacts the locks make dependent (leastEffortFriction): ν free along the balance's null directions n
+  Eigen::VectorXd pattern_direction;        // nv: λ of the locked DOFs from a unit ν along one n
+  Eigen::MatrixXd free_lambda;              // P: locked friction DOFs × nullity, those λ
+  Eigen::MatrixXd free_factor;              // nullity × nullity: R, PᵀP = R Rᵀ
+  Eigen::VectorXd free_step;                // nullity: z, ν moves by N z and λ by P z
+  std::vector<int> locked_dofs;             // the locked friction DOFs, as indices into Θ₀
+  Eigen::VectorXd free_target;              // per locked DOF: what Pᵀ is applied to (−λ₀, or h − λ₀)
+  Eigen::VectorXd margin_lo, margin_hi;     // on Θ₀: the margin box about the smallest maximiser
+  Eigen::VectorXd pattern_nu, pattern_rhs;  // the pass's ν and balance right-hand side, kept across freeBalanceRegular
+  bool pattern_indeterminate = false;       // the pass's μ was chosen among maximisers (leastEffortFriction)
+  bool sensitivities_written = false;       // FrictionResult::dqdd_dmu holds columns of the last full solve
 
   // Outputs
   Eigen::VectorXd tau_joint;  // τ − kinetic − μ*: what the joints feel (the Gauss function's torques)

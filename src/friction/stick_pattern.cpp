@@ -86,17 +86,22 @@ int lockPattern(const Model& model, const Task& task, const FrictionResult& fr, 
   return prescribed;
 }
 
-// Whether ν may be left free by the locks (smallestFriction): every row a contact, so that τ_control = τ whatever ν
-// (the full solve's EffortChange::Fixed) and the balance is on the solver's columns (its null basis is ν's).
-bool contactsOnly(const Task& task) {
+// How τ_control moves where the locks leave ν free (leastEffortFriction), as the full solve's EffortChange: Fixed
+// when every row is a contact (τ_control = τ whatever ν), Own when none is (each sticking DOF's τ_control moves one
+// for one with its μ); None for a mix of the two, mimic rows, or a balance on rows (its null basis is not ν's):
+// the full solve chooses there.
+enum class FreeNu { None, Fixed, Own };
+FreeNu freeNuEffort(const Task& task) {
   const std::vector<char>& contact = solverOrder(task).contactColumns();
-  if (solverOrder(task).balanceOnRows() || task.solverColumns() == 0) return false;
-  return std::all_of(contact.begin(), contact.begin() + task.solverColumns(), [](char c) { return c != 0; });
+  const int m = task.solverColumns();
+  if (solverOrder(task).balanceOnRows() || m == 0 || task.mimicRows() > 0) return FreeNu::None;
+  const auto contacts = std::count_if(contact.begin(), contact.begin() + m, [](char c) { return c != 0; });
+  return contacts == m ? FreeNu::Fixed : contacts == 0 ? FreeNu::Own : FreeNu::None;
 }
 
 // One pass of the sweeps with the pattern's modes, the kinematics done: false when a joint has no inertia to move or
 // the balance is not regular with the sticking DOFs locked (μ* may not be unique: the full solve chooses) — except,
-// with free_nu, exact rank loss with every row met (smallestFriction then chooses).
+// with free_nu, exact rank loss with every row met (leastEffortFriction then chooses).
 bool passOfSweeps(const Model& model, const Task& task, bool free_nu, Workspace& ws, FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
   const BalanceReport& report = ws.solution.balance;
@@ -122,50 +127,51 @@ bool passOfSweeps(const Model& model, const Task& task, bool free_nu, Workspace&
   return true;
 }
 
-// Contacts the locks make dependent (feet on the ground, every joint sticking: the rigid robot stands on more rows
-// than it has coordinates). The pattern's motion is unique, but ν is free along the balance's null directions n,
-// and with it the locked DOFs' friction: λ = λ₀ + P z, P's columns the λ a unit ν along each n gives (−Sᵀ Σ A n over
-// the subtree). These are the maximisers with this motion, and with every row a contact every one costs the same
-// effort (τ_control = τ): the full solve's choice is the smallest μ = −λ on the sticking DOFs, λ₀'s projection off
-// range(P): λ ← λ₀ + P z, ν ← ν + N z, z = −(PᵀP)⁻¹Pᵀλ₀. False when P's columns are nearly dependent
-// (a contact direction the joints hardly feel: the full solve decides).
-bool smallestFriction(const Model& model, const Task& task, const FrictionResult& fr, Workspace& ws,
-                      FrictionScratch& fs) {
+// μ on the locked DOFs for λ = λ₀ + P z: −(λ₀ + P z) strictly inside [lo, hi] (on Θ₀) with the pattern search's
+// margin (kBoxMargin of 1 + f).
+bool strictlyInside(const Model& model, const FrictionResult& fr, const Eigen::Ref<const Eigen::VectorXd>& z,
+                    const Eigen::Ref<const Eigen::VectorXd>& lo, const Eigen::Ref<const Eigen::VectorXd>& hi,
+                    const FrictionScratch& fs) {
+  const int base_velocity_size = model.baseVelocitySize();
+  for (std::size_t t = 0; t < fs.locked_dofs.size(); ++t) {
+    const auto a = static_cast<std::size_t>(fs.locked_dofs[t]);
+    const double mu = -(fs.pattern_residual[base_velocity_size + fr.stuck[a]] +
+                        fs.free_lambda.row(static_cast<Eigen::Index>(t)).head(z.size()).dot(z));
+    const double margin = kBoxMargin * (1.0 + fs.breakaway[fr.stuck[a]]);
+    const auto e = static_cast<Eigen::Index>(a);
+    if (!(mu > lo[e] + margin && mu < hi[e] - margin)) return false;
+  }
+  return true;
+}
+
+// z = (PᵀP)⁻¹ Pᵀ y (R Rᵀ = PᵀP in fs.free_factor), y per locked DOF in fs.free_target.
+void normalSolve(Eigen::Index nullity, Eigen::Index locked_count, const FrictionScratch& fs,
+                 Eigen::Ref<Eigen::VectorXd> z) {
+  const auto R = fs.free_factor.topLeftCorner(nullity, nullity);
+  for (Eigen::Index c = 0; c < nullity; ++c)
+    z[c] = fs.free_lambda.col(c).head(locked_count).dot(fs.free_target.head(locked_count));
+  for (Eigen::Index c = 0; c < nullity; ++c) {  // R y = Pᵀ y
+    for (Eigen::Index l = 0; l < c; ++l) z[c] -= R(c, l) * z[l];
+    z[c] /= R(c, c);
+  }
+  for (Eigen::Index c = nullity - 1; c >= 0; --c) {  // Rᵀ z = y
+    for (Eigen::Index l = c + 1; l < nullity; ++l) z[c] -= R(l, c) * z[l];
+    z[c] /= R(c, c);
+  }
+}
+
+// R Rᵀ = PᵀP in place (lower); false when a column of P is within kIndependent of the others' span (R_cc² is its
+// distance² from the span of the columns before it).
+bool factorNormalMatrix(Eigen::Index nullity, Eigen::Index locked_count, FrictionScratch& fs) {
   // A column of P this close to the span of the others: the balance with the DOFs free would see its rows as
   // near-singular (σ̃ ~ the square of it against singular_threshold = 1e-6), which the full solve damps.
   constexpr double kIndependent = 1e-3;
-  WorkspaceScratch& sw = scratchOf(ws);
-  const BalanceFactorisation& f = sw.balance_factorisation;
-  const int m = task.solverColumns(), base_velocity_size = model.baseVelocitySize();
-  const Eigen::Index nullity = f.near_null_count;
-  fs.locked_dofs.clear();  // reserved for every DOF: no allocation
-  for (std::size_t a = 0; a < fr.stuck.size(); ++a)
-    if (locked(fs.trial_state[a])) fs.locked_dofs.push_back(base_velocity_size + fr.stuck[a]);
-  const auto locked_count = static_cast<Eigen::Index>(fs.locked_dofs.size());
-  const int* rows = fs.locked_dofs.data();
-  auto P = fs.free_lambda.topLeftCorner(locked_count, nullity);
-  for (Eigen::Index e = 0; e < nullity; ++e) {
-    prescribedContactTorques(model, task, ws, f.near_null_basis.col(e).head(m), fs.pattern_direction);
-    for (Eigen::Index t = 0; t < locked_count; ++t) P(t, e) = fs.pattern_direction[rows[t]];
-  }
-  // z = −(PᵀP)⁻¹ Pᵀλ₀ by the Cholesky factor R of PᵀP (P's columns are independent to kIndependent, so squaring
-  // their condition costs at most 1e-6 of the rounding the least-norm λ can have), then λ ← λ₀ + P z.
+  const auto P = fs.free_lambda.topLeftCorner(locked_count, nullity);
   auto R = fs.free_factor.topLeftCorner(nullity, nullity);
-  auto z = fs.free_step.head(nullity);
+  for (Eigen::Index c = 0; c < nullity; ++c)
+    for (Eigen::Index d = 0; d <= c; ++d) R(c, d) = P.col(c).dot(P.col(d));
   for (Eigen::Index c = 0; c < nullity; ++c) {
-    const double* p_c = P.col(c).data();
-    for (Eigen::Index d = 0; d <= c; ++d) {
-      const double* p_d = P.col(d).data();
-      double dot = 0.0;
-      for (Eigen::Index t = 0; t < locked_count; ++t) dot += p_c[t] * p_d[t];
-      R(c, d) = dot;
-    }
-    double along = 0.0;
-    for (Eigen::Index t = 0; t < locked_count; ++t) along += p_c[t] * fs.pattern_residual[rows[t]];
-    z[c] = -along;
-  }
-  for (Eigen::Index c = 0; c < nullity; ++c) {  // R Rᵀ = PᵀP in place (lower); R_cc² is P_c's distance² from the
-    const double length2 = R(c, c);             // span of the columns before it
+    const double length2 = R(c, c);
     for (Eigen::Index d = 0; d <= c; ++d) {
       double value = R(c, d);
       for (Eigen::Index l = 0; l < d; ++l) value -= R(c, l) * R(d, l);
@@ -177,18 +183,60 @@ bool smallestFriction(const Model& model, const Task& task, const FrictionResult
       }
     }
   }
-  for (Eigen::Index c = 0; c < nullity; ++c) {  // R y = −Pᵀλ₀
-    for (Eigen::Index l = 0; l < c; ++l) z[c] -= R(c, l) * z[l];
-    z[c] /= R(c, c);
+  return true;
+}
+
+// Rows the locks make dependent (feet on the ground with every joint sticking: the rigid robot stands on more rows
+// than it has coordinates; an arm holding a 6-D pose with every joint sticking: nothing moves). The pattern's
+// motion is unique, but ν is free along the balance's null directions n, and with it the locked DOFs' friction:
+// λ = λ₀ + P z, P's columns the λ a unit ν along each n gives (−Sᵀ Σ A n over the subtree). These are the
+// maximisers with this motion; among them the full solve's choice ("When μ* is not unique"):
+//  (a) the smallest μ = −λ, λ₀ projected off range(P): z = −(PᵀP)⁻¹Pᵀλ₀ (Fixed stops here);
+//  (b) Own, where (a) is strictly inside its box: the least ‖h + μ‖² within the margin box about it,
+//      h = d q̈ + Sᵀ Σ (I a + F_bias) what each motor carries without friction: z = (PᵀP)⁻¹Pᵀ(h − λ₀).
+// Then λ ← λ₀ + P z, ν ← ν + N z. A smallest μ outside its box breaks the pattern (the pivoting goes on); a pick
+// (b) outside the margin box (the full solve's bounded least-distance problem decides), or P's columns nearly
+// dependent (a direction the joints hardly feel): false.
+bool leastEffortFriction(const Model& model, const Task& task, const FrictionResult& fr, FreeNu effort, double margin,
+                         Workspace& ws, FrictionScratch& fs) {
+  WorkspaceScratch& sw = scratchOf(ws);
+  const BalanceFactorisation& f = sw.balance_factorisation;
+  const int m = task.solverColumns(), base_velocity_size = model.baseVelocitySize();
+  const Eigen::Index nullity = f.near_null_count;
+  fs.locked_dofs.clear();  // reserved for every DOF: no allocation
+  for (std::size_t a = 0; a < fr.stuck.size(); ++a)
+    if (locked(fs.trial_state[a])) fs.locked_dofs.push_back(static_cast<int>(a));
+  const auto locked_count = static_cast<Eigen::Index>(fs.locked_dofs.size());
+  const auto row = [&](Eigen::Index t) {
+    return base_velocity_size + fr.stuck[static_cast<std::size_t>(fs.locked_dofs[static_cast<std::size_t>(t)])];
+  };
+  auto P = fs.free_lambda.topLeftCorner(locked_count, nullity);
+  for (Eigen::Index e = 0; e < nullity; ++e) {
+    prescribedConstraintTorques(model, task, ws, f.near_null_basis.col(e).head(m), fs.pattern_direction);
+    for (Eigen::Index t = 0; t < locked_count; ++t) P(t, e) = fs.pattern_direction[row(t)];
   }
-  for (Eigen::Index c = nullity - 1; c >= 0; --c) {  // Rᵀ z = y
-    for (Eigen::Index l = c + 1; l < nullity; ++l) z[c] -= R(l, c) * z[l];
-    z[c] /= R(c, c);
+  if (!factorNormalMatrix(nullity, locked_count, fs)) return false;
+  auto z = fs.free_step.head(nullity);
+  for (Eigen::Index t = 0; t < locked_count; ++t) fs.free_target[t] = -fs.pattern_residual[row(t)];  // (a): −λ₀
+  normalSolve(nullity, locked_count, fs, z);
+  const auto lo = fs.lo.head(static_cast<Eigen::Index>(fr.stuck.size()));
+  const auto hi = fs.hi.head(static_cast<Eigen::Index>(fr.stuck.size()));
+  if (effort == FreeNu::Own && strictlyInside(model, fr, z, lo, hi, fs)) {
+    for (Eigen::Index t = 0; t < locked_count; ++t) {  // the margin box about μ_ref (finite bounds only)
+      const auto a = static_cast<Eigen::Index>(fs.locked_dofs[static_cast<std::size_t>(t)]);
+      const double f_a = margin * fs.breakaway[fr.stuck[static_cast<std::size_t>(a)]];
+      const double mu_ref = -(fs.pattern_residual[row(t)] + P.row(t).dot(z));
+      fs.margin_lo[a] = std::isfinite(lo[a]) ? std::max(lo[a], std::min(-f_a, mu_ref)) : lo[a];
+      fs.margin_hi[a] = std::isfinite(hi[a]) ? std::min(hi[a], std::max(f_a, mu_ref)) : hi[a];
+    }
+    // (b): h − λ₀, h the residual without ν (prescribedTorques counts the contacts' forces only: none here) + τ.
+    prescribedTorques(model, task, ws, sw.nu_columns.head(m), ws.solution.qdd, fs.pattern_tau, fs.pattern_direction);
+    for (Eigen::Index t = 0; t < locked_count; ++t)
+      fs.free_target[t] = fs.pattern_direction[row(t)] + fs.pattern_tau[row(t)] - fs.pattern_residual[row(t)];
+    normalSolve(nullity, locked_count, fs, z);
+    if (!strictlyInside(model, fr, z, fs.margin_lo.head(lo.size()), fs.margin_hi.head(hi.size()), fs)) return false;
   }
-  for (Eigen::Index c = 0; c < nullity; ++c) {
-    const double* p_c = P.col(c).data();
-    for (Eigen::Index t = 0; t < locked_count; ++t) fs.pattern_residual[rows[t]] += z[c] * p_c[t];
-  }
+  for (Eigen::Index t = 0; t < locked_count; ++t) fs.pattern_residual[row(t)] += P.row(t).dot(z);
   sw.nu_columns.head(m).noalias() += f.near_null_basis.topLeftCorner(m, nullity) * z;
   // Given μ, ν is the only one (P's columns independent): the report says so, as the full solve's does.
   BalanceReport& report = ws.solution.balance;
@@ -198,6 +246,28 @@ bool smallestFriction(const Model& model, const Task& task, const FrictionResult
   report.condition = f.regular_condition;
   fs.pattern_indeterminate = true;
   return true;
+}
+
+// Own's choice is the full solve's only where the balance with the stuck DOFs free is regular: rows nearly
+// dependent with them free (which the full solve damps) can be exactly dependent with them locked, and then P
+// cannot tell (one null direction has no others to be near). One inward sweep and balance with the task's own
+// modes (𝓛 does not depend on τ) tell; the pass's ν, right-hand side and report are put back.
+bool freeBalanceRegular(const Model& model, const Task& task, Workspace& ws, FrictionScratch& fs) {
+  WorkspaceScratch& sw = scratchOf(ws);
+  const int m = task.solverColumns();
+  fs.pattern_nu.head(m) = sw.nu_columns.head(m);
+  fs.pattern_rhs.head(m) = sw.rhs.head(m);
+  const BalanceReport kept = ws.solution.balance;
+  bindTaskModes(task, sw);
+  bool regular = inwardSweep(model, task, fs.tau_effective, ws).ok();
+  if (regular) {
+    balance(task, ws);
+    regular = !ws.solution.balance.singular;
+  }
+  sw.nu_columns.head(m) = fs.pattern_nu.head(m);
+  sw.rhs.head(m) = fs.pattern_rhs.head(m);
+  ws.solution.balance = kept;
+  return regular;
 }
 
 // Marks each DOF whose condition the pass broke — a locked DOF's μ (into fs.mu) beyond its box, a slipping DOF
@@ -266,10 +336,11 @@ bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::Vec
 }
 
 // The passes from the start pattern: true when one holds.
-bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& fr, int max_passes, Workspace& ws,
-                    FrictionScratch& fs, double& acc_tolerance, int& passes) {
+bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& fr, int max_passes, double margin,
+                    Workspace& ws, FrictionScratch& fs, double& acc_tolerance, int& passes) {
   WorkspaceScratch& sw = scratchOf(ws);
-  const bool free_nu = contactsOnly(task);
+  const FreeNu effort = freeNuEffort(task);
+  const bool free_nu = effort != FreeNu::None;
   copyTaskModes(task, fs);
   sw.dof_modes = fs.pattern_modes.data();
   sw.prescribed_qdd = fs.pattern_qdd.data();
@@ -277,15 +348,17 @@ bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& 
   while (passes < max_passes) {
     sw.prescribed_count = lockPattern(model, task, fr, fs);
     // More rows and locks than the motion has coordinates: the balance is singular (μ* not unique), which
-    // smallestFriction resolves only for contacts.
+    // leastEffortFriction resolves where every row is a contact or none is.
     if (!free_nu && sw.prescribed_count + task.balanceRows() > model.nv()) return false;
     ++passes;
     fs.pattern_indeterminate = false;
     if (!passOfSweeps(model, task, free_nu, ws, fs)) return false;
-    if (!ws.solution.balance.nu_unique && !smallestFriction(model, task, fr, ws, fs)) return false;
+    if (!ws.solution.balance.nu_unique && !leastEffortFriction(model, task, fr, effort, margin, ws, fs)) return false;
     const int broken = brokenConditions(model, fr, ws.solution.qdd, fs);
     if (broken < 0) return false;
-    if (broken == 0) return patternHolds(model, fr, ws.solution.qdd, fs, acc_tolerance);
+    if (broken == 0)
+      return patternHolds(model, fr, ws.solution.qdd, fs, acc_tolerance) &&
+             (effort != FreeNu::Own || !fs.pattern_indeterminate || freeBalanceRegular(model, task, ws, fs));
     if (broken < fewest) {
       fewest = broken;
       block_tries = kBlockTries;
@@ -304,14 +377,14 @@ bool keptPatternApplies(const Model& model, const Task& task, const FrictionScra
 }
 
 bool searchPatterns(const Model& model, const Task& task, const FrictionResult& fr, bool from_kept, int max_passes,
-                    Workspace& ws, FrictionScratch& fs, double& acc_tolerance, int& passes) {
+                    double margin, Workspace& ws, FrictionScratch& fs, double& acc_tolerance, int& passes) {
   passes = 0;
   if (fr.stuck.empty() || max_passes < 1) return false;
   if (from_kept)
     startFromKept(fr, fs);
   else
     startSticking(fr, fs);
-  const bool held = pivotToOptimum(model, task, fr, max_passes, ws, fs, acc_tolerance, passes);
+  const bool held = pivotToOptimum(model, task, fr, max_passes, margin, ws, fs, acc_tolerance, passes);
   bindTaskModes(task, scratchOf(ws));  // the stages after it (the task's prescribed torques, the full solve) read them
   return held;
 }

@@ -702,6 +702,36 @@ TEST_CASE("floating bases: the humanoid on two feet with every joint stuck, the 
   CHECK(ws.solution.balance.nu_unique);
 }
 
+// An arm holding its flange (6 world rows, motor rows) with every joint stuck and friction that can carry all of
+// gravity: the pattern search's least-effort choice (EffortChange::Own) and its check of the free balance.
+TEST_CASE("the Panda holding its flange with every joint stuck, the pattern search's least effort, allocates nothing",
+          "[friction]") {
+  const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
+  Task task(model);
+  task.addConstraint("panda_link8", ConstraintMatrix::Identity(6, 6), Expressed::World);
+  const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(model.nq(), -0.4, 0.6), rest = Eigen::VectorXd::Zero(model.nv());
+  const Eigen::VectorXd tau = Eigen::VectorXd::Zero(model.nv());
+  FrictionOptions cold, warm;
+  cold.breakaway = Eigen::VectorXd::Constant(model.dof(), 1e3);  // far above what gravity asks: μ = −G inside
+  cold.method = FrictionMethod::StickPatterns;  // 7 stuck DOFs: the automatic choice would run the active set
+  warm = cold;
+  warm.warm_start = true;
+  Workspace ws(model, task);
+  Status status[2];
+  const auto both = [&] {
+    status[0] = solveWithFriction(model, ws, q, rest, tau, task, cold);
+    status[1] = solveWithFriction(model, ws, q, rest, tau, task, warm);
+  };
+  both();  // the workspace's first task
+  CHECK(allocationsDuring(both) == 0);
+  CHECK(status[0].ok());
+  CHECK(status[1].ok());
+  CHECK(ws.friction.method == FrictionMethod::StickPatterns);
+  CHECK(ws.friction.warm_started);
+  CHECK(ws.friction.indeterminate);
+  CHECK(ws.solution.tau_control.cwiseAbs().maxCoeff() < 1e-9);  // friction carries all of it: no motor effort
+}
+
 TEST_CASE("floating bases: a stuck joint on a limit, an infeasible task and the base's errors allocate nothing",
           "[floating]") {
   FloatingCase c = humanoidOnTwoFeet(BaseType::Free);

@@ -358,6 +358,11 @@ TEST_CASE("active-set and projected-gradient maximisers give the same motion") {
 }
 
 TEST_CASE("indeterminate hold-still on the Panda: friction carries load, effort drops") {
+  // The automatic choice (the active set: 7 stuck joints) and the pattern search forced, which makes the
+  // least-effort choice itself, on the margin box here (docs/friction.md, "The pattern search").
+  const FrictionMethod method = GENERATE(FrictionMethod::Automatic, FrictionMethod::StickPatterns);
+  INFO("method " << toString(method));
+  int searched = 0;
   const Model model = loadUrdfFile(std::string(ZWANG_MODELS_DIR) + "/panda.urdf");
   REQUIRE(model.dof() == 7);
   Task task(model);                                                                 // default gravity
@@ -387,9 +392,11 @@ TEST_CASE("indeterminate hold-still on the Panda: friction carries load, effort 
       INFO("pose " << q.transpose() << ", margin " << margin);
       FrictionOptions options;
       options.margin = margin;
+      options.method = method;
       const Solved s = solveChecked(model, task, q, qd, tau, options);
       REQUIRE_SOLVED(s);
       CHECK(s.friction.indeterminate);
+      searched += s.friction.method == FrictionMethod::StickPatterns ? 1 : 0;
       CHECK(s.solution.qdd.cwiseAbs().maxCoeff() < 1e-9);
       // Closed form: τ_ctrl = G + μ with |μ_j| ≤ margin f_j, minimal ‖τ_ctrl‖.
       for (int j = 0; j < 7; ++j) {
@@ -401,10 +408,11 @@ TEST_CASE("indeterminate hold-still on the Panda: friction carries load, effort 
         CHECK(s.solution.tau_control.norm() < G.norm() - 1e-3);
       else
         CHECK(s.solution.tau_control.norm() == Approx(G.norm()).epsilon(1e-9));
-      std::printf("panda hold-still, margin %.1f: |tau_ctrl| %.3f N·m without friction, %.3f with\n", margin, G.norm(),
-                  s.solution.tau_control.norm());
+      std::printf("panda hold-still, margin %.1f: |tau_ctrl| %.3f N·m without friction, %.3f with (%s)\n", margin,
+                  G.norm(), s.solution.tau_control.norm(), toString(s.friction.method));
     }
   }
+  if (method == FrictionMethod::StickPatterns) CHECK(searched >= 8);  // of 12: the search's own choice
 }
 
 TEST_CASE("1-DOF arm held still under gravity: |tau| = max(0, |G| - margin f)") {

@@ -516,8 +516,8 @@ Status solveWithFriction(const Model& model, Workspace& ws, const Eigen::Ref<con
   double acc_tolerance = 0.0;  // what counts as q̈_j = 0 (a sticking joint): set by the method that answers
   const bool from_kept = options.warm_start && keptPatternApplies(model, task, fs);
   int passes = 0;
-  if (searchPatterns(model, task, fr, from_kept, patternPassBudget(options, stuck_count, from_kept), options.margin, ws,
-                     fs, acc_tolerance, passes)) {
+  if (searchPatterns(model, task, fr, from_kept, patternPassBudget(options, stuck_count, from_kept), options, ws, fs,
+                     acc_tolerance, passes)) {
     publishPatternSolution(model, task, tau, acc_tolerance, passes, from_kept, ws, fs, fr);
     rememberPattern(model, task, fr, true, fs);
     return {};

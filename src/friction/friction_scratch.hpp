@@ -56,6 +56,13 @@ struct FrictionScratch {
     margin_lo.setZero(dof);
     margin_hi.setZero(dof);
     pattern_nu.setZero(capacity);
+    free_bounded.setZero(dof, capacity);
+    free_reference.setZero(capacity);
+    free_shift.setZero(capacity);
+    free_dw.setZero(capacity);
+    free_mu.setZero(dof);
+    free_lo.setZero(dof);
+    free_hi.setZero(dof);
     pattern_rhs.setZero(capacity);
   }
 
@@ -102,14 +109,19 @@ struct FrictionScratch {
   Eigen::VectorXd pattern_tau;            // nv: τ_effective with the slipping DOFs' friction bound applied
   Eigen::VectorXd pattern_residual;       // nv: λ of the locked DOFs (prescribedDofResiduals)
   // Contacts the locks make dependent (leastEffortFriction): ν free along the balance's null directions n
-  Eigen::VectorXd pattern_direction;        // nv: λ of the locked DOFs from a unit ν along one n
-  Eigen::MatrixXd free_lambda;              // P: locked friction DOFs × nullity, those λ
-  Eigen::MatrixXd free_factor;              // nullity × nullity: R, PᵀP = R Rᵀ
-  Eigen::VectorXd free_step;                // nullity: z, ν moves by N z and λ by P z
-  std::vector<int> locked_dofs;             // the locked friction DOFs, as indices into Θ₀
-  Eigen::VectorXd free_target;              // per locked DOF: what Pᵀ is applied to (−λ₀, or h − λ₀)
-  Eigen::VectorXd margin_lo, margin_hi;     // on Θ₀: the margin box about the smallest maximiser
+  Eigen::VectorXd pattern_direction;     // nv: λ of the locked DOFs from a unit ν along one n
+  Eigen::MatrixXd free_lambda;           // P: locked friction DOFs × nullity, those λ
+  Eigen::MatrixXd free_factor;           // nullity × nullity: R, PᵀP = R Rᵀ
+  Eigen::VectorXd free_step;             // nullity: z, ν moves by N z and λ by P z
+  std::vector<int> locked_dofs;          // the locked friction DOFs, as indices into Θ₀
+  Eigen::VectorXd free_target;           // per locked DOF: what Pᵀ is applied to (−λ₀, or h − λ₀)
+  Eigen::VectorXd margin_lo, margin_hi;  // on Θ₀: the margin box about the smallest maximiser
+  // The bounded least effort (boundedLeastEffort): −Q, z_a, Rᵀ(z_b − z_a), the step in w, μ_ref and the margin box
+  // on the locked DOFs
+  Eigen::MatrixXd free_bounded;
+  Eigen::VectorXd free_reference, free_shift, free_dw, free_mu, free_lo, free_hi;
   Eigen::VectorXd pattern_nu, pattern_rhs;  // the pass's ν and balance right-hand side, kept across freeBalanceRegular
+  bool pattern_on_bounds = false;           // its μ was put on the margin box by the bounded least effort
   bool pattern_indeterminate = false;       // the pass's μ was chosen among maximisers (leastEffortFriction)
   bool sensitivities_written = false;       // FrictionResult::dqdd_dmu holds columns of the last full solve
 

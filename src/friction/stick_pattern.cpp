@@ -99,6 +99,19 @@ FreeNu freeNuEffort(const Task& task) {
   return contacts == m ? FreeNu::Fixed : contacts == 0 ? FreeNu::Own : FreeNu::None;
 }
 
+// The balance's right-hand side on the range of 𝓛: its part along the null directions (what no force can meet)
+// at rounding of it. taskResidual's test is relative to the rows' terms, ν's among them, which an ill-conditioned
+// balance makes large enough to pass a row the locks leave unmet (stress seed 72).
+bool onRange(const BalanceFactorisation& f, const Eigen::Ref<const Eigen::VectorXd>& rhs) {
+  constexpr double kRounding = 1e-9;  // of ‖r‖: r is a difference of terms its own size, computed to ε of them
+  double off2 = 0.0;
+  for (int e = 0; e < f.near_null_count; ++e) {
+    const double along = f.near_null_basis.col(e).head(rhs.size()).dot(rhs);
+    off2 += along * along;
+  }
+  return off2 <= kRounding * kRounding * rhs.squaredNorm();
+}
+
 // One pass of the sweeps with the pattern's modes, the kinematics done: false when a joint has no inertia to move or
 // the balance is not regular with the sticking DOFs locked (μ* may not be unique: the full solve chooses) — except,
 // with free_nu, exact rank loss with every row met (leastEffortFriction then chooses).
@@ -118,11 +131,11 @@ bool passOfSweeps(const Model& model, const Task& task, bool free_nu, Workspace&
       return false;
     outwardAccelerations(model, task, ws, ws.solution.qdd);
   }
+  const int m = task.solverColumns();
   if (!report.nu_unique) {  // rows the locks made dependent must still be met, or the pattern cannot hold
     taskResidual(task, ws);
-    if (!report.consistent) return false;
+    if (!report.consistent || !onRange(sw.balance_factorisation, sw.rhs.head(m))) return false;
   }
-  const int m = task.solverColumns();
   prescribedDofResiduals(model, task, ws, sw.nu_columns.head(m), ws.solution.qdd, fs.pattern_tau, fs.pattern_residual);
   return true;
 }
@@ -186,6 +199,50 @@ bool factorNormalMatrix(Eigen::Index nullity, Eigen::Index locked_count, Frictio
   return true;
 }
 
+// (b) where the unbounded least effort leaves the margin box: the bounded least-distance problem the full solve
+// solves, min ‖w − w_b‖² over lo ≤ μ_ref − Q w ≤ hi with P = Q Rᵀ (Q orthonormal, w = Rᵀ(z − z_a)), from μ_ref
+// (inside the margin box by its construction). On success μ (clamped into the box: rounding) into λ = −μ on the
+// locked DOFs, and z. z holds z_b on entry; fs.free_reference holds z_a.
+bool boundedLeastEffort(const FrictionResult& fr, int base_velocity_size, Eigen::Index nullity,
+                        Eigen::Index locked_count, int max_iterations, Eigen::Ref<Eigen::VectorXd> z,
+                        FrictionScratch& fs) {
+  const auto row = [&](Eigen::Index t) {
+    return base_velocity_size + fr.stuck[static_cast<std::size_t>(fs.locked_dofs[static_cast<std::size_t>(t)])];
+  };
+  const auto P = fs.free_lambda.topLeftCorner(locked_count, nullity);
+  const auto R = fs.free_factor.topLeftCorner(nullity, nullity);
+  auto M = fs.free_bounded.topLeftCorner(locked_count, nullity);  // −Q: Q_c = (P_c − Σ_{d<c} Q_d R_cd) / R_cc
+  for (Eigen::Index c = 0; c < nullity; ++c) {
+    M.col(c) = -P.col(c);
+    for (Eigen::Index d = 0; d < c; ++d) M.col(c) -= R(c, d) * M.col(d);
+    M.col(c) /= R(c, c);
+  }
+  auto target = fs.free_shift.head(nullity);  // Rᵀ(z_b − z_a)
+  auto shift = fs.free_dw.head(nullity);
+  for (Eigen::Index c = 0; c < nullity; ++c) {
+    double value = 0.0;
+    for (Eigen::Index d = c; d < nullity; ++d) value += R(d, c) * (z[d] - fs.free_reference[d]);
+    target[c] = value;
+  }
+  auto mu = fs.free_mu.head(locked_count), lo = fs.free_lo.head(locked_count), hi = fs.free_hi.head(locked_count);
+  for (Eigen::Index t = 0; t < locked_count; ++t) {
+    const auto a = static_cast<Eigen::Index>(fs.locked_dofs[static_cast<std::size_t>(t)]);
+    mu[t] = -(fs.pattern_residual[row(t)] + P.row(t).dot(fs.free_reference.head(nullity)));
+    lo[t] = fs.margin_lo[a];
+    hi[t] = fs.margin_hi[a];
+  }
+  shift.setZero();
+  if (!leastDistanceQp(M, target, mu, lo, hi, shift, fs.qp, max_iterations).converged) return false;
+  for (Eigen::Index t = 0; t < locked_count; ++t)
+    fs.pattern_residual[row(t)] = -std::clamp(mu[t] + M.row(t).dot(shift), lo[t], hi[t]);
+  for (Eigen::Index c = nullity - 1; c >= 0; --c) {  // z = z_a + R⁻ᵀ shift
+    double value = shift[c];
+    for (Eigen::Index d = c + 1; d < nullity; ++d) value -= R(d, c) * (z[d] - fs.free_reference[d]);
+    z[c] = fs.free_reference[c] + value / R(c, c);
+  }
+  return true;
+}
+
 // Rows the locks make dependent (feet on the ground with every joint sticking: the rigid robot stands on more rows
 // than it has coordinates; an arm holding a 6-D pose with every joint sticking: nothing moves). The pattern's
 // motion is unique, but ν is free along the balance's null directions n, and with it the locked DOFs' friction:
@@ -197,8 +254,8 @@ bool factorNormalMatrix(Eigen::Index nullity, Eigen::Index locked_count, Frictio
 // Then λ ← λ₀ + P z, ν ← ν + N z. A smallest μ outside its box breaks the pattern (the pivoting goes on); a pick
 // (b) outside the margin box (the full solve's bounded least-distance problem decides), or P's columns nearly
 // dependent (a direction the joints hardly feel): false.
-bool leastEffortFriction(const Model& model, const Task& task, const FrictionResult& fr, FreeNu effort, double margin,
-                         Workspace& ws, FrictionScratch& fs) {
+bool leastEffortFriction(const Model& model, const Task& task, const FrictionResult& fr, FreeNu effort,
+                         const FrictionOptions& options, Workspace& ws, FrictionScratch& fs) {
   WorkspaceScratch& sw = scratchOf(ws);
   const BalanceFactorisation& f = sw.balance_factorisation;
   const int m = task.solverColumns(), base_velocity_size = model.baseVelocitySize();
@@ -224,7 +281,7 @@ bool leastEffortFriction(const Model& model, const Task& task, const FrictionRes
   if (effort == FreeNu::Own && strictlyInside(model, fr, z, lo, hi, fs)) {
     for (Eigen::Index t = 0; t < locked_count; ++t) {  // the margin box about μ_ref (finite bounds only)
       const auto a = static_cast<Eigen::Index>(fs.locked_dofs[static_cast<std::size_t>(t)]);
-      const double f_a = margin * fs.breakaway[fr.stuck[static_cast<std::size_t>(a)]];
+      const double f_a = options.margin * fs.breakaway[fr.stuck[static_cast<std::size_t>(a)]];
       const double mu_ref = -(fs.pattern_residual[row(t)] + P.row(t).dot(z));
       fs.margin_lo[a] = std::isfinite(lo[a]) ? std::max(lo[a], std::min(-f_a, mu_ref)) : lo[a];
       fs.margin_hi[a] = std::isfinite(hi[a]) ? std::min(hi[a], std::max(f_a, mu_ref)) : hi[a];
@@ -233,10 +290,16 @@ bool leastEffortFriction(const Model& model, const Task& task, const FrictionRes
     prescribedTorques(model, task, ws, sw.nu_columns.head(m), ws.solution.qdd, fs.pattern_tau, fs.pattern_direction);
     for (Eigen::Index t = 0; t < locked_count; ++t)
       fs.free_target[t] = fs.pattern_direction[row(t)] + fs.pattern_tau[row(t)] - fs.pattern_residual[row(t)];
+    fs.free_reference.head(nullity) = z;  // z_a
     normalSolve(nullity, locked_count, fs, z);
-    if (!strictlyInside(model, fr, z, fs.margin_lo.head(lo.size()), fs.margin_hi.head(hi.size()), fs)) return false;
+    if (!strictlyInside(model, fr, z, fs.margin_lo.head(lo.size()), fs.margin_hi.head(hi.size()), fs)) {
+      if (!boundedLeastEffort(fr, base_velocity_size, nullity, locked_count, options.max_iterations, z, fs))
+        return false;
+      fs.pattern_on_bounds = true;  // λ set: μ may sit on the margin box
+    }
   }
-  for (Eigen::Index t = 0; t < locked_count; ++t) fs.pattern_residual[row(t)] += P.row(t).dot(z);
+  if (!fs.pattern_on_bounds)
+    for (Eigen::Index t = 0; t < locked_count; ++t) fs.pattern_residual[row(t)] += P.row(t).dot(z);
   sw.nu_columns.head(m).noalias() += f.near_null_basis.topLeftCorner(m, nullity) * z;
   // Given μ, ν is the only one (P's columns independent): the report says so, as the full solve's does.
   BalanceReport& report = ws.solution.balance;
@@ -262,7 +325,10 @@ bool freeBalanceRegular(const Model& model, const Task& task, Workspace& ws, Fri
   bool regular = inwardSweep(model, task, fs.tau_effective, ws).ok();
   if (regular) {
     balance(task, ws);
-    regular = !ws.solution.balance.singular;
+    // Certified as the regular path certifies (κ̃_F·threshold < 1): a balance the full solve cannot certify may
+    // carry rounding of its condition into its answer (stress seed 72: κ̃_F 1.3e6, nothing damped).
+    const BalanceReport& free = ws.solution.balance;
+    regular = !free.singular && free.condition * task.balance.singular_threshold < 1.0;
   }
   sw.nu_columns.head(m) = fs.pattern_nu.head(m);
   sw.rhs.head(m) = fs.pattern_rhs.head(m);
@@ -321,8 +387,12 @@ bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::Vec
     const auto e = static_cast<Eigen::Index>(a);
     const JointState state = fs.trial_state[a];
     if (locked(state)) {  // μ already in fs.mu
-      const double margin = kBoxMargin * (1.0 + fs.breakaway[j]);
-      if (!(fs.mu[e] > fs.lo[e] + margin && fs.mu[e] < fs.hi[e] - margin)) return false;
+      // The bounded least effort puts μ on its margin box by choice, among maximisers that all stick: inside Λ
+      // is all it needs.
+      const double margin = fs.pattern_on_bounds ? 0.0 : kBoxMargin * (1.0 + fs.breakaway[j]);
+      const bool inside = fs.pattern_on_bounds ? fs.mu[e] >= fs.lo[e] && fs.mu[e] <= fs.hi[e]
+                                               : fs.mu[e] > fs.lo[e] + margin && fs.mu[e] < fs.hi[e] - margin;
+      if (!inside) return false;
     } else if (state == JointState::SlipPositive) {
       if (!(qdd[v] > slip_margin)) return false;
       fs.mu[e] = fs.hi[e];
@@ -336,8 +406,9 @@ bool patternHolds(const Model& model, const FrictionResult& fr, const Eigen::Vec
 }
 
 // The passes from the start pattern: true when one holds.
-bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& fr, int max_passes, double margin,
-                    Workspace& ws, FrictionScratch& fs, double& acc_tolerance, int& passes) {
+bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& fr, int max_passes,
+                    const FrictionOptions& options, Workspace& ws, FrictionScratch& fs, double& acc_tolerance,
+                    int& passes) {
   WorkspaceScratch& sw = scratchOf(ws);
   const FreeNu effort = freeNuEffort(task);
   const bool free_nu = effort != FreeNu::None;
@@ -352,8 +423,9 @@ bool pivotToOptimum(const Model& model, const Task& task, const FrictionResult& 
     if (!free_nu && sw.prescribed_count + task.balanceRows() > model.nv()) return false;
     ++passes;
     fs.pattern_indeterminate = false;
+    fs.pattern_on_bounds = false;
     if (!passOfSweeps(model, task, free_nu, ws, fs)) return false;
-    if (!ws.solution.balance.nu_unique && !leastEffortFriction(model, task, fr, effort, margin, ws, fs)) return false;
+    if (!ws.solution.balance.nu_unique && !leastEffortFriction(model, task, fr, effort, options, ws, fs)) return false;
     const int broken = brokenConditions(model, fr, ws.solution.qdd, fs);
     if (broken < 0) return false;
     if (broken == 0)
@@ -377,14 +449,15 @@ bool keptPatternApplies(const Model& model, const Task& task, const FrictionScra
 }
 
 bool searchPatterns(const Model& model, const Task& task, const FrictionResult& fr, bool from_kept, int max_passes,
-                    double margin, Workspace& ws, FrictionScratch& fs, double& acc_tolerance, int& passes) {
+                    const FrictionOptions& options, Workspace& ws, FrictionScratch& fs, double& acc_tolerance,
+                    int& passes) {
   passes = 0;
   if (fr.stuck.empty() || max_passes < 1) return false;
   if (from_kept)
     startFromKept(fr, fs);
   else
     startSticking(fr, fs);
-  const bool held = pivotToOptimum(model, task, fr, max_passes, margin, ws, fs, acc_tolerance, passes);
+  const bool held = pivotToOptimum(model, task, fr, max_passes, options, ws, fs, acc_tolerance, passes);
   bindTaskModes(task, scratchOf(ws));  // the stages after it (the task's prescribed torques, the full solve) read them
   return held;
 }

@@ -18,7 +18,8 @@
 //   hd_traj/<model>, fric_warm_traj/<model>
 //                          along a trajectory of a 1 kHz loop (makeTrajectory; <model> = panda, N=64,
 //                          humanoid): the plain solve on each state, the friction solve warm-started from the
-//                          state before; worst_warm_traj/panda: 10⁶ of those calls, each timed
+//                          state before; worst_warm_traj/panda: 10⁶ of those calls, each timed, and the
+//                          plain solve's on the same states between them (plain_*)
 //   grid_{free,ee6}_k{1,2} the report's method: 21 friction values per stuck joint, one full
 //                          solveHybridDynamics per grid point, keep the largest g(μ)
 //   naivepg_{free,ee6}_k{1,2}
@@ -702,14 +703,14 @@ void benchFriction(benchmark::State& state, const Problem* p, TaskKind kind, int
 // guarantees). Each call is timed on its own with steady_clock (its overhead,
 // some 20 ns, is included); counters give the maximum and the tail.
 
-void setQuantileCounters(benchmark::State& state, std::vector<double>& ns) {
+void setQuantileCounters(benchmark::State& state, std::vector<double>& ns, const std::string& prefix = "") {
   std::sort(ns.begin(), ns.end());
   auto quantile = [&](double q) { return ns[std::min(ns.size() - 1, static_cast<std::size_t>(q * ns.size()))]; };
-  state.counters["calls"] = static_cast<double>(ns.size());
-  state.counters["median_ns"] = quantile(0.5);
-  state.counters["p99_ns"] = quantile(0.99);
-  state.counters["p99.99_ns"] = quantile(0.9999);
-  state.counters["max_ns"] = ns.back();
+  state.counters[prefix + "calls"] = static_cast<double>(ns.size());
+  state.counters[prefix + "median_ns"] = quantile(0.5);
+  state.counters[prefix + "p99_ns"] = quantile(0.99);
+  state.counters[prefix + "p99.99_ns"] = quantile(0.9999);
+  state.counters[prefix + "max_ns"] = ns.back();
 }
 
 void benchWorstCase(benchmark::State& state, const Problem* p, TaskKind kind, int calls) {
@@ -897,25 +898,45 @@ void benchTrajectoryFriction(benchmark::State& state, const Problem* p, const Tr
   state.counters["warm_share"] = warm;
 }
 
+// The friction solve's tail and, interleaved call by call on the same states, the plain solve's (plain_*): what
+// the machine adds to any call (interrupts, migrations) shows in both.
 void benchTrajectoryWorstCase(benchmark::State& state, const Problem* p, const Trajectory* t, int calls) {
-  Workspace ws(p->model, t->task);
+  Workspace ws(p->model, t->task), ws_plain(p->model, t->task);
   const double warm = warmShare(*p, *t, ws);
-  std::vector<double> ns(static_cast<std::size_t>(calls));
+  std::vector<double> ns(static_cast<std::size_t>(calls)), ns_plain(static_cast<std::size_t>(calls));
   for (auto _ : state) {
     std::size_t i = 0;
     for (int c = 0; c < calls; ++c) {
       const auto t0 = std::chrono::steady_clock::now();
       const Status s = solveWithFriction(p->model, ws, t->q[i], t->qd[i], t->tau[i], t->task, t->options);
       const auto t1 = std::chrono::steady_clock::now();
+      const Status s_plain = solveHybridDynamics(p->model, ws_plain, t->q[i], t->qd[i], t->tau[i], t->task);
+      const auto t2 = std::chrono::steady_clock::now();
       benchmark::DoNotOptimize(s.code);
+      benchmark::DoNotOptimize(s_plain.code);
       benchmark::DoNotOptimize(ws.solution.qdd.data());
+      benchmark::DoNotOptimize(ws_plain.solution.qdd.data());
       ns[static_cast<std::size_t>(c)] = std::chrono::duration<double, std::nano>(t1 - t0).count();
+      ns_plain[static_cast<std::size_t>(c)] = std::chrono::duration<double, std::nano>(t2 - t1).count();
       i = i + 1 == t->q.size() ? 0 : i + 1;
     }
   }
   setTrajectoryCounters(state, *p, *t);
   state.counters["warm_share"] = warm;
+  // Each state's fastest call over the passes (the machine's interruptions removed; the warm start sees the same
+  // state before it every pass): their median and slowest are the solver's own on this trajectory.
+  const std::size_t states = t->q.size();
+  auto perState = [&](const std::vector<double>& times, const std::string& prefix) {
+    std::vector<double> fastest(states, std::numeric_limits<double>::infinity());
+    for (std::size_t c = 0; c < times.size(); ++c) fastest[c % states] = std::min(fastest[c % states], times[c]);
+    std::sort(fastest.begin(), fastest.end());
+    state.counters[prefix + "state_median_ns"] = fastest[states / 2];
+    state.counters[prefix + "state_max_ns"] = fastest.back();
+  };
+  perState(ns, "");
+  perState(ns_plain, "plain_");
   setQuantileCounters(state, ns);
+  setQuantileCounters(state, ns_plain, "plain_");
 }
 
 // ---------------------------------------------------------------------------

@@ -1089,28 +1089,41 @@ void constraintTorques(const Model& model, const Task& task, Workspace& ws, cons
 namespace {
 // prescribedTorques and prescribedContactTorques: with kMotion the whole torque, without it the contacts' part;
 // with kEveryColumn every constraint force acts on the bodies, not only the contacts' (prescribedDofResiduals).
-template <bool kMotion, bool kEveryColumn = false>
-void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
-                          const double* qdd, const double* tau, Eigen::Ref<Eigen::VectorXd> tau_c) {
-  WorkspaceScratch& sw = scratchOf(ws);
-  if (sw.prescribed_count == 0) return;
+// What the joint of body i transmits to its subtree: on a chain (kChain) one running sum from the tip, kept in a
+// register; on a tree each body's slot of sw.f collects its children's.
+template <bool kMotion, bool kEveryColumn, bool kChain>
+void subtreeTorques(const Model& model, const Task& task, WorkspaceScratch& sw, int lowest, const VectorRef& nu_solver,
+                    const double* qdd, const double* tau, Eigen::Ref<Eigen::VectorXd> tau_c) {
   const int N = model.nv();
-  // The bodies before the first prescribed DOF's lie in no prescribed DOF's subtree (depth-first order).
-  int lowest = 1;
-  while (!isPrescribed(sw, lowest - 1)) ++lowest;
-  for (int i = lowest; i <= N; ++i) sw.f[at(i)].setZero();
   const std::vector<char>& contact = solverOrder(task).contactColumns();
   const Eigen::VectorXd& rotor_inertia = model.rotorInertia();
+  Vec6 carried = Vec6::Zero();
+  if (!kChain)
+    for (int i = lowest; i <= N; ++i) sw.f[at(i)].setZero();
   for (int i = N; i >= lowest; --i) {
-    Vec6& f = sw.f[at(i)];  // what the joint of body i transmits to its subtree
+    Vec6& f = kChain ? carried : sw.f[at(i)];
     if (kMotion) f += sw.I[at(i)] * sw.a[at(i)] + sw.Fbias[at(i)];
     const int own_first = solverOrder(task).columnsEnd(i + 1), own_end = solverOrder(task).columnsEnd(i);
     for (int col = own_first; col < own_end; ++col)
       if (kEveryColumn || contact[at(col)]) f.noalias() -= sw.A_body.col(col) * nu_solver[col];
     if (isPrescribed(sw, i - 1))
       tau_c[i - 1] = sw.S[at(i)].dot(f) + (kMotion ? rotor_inertia[i - 1] * qdd[i - 1] - tau[i - 1] : 0.0);
-    if (model.parent(i) >= lowest) sw.f[at(model.parent(i))] += f;
+    if (!kChain && model.parent(i) >= lowest) sw.f[at(model.parent(i))] += f;
   }
+}
+
+template <bool kMotion, bool kEveryColumn = false>
+void prescribedDofTorques(const Model& model, const Task& task, Workspace& ws, const VectorRef& nu_solver,
+                          const double* qdd, const double* tau, Eigen::Ref<Eigen::VectorXd> tau_c) {
+  WorkspaceScratch& sw = scratchOf(ws);
+  if (sw.prescribed_count == 0) return;
+  // The bodies before the first prescribed DOF's lie in no prescribed DOF's subtree (depth-first order).
+  int lowest = 1;
+  while (!isPrescribed(sw, lowest - 1)) ++lowest;
+  if (model.isChain())
+    subtreeTorques<kMotion, kEveryColumn, true>(model, task, sw, lowest, nu_solver, qdd, tau, tau_c);
+  else
+    subtreeTorques<kMotion, kEveryColumn, false>(model, task, sw, lowest, nu_solver, qdd, tau, tau_c);
 }
 }  // namespace
 

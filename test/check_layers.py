@@ -15,6 +15,8 @@ allowed = {
     "model": {"model"},
     "dynamics": {"linalg", "model", "dynamics"},  # model/task_layout.hpp: the task's constraints as the solver reads them
     "friction": {"linalg", "qp", "model", "dynamics", "friction"},
+    # Motion over time: the library's public API only (solveWithFriction, integrate, …).
+    "simulation": {"simulation"},
     # The MJCF loader (zwang_mujoco, optional): above the model layer through its public API and
     # model/loader_messages.hpp, the messages it spells as the URDF loader does.
     "mujoco": {"mujoco", "model"},

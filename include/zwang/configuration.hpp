@@ -73,6 +73,21 @@ Status integrate(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q,
 Status difference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
                   const Eigen::Ref<const Eigen::VectorXd>& q1, Eigen::Ref<Eigen::VectorXd> v_out) noexcept;
 
+/// u̇ for q(t) = q₀ ⊕ u(t) moving with the velocity v (q₀ fixed; u, v, u̇_out
+/// nv() entries each, u̇_out not sharing memory with them): what a Runge–Kutta
+/// step on the configuration space integrates (the Munthe-Kaas form: u
+/// starts at 0 each step, q = q₀ ⊕ u stays on the space, quaternions unit).
+///   Spherical : dexp⁻¹_u(ω) = ω + ½ u × ω + (1/12) u × (u × ω), the inverse
+///               right Jacobian of SO(3) to second order in u;
+///   Free      : the same series in the bracket of se(3), with u = [ρ; φ] and
+///               v = [v; ω]: [u, v] = [φ × v + ρ × ω; φ × ω];
+///   Planar, one-DOF : v itself (their coordinates add).
+/// Second order in u is what a method of order four needs (the terms left
+/// out are O(h³) in a step of length h and enter its error at O(h⁵):
+/// Munthe-Kaas, "High order Runge–Kutta methods on manifolds", 1999).
+Status tangentRate(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& u,
+                   const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Ref<Eigen::VectorXd> u_dot_out) noexcept;
+
 /// The neutral configuration: every multi-DOF joint (the base's root joint
 /// too) at the origin of its joint frame with the identity orientation (q_w =
 /// 1, ψ = 0), each one-DOF joint at 0 clamped into its limits. A leader is clamped into the range that also keeps

@@ -20,6 +20,7 @@ enum class StatusCode {
   MimicMismatch,      ///< a mimic joint's q or q̇ does not follow its leader's (Model::followLeaders)
   BadConfiguration,   ///< q is no pose: a free base's quaternion off unit length
   NotComputed,        ///< a query for results the workspace does not hold (kinematics.hpp): compute them first
+  EventCascade,       ///< a simulation step met more events than SimulationOptions::max_events_per_step (Zeno)
 };
 
 /// The result of a hot-path call: a code and, on error, a message naming the input at fault.

@@ -11,6 +11,7 @@
 #include "zwang/model.hpp"
 #include "zwang/orientation.hpp"
 #include "zwang/placement.hpp"
+#include "zwang/simulation.hpp"
 #include "zwang/status.hpp"
 #include "zwang/task.hpp"
 #include "zwang/urdf.hpp"

@@ -337,6 +337,32 @@ void differenceJoint(JointType type, const double* q0, const double* q1, double*
   }
 }
 
+// out = dexp⁻¹_u(v) to second order in u: v + ½[u, v] + (1/12)[u, [u, v]], [·,·] the joint's Lie bracket.
+void tangentRateJoint(JointType type, const double* u, const double* v, double* out) {
+  switch (type) {
+    case JointType::Revolute:
+    case JointType::Continuous:
+    case JointType::Prismatic: out[0] = v[0]; return;
+    case JointType::Planar:
+      for (int k = 0; k < 3; ++k) out[k] = v[k];
+      return;
+    case JointType::Spherical: {  // so(3): [u, ω] = u × ω
+      const Vec3 phi = ConstVec3Map(u), w = ConstVec3Map(v);
+      const Vec3 bracket = phi.cross(w);
+      Vec3Map{out} = w + 0.5 * bracket + phi.cross(bracket) / 12.0;
+      return;
+    }
+    case JointType::Free: {  // se(3): [(ρ, φ), (v, ω)] = (φ × v + ρ × ω, φ × ω)
+      const Vec3 rho = ConstVec3Map(u), phi = ConstVec3Map(u + 3), lin = ConstVec3Map(v), w = ConstVec3Map(v + 3);
+      const Vec3 b_lin = phi.cross(lin) + rho.cross(w), b_ang = phi.cross(w);
+      const Vec3 bb_lin = phi.cross(b_lin) + rho.cross(b_ang), bb_ang = phi.cross(b_ang);
+      Vec3Map{out} = lin + 0.5 * b_lin + bb_lin / 12.0;
+      Vec3Map{out + 3} = w + 0.5 * b_ang + bb_ang / 12.0;
+      return;
+    }
+  }
+}
+
 // The neutral coordinates of allJoints()[j]: the identity pose, a one-DOF
 // joint's 0 clamped into its (leader) range.
 void neutralJoint(const Model& model, std::size_t j, double* out) {
@@ -479,6 +505,15 @@ Status difference(const Model& model, const ConstVector& q0, const ConstVector& 
   }
   for (const Joint& joint : model.allJoints())
     differenceJoint(joint.type, q0.data() + joint.q_index, q1.data() + joint.q_index, v_out.data() + joint.v_index);
+  return {};
+}
+
+Status tangentRate(const Model& model, const ConstVector& u, const ConstVector& v, Vector u_dot_out) noexcept {
+  if (Status s = checkVelocity(model, "u", u); !s) return s;
+  if (Status s = checkVelocity(model, "v", v); !s) return s;
+  if (u_dot_out.size() != model.nv()) return sizeMismatch(model, "u_dot_out", u_dot_out.size(), true);
+  for (const Joint& joint : model.allJoints())
+    tangentRateJoint(joint.type, u.data() + joint.v_index, v.data() + joint.v_index, u_dot_out.data() + joint.v_index);
   return {};
 }
 

@@ -35,6 +35,7 @@ const char* codeName(StatusCode code) {
     case StatusCode::MimicMismatch: return "MimicMismatch";
     case StatusCode::BadConfiguration: return "BadConfiguration";
     case StatusCode::NotComputed: return "NotComputed";
+    case StatusCode::EventCascade: return "EventCascade";
   }
   return "Unknown";
 }

@@ -967,3 +967,60 @@ TEST_CASE("the centre-of-mass and centroidal-momentum calls allocate nothing and
                                Status(const Model&, Workspace&, const Eigen::Ref<const Eigen::VectorXd>&, int,
                                       Eigen::Ref<Eigen::MatrixXd>) noexcept>);
 }
+
+TEST_CASE("a simulation's step loop allocates nothing: both integrators, breakaways, stops and a limit reached") {
+  const Model model = panda();
+  Task task(model);
+  Workspace ws(model, task);
+  const Eigen::VectorXd q0 = Eigen::VectorXd::Constant(7, 0.3);
+  REQUIRE(inverseDynamics(model, ws, q0, Eigen::VectorXd::Zero(7), Eigen::VectorXd::Zero(7), task));
+  const Eigen::VectorXd gravity = ws.tau;
+  for (const Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RungeKutta4}) {
+    SimulationOptions options;
+    options.integrator = integrator;
+    options.friction.breakaway = Eigen::VectorXd::Constant(7, 2.0);
+    options.friction.kinetic = Eigen::VectorXd::Constant(7, 1.5);
+    Simulation sim(model, task, options);
+    REQUIRE(sim.reset(q0, Eigen::VectorXd::Zero(7)));
+    // Gravity compensated at q0 and a swing of 3 N·m: joints break away, stop and stick again.
+    const TorqueSchedule tau = [&gravity](double t, Eigen::Ref<Eigen::VectorXd> out) {
+      for (Eigen::Index j = 0; j < 7; ++j) out[j] = gravity[j] + 3.0 * std::sin(2.0 * M_PI * (1.0 + 0.3 * j) * t);
+    };
+    const Eigen::VectorXd held = gravity + Eigen::VectorXd::Constant(7, 2.5);  // a push within the boxes, held
+    bool ok = true;
+    const long count = allocationsDuring([&] {
+      for (int k = 0; k < 1500; ++k) ok = (k < 200 ? sim.step(held) : sim.stepWith(tau)).ok() && ok;
+    });
+    CHECK(ok);
+    CHECK(sim.events().size() >= 10);
+    CHECK(count == 0);
+  }
+}
+
+TEST_CASE("a simulation's step loop allocates nothing when a joint stops at its limit") {
+  Joint j;
+  j.name = "hinge";
+  j.axis = Vec3::UnitY();
+  j.lower = -0.5;
+  j.upper = 0.5;
+  j.breakaway_friction = j.kinetic_friction = 0.05;
+  const RigidInertia link =
+      RigidInertia::fromMassComInertia(1.0, Vec3(0, 0, -0.5), Vec3(0.01, 0.01, 0.01).asDiagonal());
+  const Model model = ModelBuilder("pendulum", "base").addJoint(j, "link", link).build();
+  Task task(model);
+  for (const Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RungeKutta4}) {
+    SimulationOptions options;
+    options.integrator = integrator;
+    Simulation sim(model, task, options);
+    REQUIRE(sim.reset(Eigen::VectorXd::Constant(1, 0.2), Eigen::VectorXd::Constant(1, 3.0)));
+    const Eigen::VectorXd tau = Eigen::VectorXd::Zero(1);
+    bool ok = true;
+    const long count = allocationsDuring([&] {
+      for (int k = 0; k < 400; ++k) ok = sim.step(tau).ok() && ok;
+    });
+    CHECK(ok);
+    CHECK(std::count_if(sim.events().begin(), sim.events().end(),
+                        [](const SimulationEvent& e) { return e.kind == EventKind::Limit; }) >= 1);
+    CHECK(count == 0);
+  }
+}

@@ -49,7 +49,8 @@ inline bool documented(StatusCode code) {
     case StatusCode::Infeasible:
     case StatusCode::MimicMismatch:
     case StatusCode::BadConfiguration: return true;
-    case StatusCode::NotComputed: return false;
+    case StatusCode::NotComputed:
+    case StatusCode::EventCascade: return false;
   }
   return false;
 }

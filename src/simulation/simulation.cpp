@@ -87,8 +87,8 @@ Simulation::Simulation(const Model& model, const Task& task, const SimulationOpt
       ws_trial_(model, task),
       ws_impulse_(model, task) {
   const auto nv = static_cast<Eigen::Index>(model.nv()), nq = static_cast<Eigen::Index>(model.nq());
-  for (Eigen::VectorXd* v : {&qd_, &qdd_start_, &tau_, &held_, &tau_unit_, &qdd_unit_, &qd_trial_, &qd_stage_, &u_stage_,
-                             &qdd_stage_, &k_u_, &k_qd_, &rate_})
+  for (Eigen::VectorXd* v : {&qd_, &qdd_start_, &tau_, &held_, &tau_unit_, &qdd_unit_, &qd_trial_, &qd_stage_,
+                             &u_stage_, &qdd_stage_, &k_u_, &k_qd_, &rate_})
     v->setZero(nv);
   for (Eigen::VectorXd* v : {&q_, &q_trial_, &q_stage_}) v->setZero(nq);
   motion_.assign(at(model.dof()), Motion::Stuck);

@@ -18,7 +18,8 @@
 //   hd_traj/<model>, fric_warm_traj/<model>
 //                          along a trajectory of a 1 kHz loop (makeTrajectory; <model> = panda, N=64,
 //                          humanoid): the plain solve on each state, the friction solve warm-started from the
-//                          state before; worst_warm_traj/panda: 10⁶ of those calls, each timed, and the
+//                          state before; sim_{euler,rk4}/<model>: Simulation steps with the trajectory's torques
+//                          (sim_per_wall: simulated seconds per wall second); worst_warm_traj/panda: 10⁶ of those calls, each timed, and the
 //                          plain solve's on the same states between them (plain_*)
 //   grid_{free,ee6}_k{1,2} the report's method: 21 friction values per stuck joint, one full
 //                          solveHybridDynamics per grid point, keep the largest g(μ)
@@ -898,6 +899,38 @@ void benchTrajectoryFriction(benchmark::State& state, const Problem* p, const Tr
   state.counters["warm_share"] = warm;
 }
 
+// Simulation (issue #29): the trajectory's torques held over 1 ms steps from its first state, events located, the
+// friction warm-started; one step per iteration (a reset every kTrajectorySteps). sim_per_wall: simulated seconds
+// per wall second.
+void benchSimulation(benchmark::State& state, const Problem* p, const Trajectory* t, Integrator integrator) {
+  SimulationOptions options;
+  options.integrator = integrator;
+  options.friction = t->options;
+  Simulation sim(p->model, t->task, options);
+  if (!firstSolveSucceeded(state, sim.reset(t->q[0], t->qd[0]))) return;
+  std::size_t k = 0;
+  long events = 0, runs = 0;
+  for (auto _ : state) {
+    const Status s = sim.step(t->tau[k]);
+    if (!s) {
+      state.SkipWithError(s.message);
+      return;
+    }
+    if (++k == t->tau.size()) {
+      events += static_cast<long>(sim.events().size());
+      ++runs;
+      state.PauseTiming();
+      k = 0;
+      if (!sim.reset(t->q[0], t->qd[0])) state.SkipWithError("reset failed");
+      state.ResumeTiming();
+    }
+  }
+  setTrajectoryCounters(state, *p, *t);
+  state.counters["sim_per_wall"] = benchmark::Counter(1e-3, benchmark::Counter::kIsIterationInvariantRate);
+  // Over the whole runs (2 s each); the events of the one cut short when timing stopped left out.
+  state.counters["events_per_run"] = runs > 0 ? static_cast<double>(events) / static_cast<double>(runs) : -1.0;
+}
+
 // The friction solve's tail and, interleaved call by call on the same states, the plain solve's (plain_*): what
 // the machine adds to any call (interrupts, migrations) shows in both.
 void benchTrajectoryWorstCase(benchmark::State& state, const Problem* p, const Trajectory* t, int calls) {
@@ -1268,6 +1301,10 @@ int main(int argc, char** argv) {
   for (const auto& [p, t] : trajectories) {
     reg("hd_traj", *p, [p = p, t = t.get()](benchmark::State& s) { benchTrajectoryHybrid(s, p, t); });
     reg("fric_warm_traj", *p, [p = p, t = t.get()](benchmark::State& s) { benchTrajectoryFriction(s, p, t); });
+    reg("sim_euler", *p,
+        [p = p, t = t.get()](benchmark::State& s) { benchSimulation(s, p, t, Integrator::SemiImplicitEuler); });
+    reg("sim_rk4", *p,
+        [p = p, t = t.get()](benchmark::State& s) { benchSimulation(s, p, t, Integrator::RungeKutta4); });
     if (p->label == "panda")
       benchmark::RegisterBenchmark(
           ("worst_warm_traj/" + p->label).c_str(),

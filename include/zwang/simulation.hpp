@@ -117,8 +117,8 @@ class Simulation {
   double time() const { return t_; }                 ///< now [s]
   const Eigen::VectorXd& q() const { return q_; }    ///< the configuration now (Model::nq() entries)
   const Eigen::VectorXd& qd() const { return qd_; }  ///< the velocity now (Model::nv() entries)
-  /// The solve at the state the last step started from (q̈ with the sticking DOFs' entries exactly 0, τ_control,
-  /// ν, …) and its friction (μ, the states).
+  /// The last start solve of the last step (q̈ with the sticking DOFs' entries exactly 0, τ_control, ν, …): at the
+  /// state the step started from, or, when an event cut the step, at the last event's instant.
   const Solution& solution() const { return ws_.solution; }
   /// The friction of that solve: μ per DOF, the states, tau_friction (a moving DOF's kinetic friction).
   const FrictionResult& friction() const { return ws_.friction; }

@@ -411,13 +411,17 @@ void Simulation::updateEnergyNow() noexcept {
   if (centerOfMass(*model_, ws_impulse_, q_, kWholeRobot, c)) energy_.potential = -total_mass_ * task_->gravity.dot(c);
 }
 
-// ---- Each DOF moving now keeps its direction's kinetic friction until the step ends or its velocity reaches zero
-// (an event, which ends the trial): the solve gets none for it (nor for its mimic joints), evaluate applies it.
+// ---- Each DOF moving now (or breaking away) keeps its direction's kinetic friction until the step ends or its
+// velocity reaches zero (an event, which ends the trial): the solve gets none for it (nor for its mimic joints),
+// evaluate applies it.
 void Simulation::freezeSlipDirections() noexcept {
   const int base = model_->baseVelocitySize();
   for (int j = 0; j < model_->dof(); ++j) {
     const double v = qd_[base + j];
     slip_sign_[at(j)] = eventDof(j) && v != 0.0 ? (v > 0.0 ? 1 : -1) : 0;
+    // A located breakaway not yet moving: it slips the way |μ| reached f, under kinetic friction (its q̈ at the
+    // instant is 0⁺ with f_c = f, the solve's rounding of it either sign).
+    if (eventDof(j) && v == 0.0 && breaking_[at(j)]) slip_sign_[at(j)] = motion_[at(j)] == Motion::Positive ? 1 : -1;
   }
   for (int j = 0; j < model_->dof(); ++j) {
     const int leader = mimic_of_[at(j)];

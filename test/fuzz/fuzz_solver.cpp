@@ -9,7 +9,7 @@
 // base state (a free base's quaternion unit, off unit by 1e-12–1e-2, or any,
 // zero included), base velocities and generalized forces; contacts and joint
 // rows among the task's rows; prescribed and locked DOFs. Calls solveHybridDynamics, both friction
-// maximisers, RNEA, CRBA and a Jacobian.
+// maximisers, RNEA, CRBA and a Jacobian, and two steps of a Simulation (either integrator, a drawn step).
 //
 // Fails (abort) when a call that returns Ok — or Infeasible, whose outputs
 // docs/friction.md promises finite — leaves a NaN or Inf in its outputs, when a
@@ -544,6 +544,39 @@ void runSolves(const Model& model, const Task& task, const Eigen::VectorXd& q, c
   }
 }
 
+// A few steps of a Simulation from the state (issue #29): both integrators, a drawn step, the drawn friction options;
+// the statuses documented ones (or EventCascade, the simulation's own), the state finite with unit quaternions, the
+// events inside the time simulated and in time order, the energy finite.
+void runSimulation(FuzzedDataProvider& in, const Model& model, const Task& task, const Eigen::VectorXd& q,
+                   const Eigen::VectorXd& qd, const Eigen::VectorXd& tau, const FrictionOptions& friction) {
+  SimulationOptions options;
+  options.friction = friction;
+  options.friction.method = FrictionMethod::Automatic;  // the loop's own choice (runSolves left the last one forced)
+  options.friction.warm_start = in.ConsumeBool();
+  options.dt = logUniform(in, 1e-5, 1e-2);
+  options.integrator = in.ConsumeBool() ? Integrator::RungeKutta4 : Integrator::SemiImplicitEuler;
+  options.max_events_per_step = 4;  // an input stays well inside the fuzzer's 1 s
+  Simulation sim(model, task, options);
+  Status status = sim.reset(q, qd);
+  const char* where = "Simulation";
+  for (int k = 0; k < 2 && status.ok(); ++k) status = sim.step(tau);
+  if (!fuzz::documented(status.code) && status.code != StatusCode::EventCascade)
+    fuzz::failure("undocumented status", where);
+  if (!status.ok()) return;
+  fuzz::requireFinite(sim.q(), "q", where);
+  fuzz::requireFinite(sim.qd(), "qd", where);
+  if (!checkConfiguration(model, sim.q())) fuzz::failure("a quaternion off unit length after a step", where);
+  double last = 0.0;
+  for (const SimulationEvent& e : sim.events()) {
+    if (!(e.t >= last && e.t <= sim.time()))
+      fuzz::failure("an event out of order or outside the time simulated", where);
+    last = e.t;
+  }
+  const EnergyLedger& energy = sim.energy();
+  fuzz::requireFinite(energy.kinetic + energy.potential + energy.motor_effort + energy.friction_dissipation, "energy",
+                      where);
+}
+
 // Quaternions refused: normalizeConfiguration must fix any finite non-zero
 // ones, every joint's (docs/conventions.md), and the solve then take them.
 void checkNormalisation(const Model& model, const Task& task, Eigen::VectorXd q, const Eigen::VectorXd& qd,
@@ -589,5 +622,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Workspace ws(model, task);
   runSolves(model, task, q, qd, tau, options, ws);
   checkNormalisation(model, task, q, qd, tau, ws);
+  runSimulation(in, model, task, q, qd, tau, options);
   return 0;
 }

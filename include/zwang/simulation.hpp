@@ -152,7 +152,8 @@ class Simulation {
   const Task* task_;
   SimulationOptions options_;
   Workspace ws_, ws_trial_, ws_impulse_;
-  double t_ = 0.0;
+  double t_ = 0.0, t_reset_ = 0.0;
+  long steps_ = 0;  // since reset: each step ends at t_reset_ + steps_ · dt exactly, not at a sum of dt's
   Eigen::VectorXd q_, qd_;
   // The step's start: its solve (qdd_start_, powers), and the trial's stages and end state.
   Eigen::VectorXd qdd_start_, tau_, held_, tau_unit_, qdd_unit_;

@@ -125,6 +125,7 @@ int reportExitCode(const ReportCommand& report, bool all_ok, const std::string& 
 int commandSolve(int argc, char** argv);
 // `zwang forward-dynamics PROBLEM.json`: the same problem, solved without constraints or friction.
 int commandForwardDynamics(int argc, char** argv);
+int commandSimulate(int argc, char** argv);
 int commandInfo(int argc, char** argv);
 // `zwang fk MODEL.urdf [--q Q] …` or `zwang fk PROBLEM.json`: frame poses and the centre of mass (fk.cpp).
 int commandFk(int argc, char** argv);

@@ -47,6 +47,21 @@ constexpr const char* kForwardDynamicsUsage =
     "\n"
     "Exit codes: 0 solved, 1 error (file, JSON, model, solver), 2 usage.\n";
 
+constexpr const char* kSimulateUsage =
+    "usage: zwang simulate PROBLEM.json [-o FILE] [--pretty]\n"
+    "\n"
+    "Simulate the problem over time (docs/simulation.md): its \"simulate\" section gives\n"
+    "\"duration\", \"dt\" (default 0.001) and \"integrator\" (\"euler\" or \"rk4\"); \"tau\" is\n"
+    "held, or a \"schedule\" gives it over time (piecewise linear). Friction as the\n"
+    "\"friction\" section says (none without one); stick, slip and limit events are\n"
+    "located inside the steps. Prints t, q, qd per step, the solve's tau_control, mu and\n"
+    "states, the events and the energy as JSON.\n"
+    "\n"
+    "  -o, --output FILE  write the result to FILE instead of stdout\n"
+    "  --pretty           indent the JSON for humans\n"
+    "\n"
+    "Exit codes: 0 simulated, 1 error (file, JSON, model, a step refused), 2 usage.\n";
+
 constexpr const char* kInfoUsage =
     "usage: zwang info MODEL.urdf [--root LINK] [--tip LINK] [--base free|planar] [--strict]\n"
     "                  [--attach-beyond-tip] [--lock-mimic] [--json]\n"
@@ -151,6 +166,7 @@ constexpr const char* kCommandsUsage =
     "commands:\n"
     "  solve PROBLEM.json [-o FILE] [--pretty]        solve a JSON problem, print the solution as JSON\n"
     "  forward-dynamics PROBLEM.json [-o FILE]        q̈ of the unconstrained robot (no constraints, no friction)\n"
+    "  simulate PROBLEM.json [-o FILE] [--pretty]     the motion over time, stick-slip events located, as JSON\n"
     "  info MODEL.urdf [--root L] [--tip L] [--json]  base, joints, frames and mass of a URDF tree or chain\n"
     "  info MODEL.xml [--json]                        the same of an MJCF model (zwang built with MuJoCo)\n"
     "  fk MODEL.urdf [--q Q] | fk PROBLEM.json        frame poses and centre of mass at one state, as JSON\n"
@@ -170,6 +186,7 @@ constexpr const char* kCommandsUsage =
 const char* usageText(const std::string& command) {
   const std::pair<const char*, const char*> usages[] = {{"solve", kSolveUsage},
                                                         {"forward-dynamics", kForwardDynamicsUsage},
+                                                        {"simulate", kSimulateUsage},
                                                         {"info", kInfoUsage},
                                                         {"fk", kFkUsage},
                                                         {"scenarios", kScenariosUsage},

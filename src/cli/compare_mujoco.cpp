@@ -137,12 +137,6 @@ std::string number(double x) {
 }
 std::string seconds(double t) { return number(t) + " s"; }
 
-Json array(const Eigen::Ref<const Eigen::VectorXd>& v) {
-  Json out = Json::array();
-  for (Eigen::Index k = 0; k < v.size(); ++k) out.push_back(v[k]);
-  return out;
-}
-
 Json states(const std::vector<JointState>& state) {
   Json out = Json::array();
   for (const JointState s : state) out.push_back(toString(s));

@@ -43,12 +43,6 @@ Model loadModel(const Arguments& args) {
   }
 }
 
-Json array(const Eigen::Ref<const Eigen::VectorXd>& v) {
-  Json out = Json::array();
-  for (Eigen::Index k = 0; k < v.size(); ++k) out.push_back(v[k]);
-  return out;
-}
-
 Json reportJson(const problem::KinematicsReport& report, const Eigen::VectorXd& q) {
   Json frames = Json::object();
   for (const problem::FramePose& f : report.frames)

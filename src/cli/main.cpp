@@ -2,6 +2,7 @@
 //
 //   zwang solve PROBLEM.json [-o FILE] [--pretty]
 //   zwang forward-dynamics PROBLEM.json [-o FILE] [--pretty]
+//   zwang simulate PROBLEM.json [-o FILE] [--pretty]
 //   zwang info MODEL.urdf [--root L] [--tip L] [--json]
 //   zwang fk MODEL.urdf [--q Q] [--root L] [--tip L] [--base B] [--pretty] | zwang fk PROBLEM.json [--pretty]
 //   zwang scenarios [--out DIR] [--models DIR] [--no-plots]
@@ -35,6 +36,7 @@ int run(int argc, char** argv) {
   }
   if (command == "solve") return commandSolve(argc, argv);
   if (command == "forward-dynamics") return commandForwardDynamics(argc, argv);
+  if (command == "simulate") return commandSimulate(argc, argv);
   if (command == "info") return commandInfo(argc, argv);
   if (command == "fk") return commandFk(argc, argv);
   if (command == "scenarios") return commandScenarios(argc, argv);

@@ -368,6 +368,13 @@ void placeState(const JsonReader& in, const Problem& p, BoundProblem& b) {
   placeJointValues(in, m, p.q, "q", true, b.q);
   placeJointValues(in, m, p.qd, "qd", false, b.qd);
   placeJointValues(in, m, p.tau, "tau", false, b.tau);
+  for (std::size_t k = 0; k < p.schedule.values.size(); ++k) {  // each knot as "tau", the base's force held
+    Eigen::VectorXd tau = Eigen::VectorXd::Zero(m.nv());
+    tau.head(p.base.force.size()) = p.base.force;
+    placeJointValues(in, m, p.schedule.values[k], childPath("schedule.tau.values", k).c_str(), false, tau);
+    b.schedule_tau.push_back(tau);
+  }
+  b.schedule_t = p.schedule.t;
   for (const ConstraintSpec& c : p.constraints)  // joint rows: every joint known, one target per DOF
     if (!c.desc.joint.empty()) (void)jointRowIndex(in, m, c);
   if (p.follow_leaders) m.followLeaders(b.q, b.qd);  // the followers' entries of "q" and "qd" are replaced
@@ -410,6 +417,41 @@ void buildTask(const JsonReader& in, const Problem& p, BoundProblem& b) {
   }
 }
 
+// "simulate": {"duration", "dt", "integrator"}; the ranges are the problem layer's.
+SimulateSpec parseSimulate(const JsonReader& in, const Json& value, const std::string& path) {
+  in.object(value, path, {"duration", "dt", "integrator"});
+  SimulateSpec s;
+  s.present = true;
+  if (!value.contains("duration")) in.fail(childPath(path, "duration"), "missing (the simulated time [s])");
+  s.duration = in.number(value["duration"], childPath(path, "duration"));
+  if (value.contains("dt")) s.dt = in.number(value["dt"], childPath(path, "dt"));
+  if (value.contains("integrator")) {
+    const std::string text = in.string(value["integrator"], childPath(path, "integrator"));
+    s.integrator = atPath(in, childPath(path, "integrator"), [&] { return problem::parseIntegrator(kJson, text); });
+  }
+  s.steps = atPath(in, path, [&] { return problem::simulationSteps(s.duration, s.dt); });
+  return s;
+}
+
+// "schedule": {"tau": {"t": [t0, t1, …], "values": [τ0, τ1, …]}}, each τ_k as "tau" is written.
+ScheduleSpec parseSchedule(const JsonReader& in, const Json& value, const std::string& path) {
+  in.object(value, path, {"tau"});
+  ScheduleSpec s;
+  s.present = true;
+  const std::string tau_path = childPath(path, "tau");
+  if (!value.contains("tau")) in.fail(tau_path, "missing (\"t\" and \"values\")");
+  const Json& tau = value["tau"];
+  in.object(tau, tau_path, {"t", "values"});
+  if (!tau.contains("t") || !tau.contains("values")) in.fail(tau_path, "needs \"t\" and \"values\"");
+  const Eigen::VectorXd t = in.numbers(tau["t"], childPath(tau_path, "t"));
+  s.t.assign(t.data(), t.data() + t.size());
+  const Json& list = in.array(tau["values"], childPath(tau_path, "values"));
+  for (std::size_t k = 0; k < list.size(); ++k)
+    s.values.push_back(parseJointValues(in, list[k], childPath(childPath(tau_path, "values"), k)));
+  atPath(in, tau_path, [&] { problem::checkSchedule(s.t, s.values.size()); });
+  return s;
+}
+
 }  // namespace
 
 Problem readProblem(const std::string& file) {
@@ -417,10 +459,11 @@ Problem readProblem(const std::string& file) {
   const Json doc = parseJson(text, file);
   const JsonReader in(file);
   if (!doc.is_object()) in.fail("", "the problem must be a JSON object, got " + describe(doc));
-  in.object(doc, "",
-            {"model", "root", "tip", "strict", "attach_beyond_tip", "lock_mimic", "follow_leaders", "gravity", "q",
-             "qd", "tau", "rotor_inertia", "breakaway", "wrenches", "constraints", "joint_modes", "friction", "balance",
-             "base"});
+  in.object(doc, "", {"model",       "root",           "tip",       "strict",   "attach_beyond_tip",
+                      "lock_mimic",  "follow_leaders", "gravity",   "q",        "qd",
+                      "tau",         "rotor_inertia",  "breakaway", "wrenches", "constraints",
+                      "joint_modes", "friction",       "balance",   "base",     "simulate",
+                      "schedule"});
 
   Problem p;
   p.file = file;
@@ -457,6 +500,10 @@ Problem readProblem(const std::string& file) {
   if (doc.contains("friction")) p.friction = parseFriction(in, doc["friction"], "friction");
   if (doc.contains("balance")) p.balance = parseBalance(in, doc["balance"], "balance");
   if (doc.contains("base")) p.base = parseBase(in, doc["base"], "base");
+  if (doc.contains("simulate")) p.simulate = parseSimulate(in, doc["simulate"], "simulate");
+  if (doc.contains("schedule")) p.schedule = parseSchedule(in, doc["schedule"], "schedule");
+  if (p.schedule.present && !p.simulate.present)
+    in.fail("schedule", "has no effect without a \"simulate\" section (zwang simulate runs it)");
   if (p.breakaway && !p.friction.present)
     in.fail("breakaway", "has no effect without a \"friction\" section (add \"friction\": {} to solve with friction)");
   return p;
@@ -472,7 +519,7 @@ BoundProblem bindProblem(const Problem& p) {
   FrictionOptions friction = p.friction.options;
   if (p.breakaway) friction.breakaway = *p.breakaway;
   atPath(in, "", [&] { problem::checkFrictionOverrides(model, friction); });
-  BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, std::move(friction), {}, {}};
+  BoundProblem b{std::move(model), nullptr, {}, {}, {}, false, std::move(friction), {}, {}, {}, {}};
   placeState(in, p, b);
   buildTask(in, p, b);
   if (!p.gravity && file_gravity) b.task->gravity = *file_gravity;  // an MJCF file's gravity, unless the problem's

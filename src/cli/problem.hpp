@@ -57,6 +57,22 @@ struct JointModeSpec {
   problem::JointModeDesc desc;
 };
 
+// "simulate" (zwang simulate, docs/cli.md): the run's length, step and integrator.
+struct SimulateSpec {
+  bool present = false;
+  double duration = 0.0;  // [s]
+  double dt = 1e-3;       // [s]
+  Integrator integrator = Integrator::SemiImplicitEuler;
+  long steps = 0;  // ceil(duration / dt)
+};
+
+// "schedule": {"tau": {"t": [...], "values": [...]}}: τ at each time (each value like "tau"), piecewise linear.
+struct ScheduleSpec {
+  bool present = false;
+  std::vector<double> t;
+  std::vector<JointValues> values;
+};
+
 // The problem as written, checked for everything that does not need the model.
 struct Problem {
   std::string file;        // the problem file, as given on the command line
@@ -76,6 +92,8 @@ struct Problem {
   FrictionSpec friction;
   BalanceOptions balance;  // "balance" (defaults when absent)
   BaseSpec base;           // "base" (a fixed base when absent, unless the URDF floats: then an error)
+  SimulateSpec simulate;   // "simulate" (zwang simulate only)
+  ScheduleSpec schedule;   // "schedule" (zwang simulate only)
 };
 
 // Read, parse and check a problem file; CliError "FILE: PATH: what" on any fault.
@@ -92,6 +110,9 @@ struct BoundProblem {
   // The reported frames the task's constraint rows act on: constrained or reference frames (not joint rows'),
   // whose constraint wrench the solution reports.
   std::vector<int> constrained_frames;
+  // "schedule.tau" in full (nv entries each, the base's from "base.force"), at schedule_t.
+  std::vector<double> schedule_t;
+  std::vector<Eigen::VectorXd> schedule_tau;
 };
 
 // Load the model (rotor_inertia applied), check lengths and frames, build the

@@ -8,13 +8,13 @@
 
 namespace zwang::cli {
 
-namespace {
-
 Json array(const Eigen::Ref<const Eigen::VectorXd>& v) {
   Json out = Json::array();
   for (Eigen::Index k = 0; k < v.size(); ++k) out.push_back(v[k]);
   return out;
 }
+
+namespace {
 
 void pretty(const Json& value, int indent, std::string& out) {
   const std::string pad(static_cast<std::size_t>(indent), ' ');

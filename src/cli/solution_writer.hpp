@@ -8,6 +8,9 @@
 
 namespace zwang::cli {
 
+// A JSON array of the vector's numbers.
+Json array(const Eigen::Ref<const Eigen::VectorXd>& v);
+
 // Keys, in this order: joints, dofs (the names of the per-DOF entries), qdd,
 // tau_constraint, tau_control (per DOF below the root),
 // base (only for a floating base: its type, acceleration, acceleration_world,

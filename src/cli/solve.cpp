@@ -39,6 +39,9 @@ int runProblem(const char* command, Solver solver, int argc, char** argv) {
   const std::string output = args.has("--output") ? args.value("--output") : args.value("-o");
 
   const Problem problem = readProblem(args.positional[0]);
+  if (problem.simulate.present)
+    throw CliError(kExitError, problem.file + ": " + command +
+                                   ": the problem has a \"simulate\" section (zwang simulate runs it over time)");
   BoundProblem bound = bindProblem(problem);
   if (solver == Solver::ForwardDynamics && bound.with_friction)
     throw CliError(kExitError, problem.file + ": " + command +

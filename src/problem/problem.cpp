@@ -1,6 +1,7 @@
 // The problem layer's checks and messages (problem.hpp).
 #include "problem.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -27,7 +28,7 @@ std::string number(double value) {
   return buffer;
 }
 
-[[noreturn]] void badValue(const char* key, const std::string& what, double value) {
+[[noreturn]] void badValue(const std::string& key, const std::string& what, double value) {
   throw ProblemError(Fault::Value, key, what + ", got " + number(value));
 }
 
@@ -302,6 +303,55 @@ void checkBalance(const BalanceOptions& o) {
              o.rank_tolerance);
   if (!(o.residual_tolerance > 0.0 && std::isfinite(o.residual_tolerance)))
     badValue("residual_tolerance", "must be finite and positive", o.residual_tolerance);
+}
+
+Integrator parseIntegrator(const Spelling& spelling, const std::string& text) {
+  if (text == "euler") return Integrator::SemiImplicitEuler;
+  if (text == "rk4") return Integrator::RungeKutta4;
+  throw ProblemError(Fault::Value, "",
+                     "unknown integrator " + quoted(spelling, text) + " (one of " + quoted(spelling, "euler") + ", " +
+                         quoted(spelling, "rk4") + ")");
+}
+
+long simulationSteps(double duration, double dt) {
+  if (!(duration > 0.0 && std::isfinite(duration))) badValue("duration", "must be finite and > 0 [s]", duration);
+  if (!(dt > 0.0 && std::isfinite(dt))) badValue("dt", "must be finite and > 0 [s]", dt);
+  const double steps = std::ceil(duration / dt - 1e-9);  // a duration that is a whole number of steps, to rounding
+  if (!(steps <= static_cast<double>(kMaxSimulationSteps)))
+    throw ProblemError(Fault::Value, "dt",
+                       "gives " + number(steps) + " steps for duration " + number(duration) + " s; at most " +
+                           std::to_string(kMaxSimulationSteps) + " (a larger dt or a shorter run)");
+  return static_cast<long>(steps);
+}
+
+void checkSchedule(const std::vector<double>& t, std::size_t value_count) {
+  if (t.empty()) throw ProblemError(Fault::Value, "t", "is empty (at least one time)");
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (!std::isfinite(t[k])) badValue("t[" + std::to_string(k) + "]", "must be finite", t[k]);
+    if (k > 0 && !(t[k] > t[k - 1]))
+      badValue("t[" + std::to_string(k) + "]",
+               "must be after t[" + std::to_string(k - 1) + "] (" + number(t[k - 1]) + ")", t[k]);
+  }
+  if (value_count != t.size())
+    throw ProblemError(Fault::Value, "values",
+                       "has " + std::to_string(value_count) + " entries, expected one per time (" +
+                           std::to_string(t.size()) + ")");
+}
+
+void scheduleAt(const std::vector<double>& t, const std::vector<Eigen::VectorXd>& values, double time,
+                Eigen::Ref<Eigen::VectorXd> out) {
+  if (time <= t.front()) {
+    out = values.front();
+    return;
+  }
+  if (time >= t.back()) {
+    out = values.back();
+    return;
+  }
+  const std::size_t k =
+      static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), time) - t.begin());  // t[k−1] < time < t[k]
+  const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
+  out = (1.0 - w) * values[k - 1] + w * values[k];
 }
 
 void checkFriction(const FrictionOptions& o) {

@@ -158,6 +158,22 @@ void checkFrictionOverrides(const Model& model, const FrictionOptions& options);
 void checkBalance(const BalanceOptions& options);
 void checkFriction(const FrictionOptions& options);
 
+// A simulation's integrator: "euler" or "rk4"; ProblemError(Value) naming both.
+Integrator parseIntegrator(const Spelling& spelling, const std::string& text);
+
+// The most steps one simulation may write (each a row of the output).
+constexpr long kMaxSimulationSteps = 1000000;
+// The steps of a run of `duration` in steps of `dt` (the last one may end past it by less than a step):
+// ProblemError(Value, "duration" or "dt") for a value not finite and > 0, or more than kMaxSimulationSteps steps.
+long simulationSteps(double duration, double dt);
+
+// A piecewise-linear schedule's knots: at least one, finite and strictly increasing (ProblemError(Value, "t")),
+// with as many values (ProblemError(Value, "values")).
+void checkSchedule(const std::vector<double>& t, std::size_t value_count);
+// Its value at `time`: linear between knots, the first before them and the last after them.
+void scheduleAt(const std::vector<double>& t, const std::vector<Eigen::VectorXd>& values, double time,
+                Eigen::Ref<Eigen::VectorXd> out);
+
 // The solve a problem asks for: with friction when it has friction options, else plain.
 inline Status solve(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
                     const Eigen::Ref<const Eigen::VectorXd>& qd, const Eigen::Ref<const Eigen::VectorXd>& tau,

@@ -151,7 +151,8 @@ Status Simulation::reset(const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen
   if (!qd.allFinite()) return Status::error(StatusCode::NonFinite, "qd has an entry that is not finite");
   q_ = q;
   qd_ = qd;
-  t_ = t;
+  t_ = t_reset_ = t;
+  steps_ = 0;
   events_.clear();
   std::fill(breaking_.begin(), breaking_.end(), 0);
   energy_ = EnergyLedger{};
@@ -486,7 +487,7 @@ Status Simulation::acceptTrial(double s_at, double remaining, double t_end) noex
 // ---- One step of length h: start solve, trial, events, accept; again for what an event left of the step.
 Status Simulation::advance(double h, const TorqueSchedule* schedule, const Eigen::VectorXd* held) noexcept {
   if (!ready_) return Status::error(StatusCode::BadOption, "simulation: reset(q, qd) before the first step");
-  const double t_start = t_, t_end = t_ + h;
+  const double t_start = t_, t_end = t_reset_ + static_cast<double>(steps_ + 1) * h;
   for (int events = 0; t_ < t_end; ++events) {
     if (events > options_.max_events_per_step)
       return Status::error(StatusCode::EventCascade,
@@ -507,6 +508,7 @@ Status Simulation::advance(double h, const TorqueSchedule* schedule, const Eigen
       if (Status s = locateEvent(remaining, g_end, schedule, held, s_at); !s) return s;
     if (Status s = acceptTrial(s_at, remaining, t_end); !s) return s;
   }
+  ++steps_;
   return {};
 }
 

@@ -2214,3 +2214,96 @@ TEST_CASE("frames' wrench_world and wrench_local: closed form, and the tool and 
   CHECK_FALSE(loaded["frames"]["tip"].contains("wrench_world"));
   CHECK_FALSE(loaded["frames"]["tip"].contains("wrench_local"));
 }
+
+// ---------------------------------------------------------------------------
+// zwang simulate (docs/cli.md, "zwang simulate"; docs/simulation.md): the report's arm under a torque ramp.
+
+namespace {
+// A problem of the ramp arm (simulate_ramp.json) with `replace` swapped in for `pattern`, written to scratch.
+std::string rampVariant(const std::string& name, const std::string& pattern, const std::string& replace) {
+  std::string text = cli_test::readText(problem("simulate_ramp.json"));
+  const std::size_t at = text.find(pattern);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, pattern.size(), replace);
+  const std::string relative = "../../../models";  // the model from the scratch directory
+  text.replace(text.find(relative), relative.size(), ZWANG_MODELS_DIR);
+  const std::string path = cli_test::scratchDir() + "/" + name;
+  cli_test::writeText(path, text);
+  return path;
+}
+}  // namespace
+
+TEST_CASE("simulate: the 1-DOF arm under a ramp sticks, slips and sticks again at the closed form's times",
+          "[simulate]") {
+  const Run r = run({"simulate", problem("simulate_ramp.json")});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  const Json s = parse(r.out);
+  CHECK(s["dofs"] == Json::array({"joint1"}));
+  CHECK(s["simulate"]["integrator"] == "rk4");
+  CHECK(s["simulate"]["steps"] == 2600);
+  // Breakaway at τ = f (0.5 s), at rest at 1 + (1 + √2)/2 s (∫(τ − f) dt = 0 again), away again at τ = −f (2.5 s).
+  const Json& events = s["events"];
+  REQUIRE(events.size() == 3);
+  const double expected[] = {0.5, 1.0 + 0.5 * (1.0 + std::sqrt(2.0)), 2.5};
+  const char* kinds[] = {"slip+", "stick", "slip-"};
+  for (std::size_t k = 0; k < 3; ++k) {
+    CHECK(events[k]["joint"] == "joint1");
+    CHECK(events[k]["kind"] == kinds[k]);
+    CHECK(events[k]["t"].get<double>() == Approx(expected[k]).margin(1e-9));
+  }
+  // 2601 states (the start and each step's end) on the grid; 2600 solves.
+  REQUIRE(s["t"].size() == 2601);
+  CHECK(s["t"][1000].get<double>() == 1.0);
+  CHECK(s["t"][2600].get<double>() == Approx(2.6).epsilon(1e-15));
+  CHECK(s["q"].size() == 2601);
+  CHECK(s["state"].size() == 2600);
+  CHECK(s["mu"][100][0].get<double>() == Approx(2.0).margin(1e-9));  // sticking at t = 0.1 s: μ = τ = 20 t
+  CHECK(s["state"][100][0] == "stick");
+  // At rest from the stop to the breakaway: not a bit of creep.
+  const double q_rest = s["q"][2300][0].get<double>();
+  for (std::size_t k = 2210; k <= 2499; ++k) CHECK(s["q"][k][0].get<double>() == q_rest);
+  // RK4 is exact for this motion (q̈ linear in t): q at rest is the closed form's ∫∫ (τ − f)/I.
+  const double d = 0.5, T = 0.5 * (1.0 + std::sqrt(2.0)), a = 20.0, I = 2.25;
+  const double q_closed = a * d * d * d / (6 * I) + a * d * d / (2 * I) * T + a / I * (0.5 * d * T * T - T * T * T / 6);
+  CHECK(q_rest == Approx(q_closed).epsilon(1e-9));
+  CHECK(std::abs(s["energy"]["balance_error"].get<double>()) < 1e-9);
+  CHECK(s["energy"]["friction_dissipation"].get<double>() > 0.0);
+}
+
+TEST_CASE("simulate: bad sections are refused with the key at fault; solve refuses a simulate section", "[simulate]") {
+  struct Case {
+    const char* name;
+    std::string pattern, replace, message;
+  };
+  const Case cases[] = {
+      {"no_duration.json", "\"duration\": 2.6, ", "", "simulate.duration: missing (the simulated time [s])"},
+      {"bad_dt.json", "\"dt\": 0.001", "\"dt\": -1", "simulate.dt: must be finite and > 0 [s], got -1"},
+      {"bad_integrator.json", "\"rk4\"", "\"leapfrog\"",
+       "simulate.integrator: unknown integrator \"leapfrog\" (one of \"euler\", \"rk4\")"},
+      {"too_many.json", "\"dt\": 0.001", "\"dt\": 1e-9", "at most 1000000"},
+      {"t_order.json", "[0, 1, 3]", "[0, 3, 1]", "schedule.tau.t[2]: must be after t[1] (3), got 1"},
+      {"values_count.json", "[[0], [20], [-20]]", "[[0], [20]]",
+       "schedule.tau.values: has 2 entries, expected one per time (3)"},
+      {"values_length.json", "[[0], [20], [-20]]", "[[0], [20, 1], [-20]]", "schedule.tau.values[1]: has 2 entries"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.name);
+    const Run r = run({"simulate", rampVariant(c.name, c.pattern, c.replace)});
+    checkOneLineError(r, 1);
+    CHECK(contains(r.err, c.message));
+  }
+  // A schedule without "simulate", and "simulate" given to solve.
+  const std::string no_simulate = rampVariant(
+      "no_simulate.json", "\"simulate\": { \"duration\": 2.6, \"dt\": 0.001, \"integrator\": \"rk4\" },", "");
+  Run r = run({"simulate", no_simulate});
+  checkOneLineError(r, 1);
+  CHECK(contains(r.err, "schedule: has no effect without a \"simulate\" section"));
+  r = run({"solve", problem("simulate_ramp.json")});
+  checkOneLineError(r, 1);
+  CHECK(contains(r.err, "solve: the problem has a \"simulate\" section (zwang simulate runs it over time)"));
+  r = run({"simulate", problem("arm_stick.json")});
+  checkOneLineError(r, 1);
+  CHECK(contains(r.err, "simulate: the problem has no \"simulate\" section"));
+}

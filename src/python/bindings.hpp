@@ -161,4 +161,17 @@ void bindModel(py::module_& m);
 void bindSolve(py::module_& m);
 void bindConfiguration(py::module_& m);  // configuration.cpp
 
+// solve()'s arguments read as solve() reads them, for another entry point (simulate): the task (cached in the
+// workspace), the friction options (nullptr: none), and copies of q, q̇, τ.
+struct SolveInputs {
+  Task* task;
+  const FrictionOptions* friction;
+  Eigen::VectorXd q, qd, tau;
+};
+SolveInputs solveInputs(const std::shared_ptr<Model>& model, py::handle ws_obj, py::handle q, py::handle qd,
+                        py::handle tau, py::handle constraints, py::handle wrenches, py::handle friction,
+                        py::handle gravity, py::handle balance, py::handle modes);
+
+void bindSimulate(py::module_& m);
+
 }  // namespace zwang::python

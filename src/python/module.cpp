@@ -110,5 +110,6 @@ PYBIND11_MODULE(zwang, m) {
 
   bindModel(m);
   bindSolve(m);
+  bindSimulate(m);
   bindConfiguration(m);
 }

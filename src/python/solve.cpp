@@ -1132,6 +1132,13 @@ void bindDynamics(py::module_& m) {
 
 }  // namespace
 
+SolveInputs solveInputs(const std::shared_ptr<Model>& model, py::handle ws_obj, py::handle q, py::handle qd,
+                        py::handle tau, py::handle constraints, py::handle wrenches, py::handle friction,
+                        py::handle gravity, py::handle balance, py::handle modes) {
+  const SolveArgs a = solveArgs(model, ws_obj, q, qd, tau, constraints, wrenches, friction, gravity, balance, modes);
+  return {&a.task, a.friction, a.q, a.qd, a.tau};
+}
+
 void bindSolve(py::module_& m) {
   bindWorkspace(m);
   bindConstraint(m);

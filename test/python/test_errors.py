@@ -228,6 +228,8 @@ calls = [lambda a, b, c: zwang.solve(m, ws, a, b, c),
          lambda a, b, c: zwang.frame_jacobian(m, ws, a, b, c),
          lambda a, b, c: zwang.inverse_dynamics(m, ws, a, b, c),
          lambda a, b, c: zwang.Workspace(a, b),
+         lambda a, b, c: zwang.simulate(m, ws, a, b, c, duration=0.01),
+         lambda a, b, c: zwang.simulate(m, ws, np.zeros(7), duration=a, dt=b, schedule_t=c, schedule_tau=c),
          lambda a, b, c: zwang.load_urdf_string(a, b, c)]
 rng = random.Random(3)
 count = 0

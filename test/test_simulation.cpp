@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "support/simulation_models.hpp"
 #include "zwang/zwang.hpp"
 
 using namespace zwang;
@@ -240,16 +241,7 @@ TEST_CASE("simulation: RK4 is fourth order and Euler first order on a chain with
 }
 
 TEST_CASE("simulation: a pendulum falling onto its limit stops there, inelastically") {
-  Joint j;
-  j.name = "hinge";
-  j.axis = Vec3::UnitY();
-  j.lower = -0.5;
-  j.upper = 0.5;
-  j.breakaway_friction = 0.05;
-  j.kinetic_friction = 0.05;
-  const RigidInertia link =
-      RigidInertia::fromMassComInertia(1.0, Vec3(0, 0, -0.5), Vec3(0.01, 0.01, 0.01).asDiagonal());
-  const Model model = ModelBuilder("pendulum", "base").addJoint(j, "link", link).build();
+  const Model model = zwang::testing::limitPendulum();
   Task task(model);
   SimulationOptions options;
   options.integrator = Integrator::RungeKutta4;

@@ -56,6 +56,14 @@ struct Arguments {
 Arguments parseArguments(const std::string& command, int argc, char** argv, int first,
                          const std::vector<std::string>& flags, const std::vector<std::string>& with_value);
 
+// The arguments of a command on one problem file: PROBLEM.json [-o|--output FILE] [--pretty]. nullopt after
+// printing the command's usage for --help; UsageError for no file or more than one.
+struct ProblemArguments {
+  std::string file, output;  // output empty: stdout
+  bool pretty = false;
+};
+std::optional<ProblemArguments> problemArguments(const char* command, int argc, char** argv);
+
 // One printable line (the problem layer's: its messages and the tool's cut names alike).
 using problem::printable;
 

@@ -197,6 +197,18 @@ const char* usageText(const std::string& command) {
   return kCommandsUsage;
 }
 
+std::optional<ProblemArguments> problemArguments(const char* command, int argc, char** argv) {
+  const Arguments args = parseArguments(command, argc, argv, 2, {"--pretty"}, {"-o", "--output"});
+  if (args.help) {
+    std::fputs(usageText(command), stdout);
+    return std::nullopt;
+  }
+  if (args.positional.size() != 1)
+    throw UsageError(command, args.positional.empty() ? "no problem file given" : "more than one problem file given");
+  return ProblemArguments{args.positional[0], args.has("--output") ? args.value("--output") : args.value("-o"),
+                          args.has("--pretty")};
+}
+
 bool Arguments::has(const std::string& name) const {
   for (const auto& option : options)
     if (option.first == name) return true;

@@ -65,16 +65,11 @@ SimulationOptions simulationOptions(const Model& model, const Problem& problem, 
 
 int commandSimulate(int argc, char** argv) {
   const char* command = "simulate";
-  const Arguments args = parseArguments(command, argc, argv, 2, {"--pretty"}, {"-o", "--output"});
-  if (args.help) {
-    std::fputs(usageText(command), stdout);
-    return kExitOk;
-  }
-  if (args.positional.size() != 1)
-    throw UsageError(command, args.positional.empty() ? "no problem file given" : "more than one problem file given");
-  const std::string output = args.has("--output") ? args.value("--output") : args.value("-o");
+  const std::optional<ProblemArguments> args = problemArguments(command, argc, argv);
+  if (!args) return kExitOk;  // --help, printed
+  const std::string& output = args->output;
 
-  const Problem problem = readProblem(args.positional[0]);
+  const Problem problem = readProblem(args->file);
   if (!problem.simulate.present)
     throw CliError(kExitError, problem.file +
                                    ": simulate: the problem has no \"simulate\" section (its \"duration\" "
@@ -121,7 +116,7 @@ int commandSimulate(int argc, char** argv) {
   out["state"] = std::move(record.state);
   out["events"] = std::move(events);
   out["energy"] = energyJson(sim.energy());
-  writeOutput(output, (args.has("--pretty") ? prettyDump(out) : out.dump()) + "\n");
+  writeOutput(output, (args->pretty ? prettyDump(out) : out.dump()) + "\n");
   return kExitOk;
 }
 

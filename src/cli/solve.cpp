@@ -29,16 +29,11 @@ Status solveBound(Solver solver, const BoundProblem& bound, Workspace& ws) {
 }
 
 int runProblem(const char* command, Solver solver, int argc, char** argv) {
-  const Arguments args = parseArguments(command, argc, argv, 2, {"--pretty"}, {"-o", "--output"});
-  if (args.help) {
-    std::fputs(usageText(command), stdout);
-    return kExitOk;
-  }
-  if (args.positional.size() != 1)
-    throw UsageError(command, args.positional.empty() ? "no problem file given" : "more than one problem file given");
-  const std::string output = args.has("--output") ? args.value("--output") : args.value("-o");
+  const std::optional<ProblemArguments> args = problemArguments(command, argc, argv);
+  if (!args) return kExitOk;  // --help, printed
+  const std::string& output = args->output;
 
-  const Problem problem = readProblem(args.positional[0]);
+  const Problem problem = readProblem(args->file);
   if (problem.simulate.present)
     throw CliError(kExitError, problem.file + ": " + command +
                                    ": the problem has a \"simulate\" section (zwang simulate runs it over time)");
@@ -58,7 +53,7 @@ int runProblem(const char* command, Solver solver, int argc, char** argv) {
 
   const Json solution = solutionJson(bound.model, ws, *bound.task, bound.with_friction, status, bound.reported_frames,
                                      bound.constrained_frames);
-  writeOutput(output, (args.has("--pretty") ? prettyDump(solution) : solution.dump()) + "\n");
+  writeOutput(output, (args->pretty ? prettyDump(solution) : solution.dump()) + "\n");
   if (bound.with_friction)
     if (const std::string impact = problem::limitImpactMessage(bound.model, ws.friction); !impact.empty())
       std::fprintf(stderr, "zwang: warning: %s: %s\n", problem.file.c_str(), impact.c_str());

@@ -13,6 +13,7 @@
 #include "support/bad_inputs.hpp"
 #include "support/random_chain.hpp"
 #include "support/random_problem.hpp"
+#include "support/simulation_models.hpp"
 #include "zwang/zwang.hpp"
 
 using namespace zwang;
@@ -998,15 +999,7 @@ TEST_CASE("a simulation's step loop allocates nothing: both integrators, breakaw
 }
 
 TEST_CASE("a simulation's step loop allocates nothing when a joint stops at its limit") {
-  Joint j;
-  j.name = "hinge";
-  j.axis = Vec3::UnitY();
-  j.lower = -0.5;
-  j.upper = 0.5;
-  j.breakaway_friction = j.kinetic_friction = 0.05;
-  const RigidInertia link =
-      RigidInertia::fromMassComInertia(1.0, Vec3(0, 0, -0.5), Vec3(0.01, 0.01, 0.01).asDiagonal());
-  const Model model = ModelBuilder("pendulum", "base").addJoint(j, "link", link).build();
+  const Model model = zwang::testing::limitPendulum();
   Task task(model);
   for (const Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RungeKutta4}) {
     SimulationOptions options;
